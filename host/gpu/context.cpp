@@ -1,0 +1,214 @@
+#include "gpu/context.h"
+
+#include <algorithm>
+#include <cctype>
+#include <iostream>
+#include <optional>
+
+#include "errors.h"
+
+namespace vkray::gpu {
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return s;
+}
+
+std::string type_name(vk::PhysicalDeviceType type) {
+  switch (type) {
+    case vk::PhysicalDeviceType::eDiscreteGpu: return "discrete GPU";
+    case vk::PhysicalDeviceType::eIntegratedGpu: return "integrated GPU";
+    case vk::PhysicalDeviceType::eVirtualGpu: return "virtual GPU";
+    case vk::PhysicalDeviceType::eCpu: return "CPU";
+    default: return "other";
+  }
+}
+
+// Lower is better: discrete, then integrated, then virtual, then CPU (lavapipe).
+int type_rank(vk::PhysicalDeviceType type) {
+  switch (type) {
+    case vk::PhysicalDeviceType::eDiscreteGpu: return 0;
+    case vk::PhysicalDeviceType::eIntegratedGpu: return 1;
+    case vk::PhysicalDeviceType::eVirtualGpu: return 2;
+    case vk::PhysicalDeviceType::eCpu: return 3;
+    default: return 4;
+  }
+}
+
+std::string version_string(uint32_t v) {
+  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+         std::to_string(VK_API_VERSION_PATCH(v));
+}
+
+std::optional<uint32_t> compute_queue_family(const vk::raii::PhysicalDevice& pd) {
+  const auto families = pd.getQueueFamilyProperties();
+  for (uint32_t i = 0; i < families.size(); ++i)
+    if (families[i].queueFlags & vk::QueueFlagBits::eCompute) return i;
+  return std::nullopt;
+}
+
+vk::raii::Instance make_instance(const vk::raii::Context& context, bool validation) {
+  if (context.enumerateInstanceVersion() < VK_API_VERSION_1_2)
+    throw DeviceError("the Vulkan loader supports only Vulkan " + version_string(context.enumerateInstanceVersion()) +
+                      "; vkray needs 1.2");
+  std::vector<const char*> layers, extensions;
+  if (validation) {
+    const auto available = context.enumerateInstanceLayerProperties();
+    if (std::none_of(available.begin(), available.end(),
+                     [](const vk::LayerProperties& p) { return std::string_view(p.layerName) == kValidationLayer; }))
+      throw DeviceError(std::string(kValidationLayer) +
+                        " is not installed (Debian: apt-get install vulkan-validationlayers)");
+    layers.push_back(kValidationLayer);
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  const vk::ApplicationInfo app("vkray", 1, "vkray", 1, VK_API_VERSION_1_2);
+  // Synchronization validation on top of the default checks: a missing barrier is a bug too.
+  const vk::ValidationFeatureEnableEXT enables[] = {vk::ValidationFeatureEnableEXT::eSynchronizationValidation};
+  const vk::ValidationFeaturesEXT features(enables);
+  vk::InstanceCreateInfo info({}, &app, layers, extensions);
+  if (validation) info.pNext = &features;
+  return vk::raii::Instance(context, info);
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                     VkDebugUtilsMessageTypeFlagsEXT,
+                                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  auto* self = static_cast<std::pair<ValidationLog*, bool>*>(user);
+  const char* level = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
+  std::string message = std::string("validation ") + level + ": " + (data->pMessage ? data->pMessage : "");
+  if (self->second) std::cerr << "vkray: " << message << "\n";
+  self->first->add(std::move(message));
+  return VK_FALSE;  // never abort the call: we report, then fail at the next check
+}
+
+}  // namespace
+
+void ValidationLog::add(std::string message) {
+  std::lock_guard lock(mutex_);
+  messages_.push_back(std::move(message));
+}
+std::vector<std::string> ValidationLog::messages() const {
+  std::lock_guard lock(mutex_);
+  return messages_;
+}
+size_t ValidationLog::count() const {
+  std::lock_guard lock(mutex_);
+  return messages_.size();
+}
+
+std::vector<DeviceInfo> list_devices() {
+  vk::raii::Context context;
+  vk::raii::Instance instance = make_instance(context, false);
+  std::vector<DeviceInfo> result;
+  const vk::raii::PhysicalDevices devices(instance);
+  for (uint32_t i = 0; i < devices.size(); ++i) {
+    const auto& pd = devices[i];
+    const auto chain = pd.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
+    const auto& props = chain.get<vk::PhysicalDeviceProperties2>().properties;
+    const auto& driver = chain.get<vk::PhysicalDeviceDriverProperties>();
+    uint64_t local = 0;
+    const auto memory = pd.getMemoryProperties();
+    for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
+      if (memory.memoryHeaps[h].flags & vk::MemoryHeapFlagBits::eDeviceLocal) local += memory.memoryHeaps[h].size;
+    result.push_back({i, props.deviceName.data(), type_name(props.deviceType),
+                      std::string(driver.driverName.data()) + " " + driver.driverInfo.data(),
+                      version_string(props.apiVersion), compute_queue_family(pd).has_value(),
+                      props.limits.maxComputeWorkGroupInvocations, props.limits.maxTexelBufferElements,
+                      props.limits.maxStorageBufferRange, local});
+  }
+  return result;
+}
+
+Context::Context(const ContextOptions& options)
+    : validation_(options.validation),
+      log_(options.validation_log ? options.validation_log : std::make_shared<ValidationLog>()),
+      echo_(options.echo_validation) {
+  instance_ = make_instance(context_, validation_);
+  if (validation_) {
+    using S = vk::DebugUtilsMessageSeverityFlagBitsEXT;
+    using T = vk::DebugUtilsMessageTypeFlagBitsEXT;
+    callback_data_ = {log_.get(), echo_};
+    messenger_ = vk::raii::DebugUtilsMessengerEXT(
+        instance_, vk::DebugUtilsMessengerCreateInfoEXT({}, S::eWarning | S::eError,
+                                                        T::eGeneral | T::eValidation | T::ePerformance,
+                                                        &on_validation_message, &callback_data_));
+  }
+
+  // ---- choose the physical device ----
+  vk::raii::PhysicalDevices devices(instance_);
+  if (devices.empty()) throw DeviceError("no Vulkan device found (install mesa-vulkan-drivers for lavapipe)");
+  std::optional<size_t> chosen;
+  if (!options.device.empty()) {
+    const bool is_index = std::all_of(options.device.begin(), options.device.end(), ::isdigit);
+    for (size_t i = 0; i < devices.size() && !chosen; ++i) {
+      const std::string name = devices[i].getProperties().deviceName.data();
+      if (is_index ? std::to_string(i) == options.device : lower(name).find(lower(options.device)) != std::string::npos)
+        chosen = i;
+    }
+    if (!chosen) {
+      std::string names;
+      for (size_t i = 0; i < devices.size(); ++i)
+        names += "\n  " + std::to_string(i) + ": " + devices[i].getProperties().deviceName.data();
+      throw DeviceError("no Vulkan device matches --device \"" + options.device + "\"; available:" + names);
+    }
+    if (!compute_queue_family(devices[*chosen]))
+      throw DeviceError(std::string(devices[*chosen].getProperties().deviceName.data()) + " has no compute queue");
+  } else {
+    for (size_t i = 0; i < devices.size(); ++i) {
+      if (!compute_queue_family(devices[i]) || devices[i].getProperties().apiVersion < VK_API_VERSION_1_2) continue;
+      if (!chosen || type_rank(devices[i].getProperties().deviceType) <
+                         type_rank(devices[*chosen].getProperties().deviceType))
+        chosen = i;
+    }
+    if (!chosen) throw DeviceError("no Vulkan 1.2 device with a compute queue found");
+  }
+  physical_device_ = std::move(devices[*chosen]);
+  const auto chain = physical_device_.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
+  properties_ = chain.get<vk::PhysicalDeviceProperties2>().properties;
+  device_name_ = properties_.deviceName.data();
+  driver_name_ = chain.get<vk::PhysicalDeviceDriverProperties>().driverName.data();
+  queue_family_ = *compute_queue_family(physical_device_);
+
+  // ---- logical device and queue ----
+  const float priority = 1.0f;
+  const vk::DeviceQueueCreateInfo queue_info({}, queue_family_, 1, &priority);
+  device_ = vk::raii::Device(physical_device_, vk::DeviceCreateInfo({}, queue_info));
+  queue_ = vk::raii::Queue(device_, queue_family_, 0);
+}
+
+uint32_t Context::memory_type(uint32_t type_bits, vk::MemoryPropertyFlags required,
+                              vk::MemoryPropertyFlags preferred) const {
+  const auto memory = physical_device_.getMemoryProperties();
+  std::optional<uint32_t> fallback;
+  for (uint32_t i = 0; i < memory.memoryTypeCount; ++i) {
+    if (!(type_bits & (1u << i))) continue;
+    const auto flags = memory.memoryTypes[i].propertyFlags;
+    if ((flags & required) != required) continue;
+    if ((flags & preferred) == preferred) return i;
+    if (!fallback) fallback = i;
+  }
+  if (!fallback) throw DeviceError("no Vulkan memory type with " + vk::to_string(required) + " on " + device_name_);
+  return *fallback;
+}
+
+void Context::wait(const vk::raii::Fence& fence, std::chrono::milliseconds timeout, const char* what) const {
+  const auto ns = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count());
+  const vk::Result result = device_.waitForFences({*fence}, VK_TRUE, ns);
+  if (result == vk::Result::eTimeout)
+    throw DeviceError(std::string("vkWaitForFences: ") + what + " did not finish within " +
+                      std::to_string(timeout.count()) + " ms (VK_TIMEOUT)");
+}
+
+void Context::check_validation(const char* during) {
+  const auto messages = log_->messages();
+  if (messages.size() == validation_seen_) return;
+  std::string text = std::to_string(messages.size() - validation_seen_) + " validation message(s) during " + during +
+                     "; the first:\n  " + messages[validation_seen_];
+  validation_seen_ = messages.size();
+  throw DeviceError(text);
+}
+
+}  // namespace vkray::gpu

@@ -1,0 +1,171 @@
+#include "gpu/renderer.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+#include "errors.h"
+#include "gpu/buffer.h"
+#include "gpu/scene_packing.h"
+
+namespace vkray::gpu {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// One submission aims at about this many ray-primitive tests: a fraction of a second on lavapipe
+// with 2 cores, so no single submission runs long (lavapipe has no GPU watchdog to stop one).
+constexpr double kTestsPerTile = double(1 << 26);
+
+constexpr vk::DescriptorType kTexel = vk::DescriptorType::eUniformTexelBuffer;
+
+// A texel buffer and its RGBA32F view; never empty (Vulkan has no zero-sized buffers), the shader
+// is told the real count.
+struct TexelBuffer {
+  Buffer buffer;
+  vk::raii::BufferView view{nullptr};
+};
+
+TexelBuffer make_texel_buffer(const Context& ctx, std::vector<glm::vec4> texels, const char* what) {
+  if (texels.empty()) texels.emplace_back(0.0f);
+  if (texels.size() > ctx.limits().maxTexelBufferElements)
+    throw DeviceError(std::string("scene too large for ") + ctx.device_name() + ": " + std::to_string(texels.size()) +
+                      " " + what + " texels, maxTexelBufferElements is " +
+                      std::to_string(ctx.limits().maxTexelBufferElements));
+  TexelBuffer t;
+  const vk::DeviceSize bytes = texels.size() * sizeof(glm::vec4);
+  t.buffer = upload_buffer(ctx, texels.data(), bytes, vk::BufferUsageFlagBits::eUniformTexelBuffer);
+  t.view = vk::raii::BufferView(ctx.device(), vk::BufferViewCreateInfo({}, *t.buffer.buffer,
+                                                                       vk::Format::eR32G32B32A32Sfloat, 0, bytes));
+  return t;
+}
+
+}  // namespace
+
+TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv) {
+  using S = vk::ShaderStageFlagBits;
+  const vk::DescriptorSetLayoutBinding bindings[] = {
+      {VKRAY_BINDING_FRAME, vk::DescriptorType::eUniformBuffer, 1, S::eCompute},
+      {VKRAY_BINDING_TRIANGLES, kTexel, 1, S::eCompute},
+      {VKRAY_BINDING_SPHERES, kTexel, 1, S::eCompute},
+      {VKRAY_BINDING_MATERIALS, kTexel, 1, S::eCompute},
+      {VKRAY_BINDING_LIGHTS, kTexel, 1, S::eCompute},
+      {VKRAY_BINDING_OUTPUT, vk::DescriptorType::eStorageBuffer, 1, S::eCompute},
+  };
+  set_layout_ = vk::raii::DescriptorSetLayout(ctx.device(), vk::DescriptorSetLayoutCreateInfo({}, bindings));
+  const vk::PushConstantRange push(S::eCompute, 0, sizeof(TileConstants));
+  const vk::DescriptorSetLayout set_layout = *set_layout_;
+  layout_ = vk::raii::PipelineLayout(ctx.device(), vk::PipelineLayoutCreateInfo({}, set_layout, push));
+  const vk::raii::ShaderModule module(ctx.device(), vk::ShaderModuleCreateInfo({}, spirv));
+  const vk::PipelineShaderStageCreateInfo stage({}, S::eCompute, *module, "main");
+  pipeline_ = vk::raii::Pipeline(ctx.device(), nullptr, vk::ComputePipelineCreateInfo({}, stage, *layout_));
+}
+
+uint32_t tile_side(const Scene& scene, const ImageSettings& image) {
+  const double primitives = double(scene.triangles.size() + scene.spheres.size()) + 1.0;
+  const double tests_per_sample = primitives * (1.0 + double(scene.lights.size()));
+  const double pixels = kTestsPerTile / (tests_per_sample * image.samples_per_pixel);
+  const uint32_t side = static_cast<uint32_t>(std::sqrt(pixels)) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
+  const uint32_t largest = (std::max(image.width, image.height) + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
+  return std::clamp<uint32_t>(side, VKRAY_WORKGROUP_X, largest);
+}
+
+Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, const ImageSettings& image,
+             const RenderOptions& options, RenderStats* stats_out) {
+  RenderStats stats;
+  const vk::raii::Device& device = ctx.device();
+
+  // ---- upload ----
+  auto start = Clock::now();
+  const PackedScene packed = pack_scene(scene, image);
+  const vk::DeviceSize pixel_bytes = vk::DeviceSize(image.width) * image.height * sizeof(glm::vec4);
+  if (pixel_bytes > ctx.limits().maxStorageBufferRange)
+    throw DeviceError("image too large for " + ctx.device_name() + ": " + std::to_string(pixel_bytes) +
+                      " bytes of output, maxStorageBufferRange is " + std::to_string(ctx.limits().maxStorageBufferRange));
+  Buffer frame = upload_buffer(ctx, &packed.frame, sizeof(packed.frame), vk::BufferUsageFlagBits::eUniformBuffer);
+  const TexelBuffer triangles = make_texel_buffer(ctx, packed.triangles, "triangle");
+  const TexelBuffer spheres = make_texel_buffer(ctx, packed.spheres, "sphere");
+  const TexelBuffer materials = make_texel_buffer(ctx, packed.materials, "material");
+  const TexelBuffer lights = make_texel_buffer(ctx, packed.lights, "light");
+  using M = vk::MemoryPropertyFlagBits;
+  const Buffer output = create_buffer(ctx, pixel_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible,
+                                      M::eHostCached);
+
+  const vk::DescriptorPoolSize pool_sizes[] = {{vk::DescriptorType::eUniformBuffer, 1},
+                                               {kTexel, 4},
+                                               {vk::DescriptorType::eStorageBuffer, 1}};
+  const vk::raii::DescriptorPool pool(device, vk::DescriptorPoolCreateInfo({}, 1, pool_sizes));
+  const vk::DescriptorSetLayout set_layout = *pipeline.set_layout();
+  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pool, set_layout));
+  const vk::DescriptorSet set = *sets[0];
+  const vk::DescriptorBufferInfo frame_info(*frame.buffer, 0, VK_WHOLE_SIZE);
+  const vk::DescriptorBufferInfo output_info(*output.buffer, 0, VK_WHOLE_SIZE);
+  const vk::BufferView views[] = {*triangles.view, *spheres.view, *materials.view, *lights.view};
+  const vk::WriteDescriptorSet writes[] = {
+      {set, VKRAY_BINDING_FRAME, 0, vk::DescriptorType::eUniformBuffer, {}, frame_info},
+      {set, VKRAY_BINDING_TRIANGLES, 0, kTexel, {}, {}, views[0]},
+      {set, VKRAY_BINDING_SPHERES, 0, kTexel, {}, {}, views[1]},
+      {set, VKRAY_BINDING_MATERIALS, 0, kTexel, {}, {}, views[2]},
+      {set, VKRAY_BINDING_LIGHTS, 0, kTexel, {}, {}, views[3]},
+      {set, VKRAY_BINDING_OUTPUT, 0, vk::DescriptorType::eStorageBuffer, {}, output_info},
+  };
+  device.updateDescriptorSets(writes, {});
+  stats.upload_seconds = seconds_since(start);
+
+  // ---- trace, one submission per tile ----
+  start = Clock::now();
+  const vk::raii::CommandPool command_pool(device, {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, ctx.queue_family()});
+  vk::raii::CommandBuffers cbs(device, {*command_pool, vk::CommandBufferLevel::ePrimary, 1});
+  const vk::raii::CommandBuffer& cb = cbs[0];
+  const vk::raii::Fence fence(device, vk::FenceCreateInfo{});
+  const uint32_t side = tile_side(scene, image);
+  const uint32_t tiles_x = (image.width + side - 1) / side, tiles_y = (image.height + side - 1) / side;
+  const uint32_t tile_count = tiles_x * tiles_y;
+  for (uint32_t tile_index = 0; tile_index < tile_count; ++tile_index) {
+    TileConstants tile;
+    tile.x0 = (tile_index % tiles_x) * side;
+    tile.y0 = (tile_index / tiles_x) * side;
+    tile.width = std::min(side, image.width - tile.x0);
+    tile.height = std::min(side, image.height - tile.y0);
+
+    cb.reset();
+    cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+    cb.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline.pipeline());
+    cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline.layout(), 0, set, {});
+    cb.pushConstants<TileConstants>(*pipeline.layout(), vk::ShaderStageFlagBits::eCompute, 0, tile);
+    cb.dispatch((tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X,
+                (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y, 1);
+    // The shader's writes are read by the host after the fence.
+    const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
+    cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+    cb.end();
+    const vk::CommandBuffer raw = *cb;
+    ctx.queue().submit(vk::SubmitInfo({}, {}, raw), *fence);
+    ctx.wait(fence, options.tile_timeout, "a render tile");
+    device.resetFences(*fence);
+    if (options.progress) options.progress(tile_index + 1, tile_count);
+  }
+  stats.trace_seconds = seconds_since(start);
+  stats.tiles = tile_count;
+
+  // ---- read back ----
+  start = Clock::now();
+  output.invalidate(device);
+  Image result(image.width, image.height);
+  const auto* texels = static_cast<const glm::vec4*>(output.mapped);
+  for (size_t i = 0; i < result.pixels.size(); ++i) {
+    result.pixels[i] = glm::vec3(texels[i]);
+    stats.rays += std::bit_cast<uint32_t>(texels[i].w);
+  }
+  stats.readback_seconds = seconds_since(start);
+  ctx.check_validation("render");
+  if (stats_out) *stats_out = stats;
+  return result;
+}
+
+}  // namespace vkray::gpu

@@ -1,0 +1,57 @@
+// The GPU path: the compute pipeline built from trace.comp's SPIR-V, and a render that uploads a
+// scene, dispatches the image tile by tile and reads the radiance back.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <vulkan/vulkan_raii.hpp>
+
+#include "gpu/context.h"
+#include "image.h"
+#include "scene.h"
+
+namespace vkray::gpu {
+
+// Descriptor set layout, pipeline layout and pipeline for shaders/trace.comp's interface.
+class TracePipeline {
+ public:
+  TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv);
+
+  const vk::raii::DescriptorSetLayout& set_layout() const { return set_layout_; }
+  const vk::raii::PipelineLayout& layout() const { return layout_; }
+  const vk::raii::Pipeline& pipeline() const { return pipeline_; }
+
+ private:
+  vk::raii::DescriptorSetLayout set_layout_{nullptr};
+  vk::raii::PipelineLayout layout_{nullptr};
+  vk::raii::Pipeline pipeline_{nullptr};
+};
+
+struct RenderStats {
+  double upload_seconds = 0;
+  double trace_seconds = 0;
+  double readback_seconds = 0;
+  uint64_t rays = 0;  // camera rays + shadow rays
+  uint32_t tiles = 0;
+};
+
+struct RenderOptions {
+  // Longest a single tile may run before the render fails with a device error.
+  std::chrono::milliseconds tile_timeout{60000};
+  // Called after each tile with (tiles done, tiles in all).
+  std::function<void(uint32_t, uint32_t)> progress;
+};
+
+// Renders `scene` at `image` resolution and sample count. Throws DeviceError (and vk::SystemError
+// from failing Vulkan calls).
+Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, const ImageSettings& image,
+             const RenderOptions& options = {}, RenderStats* stats = nullptr);
+
+// Tile side in pixels (a multiple of the workgroup size) so that one submission stays near a fixed
+// budget of ray-primitive tests whatever the scene size and sample count.
+uint32_t tile_side(const Scene& scene, const ImageSettings& image);
+
+}  // namespace vkray::gpu

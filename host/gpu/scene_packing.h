@@ -1,0 +1,40 @@
+// The scene in the layout the shader reads (shaders/shared/types.h): texel arrays and frame
+// uniforms. No Vulkan here, so it is testable without a device.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene.h"
+#include "../shaders/shared/types.h"
+
+namespace vkray::gpu {
+
+// std140 layout of FrameUniforms, checked member by member.
+static_assert(offsetof(FrameUniforms, origin) == 0);
+static_assert(offsetof(FrameUniforms, forward) == 48);
+static_assert(offsetof(FrameUniforms, ambient) == 80);
+static_assert(offsetof(FrameUniforms, width) == 96);
+static_assert(offsetof(FrameUniforms, strata_y) == 124);
+static_assert(offsetof(FrameUniforms, epsilon) == 140);
+static_assert(sizeof(FrameUniforms) == 144);
+static_assert(sizeof(TileConstants) == 16);
+
+struct PackedScene {
+  FrameUniforms frame{};
+  std::vector<glm::vec4> triangles;  // VKRAY_TEXELS_PER_TRIANGLE texels each
+  std::vector<glm::vec4> spheres;    // VKRAY_TEXELS_PER_SPHERE texels each
+  std::vector<glm::vec4> materials;  // one texel each
+  std::vector<glm::vec4> lights;     // VKRAY_TEXELS_PER_LIGHT texels each
+};
+
+// `image` is the resolution actually rendered (the scene's, or the command line's).
+PackedScene pack_scene(const Scene& scene, const ImageSettings& image);
+
+// The offset applied to secondary-ray origins and the smallest accepted t: 1e-5 of the scene's
+// extent, far above float rounding at that scale (~1e-7 relative) and far below any feature.
+float scene_epsilon(const Scene& scene);
+
+}  // namespace vkray::gpu

@@ -1,0 +1,23 @@
+// GLSL compute shaders to SPIR-V at run time with glslang's C++ API, with #include support.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace vkray::gpu {
+
+struct CompiledShader {
+  std::vector<uint32_t> spirv;
+  // The entry file and every file it included, once each: what a change to must trigger a rebuild.
+  std::vector<std::filesystem::path> sources;
+};
+
+// Compiles `entry` for Vulkan 1.2. `#include "x"` is looked up next to the including file, then in
+// `include_dirs` in order; `#include <x>` only in `include_dirs`. Throws ShaderError whose message
+// has one line per problem, "file:line: error: message", where file is the file that has the error
+// (an included file too).
+CompiledShader compile_compute_shader(const std::filesystem::path& entry,
+                                      const std::vector<std::filesystem::path>& include_dirs = {});
+
+}  // namespace vkray::gpu

@@ -1,0 +1,159 @@
+#include "image.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <png.h>
+
+#include "errors.h"
+
+namespace vkray {
+namespace {
+
+std::string lower_extension(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+// A temporary file next to the target, removed unless commit() renames it into place.
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
+    std::string pattern = (target_.has_parent_path() ? target_.parent_path() / "" : std::filesystem::path())
+                              .string() + "." + target_.filename().string() + ".tmp-XXXXXX";
+    const int fd = mkstemp(pattern.data());
+    if (fd < 0) throw OutputError(target_.string() + ": cannot create file: " + std::strerror(errno));
+    temp_ = pattern;
+    file_ = fdopen(fd, "wb");
+    if (!file_) {
+      ::close(fd);
+      std::filesystem::remove(temp_);
+      throw OutputError(target_.string() + ": cannot open file: " + std::strerror(errno));
+    }
+  }
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  ~AtomicFile() {
+    if (file_) std::fclose(file_);
+    if (!committed_) {
+      std::error_code ec;
+      std::filesystem::remove(temp_, ec);
+    }
+  }
+  FILE* get() { return file_; }
+  void commit() {
+    const bool write_failed = std::ferror(file_) != 0;
+    const bool close_failed = std::fclose(file_) != 0;
+    file_ = nullptr;
+    // mkstemp creates the file 0600; give it the mode a plain open() would (0666 less the umask).
+    const mode_t mask = ::umask(0);
+    ::umask(mask);
+    if (::chmod(temp_.c_str(), 0666 & ~mask) != 0 && !write_failed && !close_failed)
+      throw OutputError(target_.string() + ": cannot set file mode: " + std::strerror(errno));
+    if (write_failed || close_failed) throw OutputError(target_.string() + ": write failed: " + std::strerror(errno));
+    std::error_code ec;
+    std::filesystem::rename(temp_, target_, ec);
+    if (ec) throw OutputError(target_.string() + ": cannot rename into place: " + ec.message());
+    committed_ = true;
+  }
+
+ private:
+  std::filesystem::path target_, temp_;
+  FILE* file_ = nullptr;
+  bool committed_ = false;
+};
+
+void write_png(const Image& image, const std::filesystem::path& file) {
+  std::vector<uint8_t> bytes(size_t(image.width) * image.height * 3);
+  for (size_t i = 0; i < image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) bytes[i * 3 + size_t(c)] = encode_srgb8(image.pixels[i][c]);
+
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = image.width;
+  png.height = image.height;
+  png.format = PNG_FORMAT_RGB;  // 8-bit sRGB: libpng writes the sRGB chunk
+  AtomicFile out(file);
+  if (!png_image_write_to_stdio(&png, out.get(), 0, bytes.data(), 0, nullptr))
+    throw OutputError(file.string() + ": PNG write failed: " + png.message);
+  out.commit();
+}
+
+void write_pfm(const Image& image, const std::filesystem::path& file) {
+  static_assert(std::endian::native == std::endian::little, "PFM writer assumes a little-endian host");
+  AtomicFile out(file);
+  std::fprintf(out.get(), "PF\n%u %u\n-1.0\n", image.width, image.height);
+  for (uint32_t row = image.height; row-- > 0;)  // PFM stores the bottom row first
+    std::fwrite(&image.at(0, row), sizeof(glm::vec3), image.width, out.get());
+  out.commit();
+}
+
+}  // namespace
+
+uint8_t encode_srgb8(float linear) {
+  const float c = linear > 0.0f ? std::min(linear, 1.0f) : 0.0f;  // NaN encodes as 0
+  const float encoded = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+  return static_cast<uint8_t>(std::lround(255.0f * encoded));
+}
+
+float decode_srgb8(uint8_t encoded) {
+  const float c = float(encoded) / 255.0f;
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+bool is_supported_image_path(const std::filesystem::path& file) {
+  const std::string ext = lower_extension(file);
+  return ext == ".png" || ext == ".pfm";
+}
+
+void write_image(const Image& image, const std::filesystem::path& file) {
+  const std::string ext = lower_extension(file);
+  if (ext == ".png") return write_png(image, file);
+  if (ext == ".pfm") return write_pfm(image, file);
+  throw OutputError(file.string() + ": unknown image type \"" + ext + "\" (expected .png or .pfm)");
+}
+
+Image read_pfm(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot open");
+  std::string magic;
+  uint32_t width = 0, height = 0;
+  float scale = 0.0f;
+  in >> magic >> width >> height >> scale;
+  in.get();  // the single whitespace byte after the header
+  if (!in || magic != "PF" || scale >= 0.0f || width == 0 || height == 0)
+    throw InputError(file.string() + ": not a little-endian RGB PFM file");
+  Image image(width, height);
+  for (uint32_t row = height; row-- > 0;)
+    in.read(reinterpret_cast<char*>(&image.at(0, row)), std::streamsize(sizeof(glm::vec3) * width));
+  if (!in) throw InputError(file.string() + ": truncated PFM data");
+  return image;
+}
+
+Image read_png(const std::filesystem::path& file) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, file.string().c_str()))
+    throw InputError(file.string() + ": " + png.message);
+  png.format = PNG_FORMAT_RGB;
+  std::vector<uint8_t> bytes(PNG_IMAGE_SIZE(png));
+  if (!png_image_finish_read(&png, nullptr, bytes.data(), 0, nullptr))
+    throw InputError(file.string() + ": " + png.message);
+  Image image(png.width, png.height);
+  for (size_t i = 0; i < image.pixels.size(); ++i)
+    image.pixels[i] = {decode_srgb8(bytes[i * 3]), decode_srgb8(bytes[i * 3 + 1]), decode_srgb8(bytes[i * 3 + 2])};
+  return image;
+}
+
+}  // namespace vkray

@@ -1,0 +1,39 @@
+// Linear-radiance images and the files they are written to: 8-bit sRGB PNG and 32-bit float PFM.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace vkray {
+
+struct Image {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::vector<glm::vec3> pixels;  // linear radiance, row-major, top row first
+
+  Image() = default;
+  Image(uint32_t w, uint32_t h) : width(w), height(h), pixels(size_t(w) * h, glm::vec3(0.0f)) {}
+  glm::vec3& at(uint32_t x, uint32_t y) { return pixels[size_t(y) * width + x]; }
+  const glm::vec3& at(uint32_t x, uint32_t y) const { return pixels[size_t(y) * width + x]; }
+};
+
+// round(255 * sRGB_encode(clamp(linear, 0, 1))), the PNG encoding of the shading contract.
+uint8_t encode_srgb8(float linear);
+float decode_srgb8(uint8_t encoded);
+
+// Writes by extension: ".png" (8-bit sRGB) or ".pfm" (32-bit float linear, rows bottom to top,
+// little-endian). The file is written under a temporary name in the same folder and renamed into
+// place, so a failure never leaves a partial image. Throws OutputError.
+void write_image(const Image& image, const std::filesystem::path& file);
+
+// Readers, for tests and tools. read_png returns decoded (linear) values. Throw InputError.
+Image read_pfm(const std::filesystem::path& file);
+Image read_png(const std::filesystem::path& file);
+
+// Whether write_image knows the file's extension.
+bool is_supported_image_path(const std::filesystem::path& file);
+
+}  // namespace vkray

@@ -1,0 +1,75 @@
+// vkray's command line: parses arguments, runs a subcommand, and turns errors into a message on
+// stderr and the documented exit code. Nothing below main() ever lets an exception escape.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <vulkan/vulkan_raii.hpp>
+
+#include "commands.h"
+#include "errors.h"
+
+namespace {
+
+constexpr const char* kExitCodes =
+    "Exit codes:\n"
+    "  0  success\n"
+    "  1  bad input: scene, mesh or shader file, or an output file that cannot be written\n"
+    "  2  usage: unknown command or option, bad option value\n"
+    "  3  Vulkan or device failure (no device, failed call, timeout, validation message)\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace vkray;
+  CLI::App app("vkray: a raytracer on Vulkan compute shaders, with a headless renderer for any Vulkan device "
+               "(lavapipe included).");
+  app.footer(kExitCodes);
+  app.require_subcommand(1);
+
+  RenderCommand render;
+  auto* render_cmd = app.add_subcommand("render", "Render a scene to a PNG or PFM image.");
+  render_cmd->add_option("scene", render.scene, "Scene file (default: the Cornell box, scenes/cornell.json)");
+  render_cmd->add_option("-o,--output", render.output, "Output image, .png (8-bit sRGB) or .pfm (float, linear); "
+                                                       "default: <scene name>.png in the current folder");
+  render_cmd->add_option("--width", render.width, "Image width in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
+  render_cmd->add_option("--height", render.height, "Image height in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
+  render_cmd->add_option("--spp", render.spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1, 65536));
+  render_cmd->add_option("--device", render.device, "Vulkan device: index or part of its name (see `vkray devices`)");
+  render_cmd->add_option("--shader-dir", render.shader_dir, "Folder with trace.comp and its includes");
+  render_cmd->add_flag("--validate", render.validate, "Enable the Khronos validation layer; any message is an error");
+  render_cmd->add_flag("-q,--quiet", render.quiet, "Print only warnings and errors");
+  render_cmd->footer(kExitCodes);
+
+  auto* devices_cmd = app.add_subcommand("devices", "List Vulkan devices with the properties that matter to vkray.");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitUsage;
+  }
+
+  try {
+    if (*render_cmd) return run_render(render);
+    if (*devices_cmd) return run_devices();
+  } catch (const ShaderError& e) {
+    std::cerr << "vkray: shader compilation failed:\n" << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const InputError& e) {
+    std::cerr << "vkray: error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const DeviceError& e) {
+    std::cerr << "vkray: device error: " << e.what() << "\n";
+    return kExitDevice;
+  } catch (const vk::SystemError& e) {
+    // Vulkan-Hpp's message names the call, e.g. "vk::raii::Device::createBuffer: ErrorOutOfDeviceMemory".
+    std::cerr << "vkray: Vulkan error: " << e.what() << "\n";
+    return kExitDevice;
+  } catch (const std::exception& e) {
+    std::cerr << "vkray: error: " << e.what() << "\n";
+    return kExitDevice;
+  }
+  return kExitUsage;
+}

@@ -1,0 +1,28 @@
+#include "paths.h"
+
+#include <system_error>
+
+namespace vkray {
+namespace {
+
+std::filesystem::path installed_data_dir() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  return exe.parent_path().parent_path() / "share" / "vkray";
+}
+
+std::filesystem::path find(const char* relative, const char* source_tree_dir, const char* probe) {
+  const auto installed = installed_data_dir() / relative;
+  std::error_code ec;
+  if (std::filesystem::exists(installed / probe, ec)) return installed;
+  return source_tree_dir;
+}
+
+}  // namespace
+
+std::filesystem::path default_shader_dir() { return find("shaders", VKRAY_SOURCE_SHADER_DIR, "trace.comp"); }
+
+std::filesystem::path default_scene() { return find("scenes", VKRAY_SOURCE_SCENE_DIR, "cornell.json") / "cornell.json"; }
+
+}  // namespace vkray

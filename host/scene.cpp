@@ -1,0 +1,360 @@
+#include "scene.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include <glm/gtc/constants.hpp>
+#include <nlohmann/json.hpp>
+
+#include "errors.h"
+#include "transform.h"
+
+namespace vkray {
+namespace {
+
+using json = nlohmann::json;
+
+// Upper bounds that keep later size arithmetic far from overflow; the device's own limits are
+// checked again before anything is allocated.
+constexpr uint32_t kMaxImageSide = 16384;
+constexpr uint32_t kMaxSamplesPerPixel = 65536;
+
+// A JSON value together with its JSON-pointer path, so every message can say where it is.
+struct Value {
+  const json& j;
+  std::string path;  // "" is the document root
+
+  Value operator[](const std::string& key) const { return {j.at(key), path + "/" + key}; }
+  Value operator[](size_t i) const { return {j.at(i), path + "/" + std::to_string(i)}; }
+  bool has(const std::string& key) const { return j.contains(key); }
+};
+
+class SceneParser {
+ public:
+  SceneParser(const std::filesystem::path& file, Scene& scene) : file_(file), scene_(scene) {}
+
+  void parse(const json& root);
+
+ private:
+  [[noreturn]] void fail(const Value& v, const std::string& what) const {
+    throw SceneError(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what);
+  }
+  void warn(const Value& v, const std::string& what) {
+    scene_.warnings.push_back(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what);
+  }
+
+  // ---- typed readers -----------------------------------------------------------------------------
+  void expect_object(const Value& v) const {
+    if (!v.j.is_object()) fail(v, std::string("expected an object, got ") + v.j.type_name());
+  }
+  void expect_array(const Value& v) const {
+    if (!v.j.is_array()) fail(v, std::string("expected an array, got ") + v.j.type_name());
+  }
+  Value require(const Value& obj, const std::string& key) const {
+    if (!obj.has(key)) fail(obj, "missing required key \"" + key + "\"");
+    return obj[key];
+  }
+  // Warns about keys the contract does not define (most often a typo).
+  void check_keys(const Value& obj, std::initializer_list<const char*> known) {
+    for (const auto& [key, unused] : obj.j.items()) {
+      if (std::none_of(known.begin(), known.end(), [&](const char* k) { return key == k; }))
+        warn(obj[key], "unknown key (ignored)");
+    }
+  }
+  // Exactly one of two alternative keys; returns true when the first is present.
+  bool one_of(const Value& obj, const char* a, const char* b) const {
+    const bool has_a = obj.has(a), has_b = obj.has(b);
+    if (has_a && has_b) fail(obj, std::string("give either \"") + a + "\" or \"" + b + "\", not both");
+    if (!has_a && !has_b) fail(obj, std::string("missing required key \"") + a + "\" (or \"" + b + "\")");
+    return has_a;
+  }
+
+  float number(const Value& v) const {
+    if (!v.j.is_number()) fail(v, std::string("expected a number, got ") + v.j.type_name());
+    const double d = v.j.get<double>();
+    if (!std::isfinite(d) || std::abs(d) > FLT_MAX) fail(v, "number is out of range for a 32-bit float");
+    return static_cast<float>(d);
+  }
+  float positive(const Value& v) const {
+    const float f = number(v);
+    if (!(f > 0.0f)) fail(v, "expected a number > 0, got " + v.j.dump());
+    return f;
+  }
+  uint32_t count(const Value& v, uint32_t max) const {
+    if (!v.j.is_number_integer() || v.j.get<int64_t>() < 1 || v.j.get<int64_t>() > max)
+      fail(v, "expected an integer from 1 to " + std::to_string(max) + ", got " + v.j.dump());
+    return static_cast<uint32_t>(v.j.get<int64_t>());
+  }
+  glm::vec3 vec3(const Value& v) const {
+    if (!v.j.is_array() || v.j.size() != 3) fail(v, "expected an array of 3 numbers, got " + v.j.dump());
+    return {number(v[0]), number(v[1]), number(v[2])};
+  }
+  glm::vec3 color(const Value& v) const {  // non-negative RGB
+    const glm::vec3 c = vec3(v);
+    if (c.r < 0.0f || c.g < 0.0f || c.b < 0.0f) fail(v, "expected non-negative values, got " + v.j.dump());
+    return c;
+  }
+  std::string string(const Value& v) const {
+    if (!v.j.is_string()) fail(v, std::string("expected a string, got ") + v.j.type_name());
+    return v.j.get<std::string>();
+  }
+
+  // ---- sections ----------------------------------------------------------------------------------
+  void parse_image(const Value& v);
+  void parse_camera(const Value& v);
+  void parse_materials(const Value& v);
+  void parse_light(const Value& v);
+  void parse_object(const Value& v);
+  glm::mat4 parse_transform(const Value& v);
+  uint32_t material_ref(const Value& v) const;
+
+  const std::filesystem::path& file_;
+  Scene& scene_;
+  std::map<std::string, uint32_t> material_index_;
+};
+
+void SceneParser::parse(const json& root_json) {
+  const Value root{root_json, ""};
+  expect_object(root);
+  check_keys(root, {"image", "camera", "background", "ambient", "materials", "lights", "objects"});
+  if (root.has("image")) parse_image(root["image"]);
+  parse_camera(require(root, "camera"));
+  if (root.has("background")) scene_.background = color(root["background"]);
+  if (root.has("ambient")) scene_.ambient = color(root["ambient"]);
+  if (root.has("materials")) parse_materials(root["materials"]);
+  if (root.has("lights")) {
+    const Value lights = root["lights"];
+    expect_array(lights);
+    for (size_t i = 0; i < lights.j.size(); ++i) parse_light(lights[i]);
+  }
+  if (root.has("objects")) {
+    const Value objects = root["objects"];
+    expect_array(objects);
+    for (size_t i = 0; i < objects.j.size(); ++i) parse_object(objects[i]);
+  }
+  if (scene_.lights.empty() && scene_.ambient == glm::vec3(0.0f) && !scene_.triangles.empty())
+    warn(root, "no lights and no ambient: every surface renders black");
+}
+
+void SceneParser::parse_image(const Value& v) {
+  expect_object(v);
+  check_keys(v, {"width", "height", "samples_per_pixel"});
+  if (v.has("width")) scene_.image.width = count(v["width"], kMaxImageSide);
+  if (v.has("height")) scene_.image.height = count(v["height"], kMaxImageSide);
+  if (v.has("samples_per_pixel"))
+    scene_.image.samples_per_pixel = count(v["samples_per_pixel"], kMaxSamplesPerPixel);
+}
+
+void SceneParser::parse_camera(const Value& v) {
+  expect_object(v);
+  check_keys(v, {"position", "look_at", "direction", "up", "vertical_fov", "focal_length"});
+  Camera& cam = scene_.camera;
+  cam.position = vec3(require(v, "position"));
+
+  const bool by_target = one_of(v, "look_at", "direction");
+  const Value aim = by_target ? v["look_at"] : v["direction"];
+  const glm::vec3 forward = by_target ? vec3(aim) - cam.position : vec3(aim);
+  const float length = glm::length(forward);
+  if (!(length > 0.0f) || !std::isfinite(length))
+    fail(aim, by_target ? "look_at equals the camera position: no view direction" : "direction has zero length");
+  cam.forward = forward / length;
+
+  if (v.has("up")) {
+    cam.up = vec3(v["up"]);
+    const float up_length = glm::length(cam.up);
+    if (!(up_length > 0.0f)) fail(v["up"], "up has zero length");
+    // Relative test: |f x up/|up|| = sin of the angle between them.
+    if (glm::length(glm::cross(cam.forward, cam.up / up_length)) < 1e-6f)
+      fail(v["up"], "up is parallel to the view direction");
+  } else if (glm::length(glm::cross(cam.forward, cam.up)) < 1e-6f) {
+    fail(v, "the default up [0,1,0] is parallel to the view direction; give \"up\"");
+  }
+
+  if (one_of(v, "vertical_fov", "focal_length")) {
+    const float fov = number(v["vertical_fov"]);
+    if (!(fov > 0.0f && fov < 180.0f)) fail(v["vertical_fov"], "expected degrees in (0, 180), got " + v["vertical_fov"].j.dump());
+    // F = (H/2) / tan(fov/2) pixels = focal_length * H.
+    cam.focal_length = 0.5f / std::tan(glm::radians(fov) * 0.5f);
+  } else {
+    cam.focal_length = positive(v["focal_length"]);
+  }
+}
+
+void SceneParser::parse_materials(const Value& v) {
+  expect_object(v);
+  for (const auto& [name, unused] : v.j.items()) {
+    const Value m = v[name];
+    expect_object(m);
+    check_keys(m, {"albedo"});
+    const glm::vec3 albedo = color(require(m, "albedo"));
+    if (albedo.r > 1.0f || albedo.g > 1.0f || albedo.b > 1.0f)
+      warn(m["albedo"], "albedo above 1 reflects more light than arrives");
+    material_index_[name] = static_cast<uint32_t>(scene_.materials.size());
+    scene_.materials.push_back({name, albedo});
+  }
+}
+
+uint32_t SceneParser::material_ref(const Value& v) const {
+  const std::string name = string(v);
+  const auto it = material_index_.find(name);
+  if (it == material_index_.end()) fail(v, "undefined material \"" + name + "\"");
+  return it->second;
+}
+
+void SceneParser::parse_light(const Value& v) {
+  expect_object(v);
+  check_keys(v, {"type", "position", "intensity", "power"});
+  const Value type = require(v, "type");
+  if (string(type) != "point") fail(type, "unknown light type " + type.j.dump() + " (expected \"point\")");
+  PointLight light;
+  light.position = vec3(require(v, "position"));
+  if (one_of(v, "intensity", "power")) {
+    light.intensity = color(v["intensity"]);
+  } else {
+    light.intensity = color(v["power"]) / (4.0f * glm::pi<float>());  // isotropic: I = P / 4pi
+  }
+  scene_.lights.push_back(light);
+}
+
+glm::mat4 SceneParser::parse_transform(const Value& v) {
+  expect_object(v);
+  check_keys(v, {"translate", "rotate", "scale", "matrix"});
+  if (v.has("matrix")) {
+    if (v.has("translate") || v.has("rotate") || v.has("scale"))
+      fail(v, "give either \"matrix\" or translate/rotate/scale, not both");
+    const Value m = v["matrix"];
+    if (!m.j.is_array() || m.j.size() != 16) fail(m, "expected an array of 16 numbers (row-major 4x4)");
+    float values[16];
+    for (size_t i = 0; i < 16; ++i) values[i] = number(m[i]);
+    if (values[12] != 0.0f || values[13] != 0.0f || values[14] != 0.0f || values[15] != 1.0f)
+      fail(m, "the last row must be [0, 0, 0, 1] (an affine transform)");
+    const glm::mat4 matrix = matrix_from_row_major(values);
+    if (glm::determinant(glm::mat3(matrix)) == 0.0f) fail(m, "the matrix is singular");
+    return matrix;
+  }
+  glm::vec3 translate(0.0f), rotate(0.0f), scale(1.0f);
+  if (v.has("translate")) translate = vec3(v["translate"]);
+  if (v.has("rotate")) rotate = vec3(v["rotate"]);
+  if (v.has("scale")) {
+    const Value s = v["scale"];
+    scale = s.j.is_number() ? glm::vec3(number(s)) : vec3(s);
+    if (scale.x == 0.0f || scale.y == 0.0f || scale.z == 0.0f) fail(s, "scale must be non-zero");
+  }
+  return compose_transform(translate, rotate, scale);
+}
+
+void SceneParser::parse_object(const Value& v) {
+  expect_object(v);
+  const Value type_value = require(v, "type");
+  const std::string type = string(type_value);
+  const glm::mat4 transform = v.has("transform") ? parse_transform(v["transform"]) : glm::mat4(1.0f);
+
+  if (type == "sphere") {
+    check_keys(v, {"type", "center", "radius", "material", "transform"});
+    Sphere sphere;
+    sphere.center = vec3(require(v, "center"));
+    sphere.radius = positive(require(v, "radius"));
+    sphere.material = material_ref(require(v, "material"));
+    if (v.has("transform")) {
+      const auto s = uniform_scale_of(transform);
+      if (!s) fail(v["transform"], "a sphere takes only a uniform scale (with rotation and translation)");
+      sphere.center = transform_point(transform, sphere.center);
+      sphere.radius *= *s;
+    }
+    scene_.spheres.push_back(sphere);
+  } else if (type == "triangles") {
+    check_keys(v, {"type", "positions", "indices", "material", "transform"});
+    const Value positions = require(v, "positions");
+    expect_array(positions);
+    std::vector<glm::vec3> points;
+    points.reserve(positions.j.size());
+    for (size_t i = 0; i < positions.j.size(); ++i) points.push_back(transform_point(transform, vec3(positions[i])));
+    const uint32_t material = material_ref(require(v, "material"));
+    const Value indices = require(v, "indices");
+    expect_array(indices);
+    size_t degenerate = 0;
+    for (size_t i = 0; i < indices.j.size(); ++i) {
+      const Value tri = indices[i];
+      if (!tri.j.is_array() || tri.j.size() != 3) fail(tri, "expected an array of 3 vertex indices, got " + tri.j.dump());
+      Triangle t;
+      t.material = material;
+      for (size_t k = 0; k < 3; ++k) {
+        const Value idx = tri[k];
+        if (!idx.j.is_number_integer() || idx.j.get<int64_t>() < 0 ||
+            idx.j.get<int64_t>() >= static_cast<int64_t>(points.size()))
+          fail(idx, "vertex index " + idx.j.dump() + " is out of range (the object has " +
+                        std::to_string(points.size()) + " positions)");
+        t.v[k] = points[idx.j.get<size_t>()];
+      }
+      // A zero-area triangle has no normal and can never be hit; leave it out.
+      if (glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f) {
+        ++degenerate;
+        continue;
+      }
+      scene_.triangles.push_back(t);
+    }
+    if (degenerate > 0) warn(indices, std::to_string(degenerate) + " degenerate (zero-area) triangles left out");
+  } else {
+    fail(type_value, "unknown object type \"" + type + "\" (expected \"sphere\" or \"triangles\")");
+  }
+}
+
+// "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error ..." -> "syntax error ..."
+std::string strip_json_prefix(const std::string& what) {
+  const auto column = what.find("column ");
+  const auto colon = what.find(": ", column == std::string::npos ? 0 : column);
+  return colon == std::string::npos ? what : what.substr(colon + 2);
+}
+
+}  // namespace
+
+float Scene::extent() const {
+  float e = 0.0f;
+  auto grow = [&e](glm::vec3 p) { e = std::max({e, std::abs(p.x), std::abs(p.y), std::abs(p.z)}); };
+  grow(camera.position);
+  for (const auto& l : lights) grow(l.position);
+  for (const auto& s : spheres) grow(glm::abs(s.center) + s.radius);
+  for (const auto& t : triangles)
+    for (const auto& p : t.v) grow(p);
+  return e;
+}
+
+Scene parse_scene(std::string_view json_text, const std::filesystem::path& file) {
+  json root;
+  try {
+    root = json::parse(json_text, /*callback=*/nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    // e.byte is the 1-based offset of the character where parsing stopped.
+    const size_t end = std::min<size_t>(e.byte == 0 ? 0 : e.byte - 1, json_text.size());
+    const auto prefix = json_text.substr(0, end);
+    const size_t line = 1 + static_cast<size_t>(std::count(prefix.begin(), prefix.end(), '\n'));
+    const auto last_newline = prefix.rfind('\n');
+    const size_t column = end - (last_newline == std::string_view::npos ? 0 : last_newline + 1) + 1;
+    throw SceneError(file.string() + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
+                     strip_json_prefix(e.what()));
+  }
+  Scene scene;
+  scene.file = file;
+  scene.name = file.stem().string();
+  SceneParser(file, scene).parse(root);
+  return scene;
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw SceneError(file.string() + ": is a directory, not a scene file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw SceneError(file.string() + ": cannot open scene file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw SceneError(file.string() + ": read error");
+  return parse_scene(text.str(), file);
+}
+
+}  // namespace vkray

@@ -1,0 +1,74 @@
+// The in-memory scene: what a scene file (see README, "Scene files") describes, with every object
+// transform already applied, so renderers only see world-space primitives.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace vkray {
+
+struct ImageSettings {
+  uint32_t width = 512;
+  uint32_t height = 512;
+  uint32_t samples_per_pixel = 1;
+};
+
+struct Camera {
+  glm::vec3 position{0.0f};
+  glm::vec3 forward{0.0f, 0.0f, 1.0f};  // unit view direction
+  glm::vec3 up{0.0f, 1.0f, 0.0f};       // not necessarily unit, never parallel to forward
+  float focal_length = 1.0f;            // in units of the image height
+};
+
+struct Material {
+  std::string name;
+  glm::vec3 albedo{0.0f};
+};
+
+struct PointLight {
+  glm::vec3 position{0.0f};
+  glm::vec3 intensity{0.0f};  // radiant intensity I (W/sr); a file's "power" P is stored as P / 4pi
+};
+
+struct Sphere {
+  glm::vec3 center{0.0f};
+  float radius = 0.0f;
+  uint32_t material = 0;
+};
+
+struct Triangle {
+  std::array<glm::vec3, 3> v;
+  uint32_t material = 0;
+};
+
+struct Scene {
+  std::filesystem::path file;  // where it was loaded from; paths inside are relative to its folder
+  std::string name;            // the file's stem: "cornell" for scenes/cornell.json
+  ImageSettings image;
+  Camera camera;
+  glm::vec3 background{0.0f};
+  glm::vec3 ambient{0.0f};
+  std::vector<Material> materials;
+  std::vector<PointLight> lights;
+  std::vector<Sphere> spheres;
+  std::vector<Triangle> triangles;
+  std::vector<std::string> warnings;  // odd but valid input, e.g. unknown keys
+
+  // Largest absolute coordinate of anything in the scene (geometry, lights, camera).
+  float extent() const;
+};
+
+// Reads and validates a scene file. Throws SceneError naming the file and the key (as a JSON
+// pointer, e.g. /objects/2/radius) or the line and column of a syntax error.
+Scene load_scene(const std::filesystem::path& file);
+
+// The same from text already in memory; `file` is used in messages and to resolve relative paths.
+Scene parse_scene(std::string_view json_text, const std::filesystem::path& file);
+
+}  // namespace vkray

@@ -1,0 +1,78 @@
+// Ray-primitive intersection, the lecture's formulations written for the GPU. Pure functions: no
+// bindings, so the unit-test kernel (tests/shaders/intersect_test.comp) includes this file as is.
+#ifndef VKRAY_INTERSECT_GLSL
+#define VKRAY_INTERSECT_GLSL
+
+#include "ray.glsl"
+
+// Ray-triangle: the lecture's 3x3 system [-d, e1, e2] (t, u, v)^T = o - v0, solved in a ray-aligned
+// frame where d = (0, 0, 1): there Cramer's rule reduces to three 2D edge functions U, V, W (the
+// barycentrics times the determinant). This is the watertight test of Woop, Benthin and Wald
+// (JCGT 2013): an edge shared by two triangles gives exactly negated edge functions in both, so a
+// ray can never slip between them (the plain Cramer/Moller-Trumbore form leaves cracks along
+// shared edges). Two-sided, edges inclusive. Returns t, or -1 for a miss.
+
+// The per-ray part: the axis permutation k (kz = the dominant axis of d) and the shear S that
+// maps d to (0, 0, 1).
+struct RayShear {
+  ivec3 k;
+  vec3 s;
+};
+
+RayShear ray_shear(vec3 d) {
+  vec3 ad = abs(d);
+  int kz = (ad.x > ad.y) ? ((ad.x > ad.z) ? 0 : 2) : ((ad.y > ad.z) ? 1 : 2);
+  int kx = kz == 2 ? 0 : kz + 1;
+  int ky = kx == 2 ? 0 : kx + 1;
+  if (d[kz] < 0.0) {  // keep the winding (and so the sign of U, V, W) consistent
+    int swap = kx;
+    kx = ky;
+    ky = swap;
+  }
+  return RayShear(ivec3(kx, ky, kz), vec3(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]));
+}
+
+float intersect_triangle(Ray ray, RayShear sh, vec3 v0, vec3 v1, vec3 v2, float t_min, float t_max) {
+  // Vertices relative to the origin, permuted and sheared into the ray's frame.
+  vec3 a = v0 - ray.origin, b = v1 - ray.origin, c = v2 - ray.origin;
+  float ax = a[sh.k.x] - sh.s.x * a[sh.k.z], ay = a[sh.k.y] - sh.s.y * a[sh.k.z];
+  float bx = b[sh.k.x] - sh.s.x * b[sh.k.z], by = b[sh.k.y] - sh.s.y * b[sh.k.z];
+  float cx = c[sh.k.x] - sh.s.x * c[sh.k.z], cy = c[sh.k.y] - sh.s.y * c[sh.k.z];
+  // Edge functions. `precise`: a fused multiply-add would break the exact antisymmetry that makes
+  // the test watertight.
+  precise float u = cx * by - cy * bx;
+  precise float v = ax * cy - ay * cx;
+  precise float w = bx * ay - by * ax;
+  if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return -1.0;
+  float det = u + v + w;
+  // det = 0: the ray lies in the triangle's plane, or the triangle is degenerate.
+  if (det == 0.0) return -1.0;
+  float t = (u * (sh.s.z * a[sh.k.z]) + v * (sh.s.z * b[sh.k.z]) + w * (sh.s.z * c[sh.k.z])) / det;
+  return (t > t_min && t < t_max) ? t : -1.0;
+}
+
+// Ray-sphere: the quadratic |o + t d - c|^2 = r^2 with |d| = 1, i.e. t^2 - 2 b t + c = 0 with
+// b = -dot(f, d), f = o - c. The discriminant is computed as r^2 - |f + b d|^2 rather than
+// b^2 - c, which cancels catastrophically for small spheres far away ("Precision Improvements for
+// Ray/Sphere Intersection", Ray Tracing Gems ch. 7). The nearest root in (t_min, t_max) counts, so a
+// ray starting inside the sphere hits its far side. Returns t, or -1 for a miss.
+float intersect_sphere(Ray ray, vec3 center, float radius, float t_min, float t_max) {
+  vec3 f = ray.origin - center;
+  float b = -dot(f, ray.dir);
+  vec3 l = f + b * ray.dir;
+  float discriminant = radius * radius - dot(l, l);
+  if (discriminant < 0.0) return -1.0;
+  // Compute the root of larger magnitude first, then the other from the product of the roots (= c),
+  // so neither suffers cancellation.
+  float q = b + (b >= 0.0 ? 1.0 : -1.0) * sqrt(discriminant);
+  float c = dot(f, f) - radius * radius;
+  float t0 = (q != 0.0) ? c / q : 0.0;
+  float t1 = q;
+  float near_t = min(t0, t1);
+  float far_t = max(t0, t1);
+  if (near_t > t_min && near_t < t_max) return near_t;
+  if (far_t > t_min && far_t < t_max) return far_t;
+  return -1.0;
+}
+
+#endif

@@ -1,0 +1,20 @@
+// Ray and hit records used by every stage of the tracer.
+#ifndef VKRAY_RAY_GLSL
+#define VKRAY_RAY_GLSL
+
+struct Ray {
+  vec3 origin;
+  vec3 dir;  // unit length
+};
+
+const uint NO_HIT = 0xffffffffu;
+const float FAR = 1e30;  // "no upper bound" for t; larger than any finite scene distance we accept
+
+struct Hit {
+  float t;
+  uint prim;  // triangle index, or triangle_count + sphere index; NO_HIT when nothing was hit
+};
+
+vec3 ray_at(Ray ray, float t) { return ray.origin + t * ray.dir; }
+
+#endif

@@ -1,0 +1,42 @@
+// Direct Lambertian shading from point lights plus an ambient term, exactly the scene contract:
+//   L = albedo * (A + sum_lights V * I * max(0, n . w) / (pi r^2))
+// with n the geometric normal facing the incoming ray, w the unit vector to the light, r its
+// distance, and V = 0 when a shadow ray finds anything closer than the light.
+#ifndef VKRAY_SHADE_GLSL
+#define VKRAY_SHADE_GLSL
+
+#include "scene.glsl"
+
+const float PI = 3.14159265358979;
+
+// Returns the radiance leaving the hit point toward the ray's origin; adds the shadow rays it casts
+// to `rays`.
+vec3 shade(Ray ray, Hit hit, inout uint rays) {
+  vec3 x = ray_at(ray, hit.t);
+  vec3 n = hit_normal(hit, x);
+  if (dot(n, ray.dir) > 0.0) n = -n;
+
+  // Shadow rays start a little off the surface, on the side the light must be on to count.
+  vec3 shadow_origin = x + frame.epsilon * n;
+  vec3 irradiance = frame.ambient.rgb;
+  for (uint i = 0u; i < frame.light_count; ++i) {
+    int base = int(i) * VKRAY_TEXELS_PER_LIGHT;
+    vec3 light_pos = texelFetch(lights, base).xyz;
+    vec3 to_light = light_pos - x;
+    float r2 = dot(to_light, to_light);
+    float cos_theta = dot(n, to_light * inversesqrt(r2));
+    // Written as !(> 0) so a light exactly at x (0/0 = NaN) contributes nothing.
+    if (!(cos_theta > 0.0)) continue;
+
+    vec3 shadow_dir = light_pos - shadow_origin;
+    float shadow_dist = length(shadow_dir);
+    rays += 1u;
+    // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
+    if (trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon))
+      continue;
+    irradiance += texelFetch(lights, base + 1).rgb * (cos_theta / (PI * r2));
+  }
+  return hit_albedo(hit) * irradiance;
+}
+
+#endif

@@ -1,0 +1,46 @@
+// The sample pattern, shared verbatim by the GPU shader and the CPU side (which compiles it as C++
+// against GLM), so both renderers trace exactly the same rays.
+//
+// Pattern: with spp = 1 the single sample is the pixel centre (0.5, 0.5). Otherwise the pixel is cut
+// into strata_x * strata_y cells (strata_x = ceil(sqrt(spp)), strata_y = ceil(spp / strata_x), chosen
+// on the host); sample k sits in cell (k mod strata_x, k div strata_x), jittered inside it by two
+// 24-bit uniforms from a PCG hash of (pixel index, k). Every operation below is an integer op or a
+// single correctly rounded float add/multiply, so the CPU and any conforming GPU agree bit for bit.
+#ifndef VKRAY_SHARED_SAMPLING_H
+#define VKRAY_SHARED_SAMPLING_H
+
+#include "types.h"
+
+#ifdef __cplusplus
+namespace vkray::gpu {
+#define VKRAY_INLINE inline
+#else
+#define VKRAY_INLINE
+#endif
+
+// PCG-RXS-M-XS 32-bit hash (Jarzynski & Olano, "Hash Functions for GPU Rendering", JCGT 2020).
+VKRAY_INLINE uint pcg_hash(uint v) {
+  uint state = v * 747796405u + 2891336453u;
+  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+// The top 24 bits as a float in [0, 1): exact, since 24 bits fit a float mantissa.
+VKRAY_INLINE float hash_to_unit(uint h) { return float(h >> 8u) * (1.0f / 16777216.0f); }
+
+// Offset of sample k inside pixel `pixel_index` (= y * width + x), in [0, 1)^2.
+VKRAY_INLINE vec2 sample_offset(uint pixel_index, uint k, uint spp, uint strata_x, float inv_strata_x,
+                                float inv_strata_y) {
+  if (spp == 1u) return vec2(0.5f, 0.5f);
+  uint h1 = pcg_hash(pcg_hash(pixel_index) + k);
+  uint h2 = pcg_hash(h1);
+  uint cell_x = k % strata_x;
+  uint cell_y = k / strata_x;
+  return vec2((float(cell_x) + hash_to_unit(h1)) * inv_strata_x,
+              (float(cell_y) + hash_to_unit(h2)) * inv_strata_y);
+}
+
+#ifdef __cplusplus
+}  // namespace vkray::gpu
+#endif
+#endif  // VKRAY_SHARED_SAMPLING_H

@@ -1,0 +1,34 @@
+// vkray's tracer: one invocation per pixel of the current tile. For each sample: primary ray ->
+// closest hit -> shade (with shadow rays) -> average -> store linear radiance.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "shared/types.h"
+#include "shared/sampling.h"
+#include "camera.glsl"
+#include "shade.glsl"
+
+layout(local_size_x = VKRAY_WORKGROUP_X, local_size_y = VKRAY_WORKGROUP_Y, local_size_z = 1) in;
+
+layout(push_constant) uniform Tile { TileConstants tile; };
+layout(std430, set = 0, binding = VKRAY_BINDING_OUTPUT) writeonly buffer Output { vec4 radiance[]; };
+
+void main() {
+  uvec2 local = gl_GlobalInvocationID.xy;
+  if (local.x >= tile.width || local.y >= tile.height) return;
+  uvec2 pixel = uvec2(tile.x0, tile.y0) + local;
+  uint index = pixel.y * frame.width + pixel.x;
+
+  vec3 sum = vec3(0.0);
+  uint rays = 0u;
+  for (uint k = 0u; k < frame.samples_per_pixel; ++k) {
+    vec2 xi = sample_offset(index, k, frame.samples_per_pixel, frame.strata_x, frame.inv_strata_x,
+                            frame.inv_strata_y);
+    Ray ray = camera_ray(pixel, xi);
+    rays += 1u;
+    Hit hit = trace_closest(ray, frame.epsilon, FAR);
+    sum += (hit.prim == NO_HIT) ? frame.background.rgb : shade(ray, hit, rays);
+  }
+  // Alpha carries the number of rays traced for this pixel (bit pattern of a uint) for the rays/s figure.
+  radiance[index] = vec4(sum * frame.inv_samples_per_pixel, uintBitsToFloat(rays));
+}
