@@ -78,29 +78,39 @@ int run_render(const RenderCommand& cmd) {
   if (!std::filesystem::is_directory(out_dir, ec)) throw OutputError(output.string() + ": folder " + out_dir.string() + " does not exist");
   const double load_ms = ms_since(start);
 
-  // ---- device and shader ----
-  gpu::ContextOptions options;
-  options.validation = cmd.validate;
-  options.device = cmd.device;
-  gpu::Context ctx(options);
-  log("device " + ctx.device_name() + " (" + ctx.driver_name() + ")" + (cmd.validate ? ", validation on" : ""));
-  start = Clock::now();
-  const std::filesystem::path shader_dir = cmd.shader_dir.empty() ? default_shader_dir() : cmd.shader_dir;
-  const gpu::CompiledShader shader = gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir});
-  const gpu::TracePipeline pipeline(ctx, shader.spirv);
-  ctx.check_validation("pipeline creation");
-  const double compile_ms = ms_since(start);
-  log(scene_file.string() + ": " + std::to_string(scene.triangles.size()) + " triangles, " +
-      std::to_string(scene.spheres.size()) + " spheres, " + std::to_string(scene.lights.size()) + " lights; " +
-      std::to_string(image.width) + "x" + std::to_string(image.height) + ", " +
-      std::to_string(image.samples_per_pixel) + " spp");
-
-  // ---- render ----
-  Progress progress(!cmd.quiet);
-  gpu::RenderOptions render_options;
-  render_options.progress = [&](uint32_t done, uint32_t total) { progress.update(done, total); };
+  // ---- device, shader, render ----
+  // The device lives in this scope only: its teardown can itself raise validation messages (leaked
+  // objects, say), and those must fail the command before an image is written.
+  auto validation_log = std::make_shared<gpu::ValidationLog>();
+  Image result;
   gpu::RenderStats stats;
-  const Image result = gpu::render(ctx, pipeline, scene, image, render_options, &stats);
+  double compile_ms = 0;
+  {
+    gpu::ContextOptions options;
+    options.validation = cmd.validate;
+    options.device = cmd.device;
+    options.validation_log = validation_log;
+    gpu::Context ctx(options);
+    log("device " + ctx.device_name() + " (" + ctx.driver_name() + ")" + (cmd.validate ? ", validation on" : ""));
+    start = Clock::now();
+    const std::filesystem::path shader_dir = cmd.shader_dir.empty() ? default_shader_dir() : cmd.shader_dir;
+    const gpu::CompiledShader shader = gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir});
+    const gpu::TracePipeline pipeline(ctx, shader.spirv);
+    ctx.check_validation("pipeline creation");
+    compile_ms = ms_since(start);
+    log(scene_file.string() + ": " + std::to_string(scene.triangles.size()) + " triangles, " +
+        std::to_string(scene.spheres.size()) + " spheres, " + std::to_string(scene.lights.size()) + " lights; " +
+        std::to_string(image.width) + "x" + std::to_string(image.height) + ", " +
+        std::to_string(image.samples_per_pixel) + " spp");
+
+    Progress progress(!cmd.quiet);
+    gpu::RenderOptions render_options;
+    render_options.progress = [&](uint32_t done, uint32_t total) { progress.update(done, total); };
+    result = gpu::render(ctx, pipeline, scene, image, render_options, &stats);
+  }
+  if (validation_log->count() > 0)
+    throw DeviceError(std::to_string(validation_log->count()) + " validation message(s); the first:\n  " +
+                      validation_log->messages().front());
 
   // ---- write ----
   start = Clock::now();

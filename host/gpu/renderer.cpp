@@ -99,7 +99,8 @@ Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, co
   const vk::DescriptorPoolSize pool_sizes[] = {{vk::DescriptorType::eUniformBuffer, 1},
                                                {kTexel, 4},
                                                {vk::DescriptorType::eStorageBuffer, 1}};
-  const vk::raii::DescriptorPool pool(device, vk::DescriptorPoolCreateInfo({}, 1, pool_sizes));
+  // eFreeDescriptorSet: vk::raii::DescriptorSets frees its set when destroyed.
+  const vk::raii::DescriptorPool pool(device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, pool_sizes));
   const vk::DescriptorSetLayout set_layout = *pipeline.set_layout();
   vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pool, set_layout));
   const vk::DescriptorSet set = *sets[0];
@@ -123,7 +124,7 @@ Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, co
   vk::raii::CommandBuffers cbs(device, {*command_pool, vk::CommandBufferLevel::ePrimary, 1});
   const vk::raii::CommandBuffer& cb = cbs[0];
   const vk::raii::Fence fence(device, vk::FenceCreateInfo{});
-  const uint32_t side = tile_side(scene, image);
+  const uint32_t side = options.tile_side ? options.tile_side : tile_side(scene, image);
   const uint32_t tiles_x = (image.width + side - 1) / side, tiles_y = (image.height + side - 1) / side;
   const uint32_t tile_count = tiles_x * tiles_y;
   for (uint32_t tile_index = 0; tile_index < tile_count; ++tile_index) {

@@ -41,6 +41,8 @@ struct RenderStats {
 struct RenderOptions {
   // Longest a single tile may run before the render fails with a device error.
   std::chrono::milliseconds tile_timeout{60000};
+  // Tile side in pixels; 0 chooses it from the scene (see tile_side()).
+  uint32_t tile_side = 0;
   // Called after each tile with (tiles done, tiles in all).
   std::function<void(uint32_t, uint32_t)> progress;
 };

@@ -80,7 +80,10 @@ std::string format_log(const std::string& log) {
   std::smatch m;
   while (std::getline(in, line)) {
     if (std::regex_match(line, m, located)) {
-      out += m[2].str() + ":" + m[3].str() + ": " + (m[1] == "ERROR" ? "error" : "warning") + ": " + m[4].str() + "\n";
+      std::string message = m[4].str();
+      if (message.rfind("'' : ", 0) == 0) message = message.substr(5);  // no token to quote
+      while (!message.empty() && message.front() == ' ') message.erase(0, 1);
+      out += m[2].str() + ":" + m[3].str() + ": " + (m[1] == "ERROR" ? "error" : "warning") + ": " + message + "\n";
     } else if (!line.empty() && line.find("compilation errors") == std::string::npos &&
                line.find("No code generated") == std::string::npos) {
       out += line + "\n";

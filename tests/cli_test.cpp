@@ -1,0 +1,143 @@
+// The vkray command as a user runs it: outputs, messages and exit codes.
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "image.h"
+#include "support/temp_dir.h"
+
+namespace vkray::test {
+namespace {
+
+struct Result {
+  int exit_code;
+  std::string out, err;
+};
+
+// Runs `vkray ARGS` in `cwd`, capturing stdout and stderr.
+Result vkray(const std::string& args, const std::filesystem::path& cwd) {
+  const auto out = cwd / ".stdout", err = cwd / ".stderr";
+  const std::string command = "cd '" + cwd.string() + "' && '" VKRAY_EXECUTABLE "' " + args + " >'" + out.string() +
+                              "' 2>'" + err.string() + "' </dev/null";
+  const int status = std::system(command.c_str());
+  auto slurp = [](const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  Result run{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+  std::filesystem::remove(out);
+  std::filesystem::remove(err);
+  return run;
+}
+
+bool has_image_files(const std::filesystem::path& dir) {
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    if (entry.path().filename().string()[0] != '.' || entry.path().filename().string().find(".tmp-") != std::string::npos)
+      return true;
+  return false;
+}
+
+const std::string kScenes = VKRAY_SCENE_DIR;
+
+TEST(CliTest, RendersTheDefaultSceneToSceneNamePng) {
+  TempDir dir;
+  const Result run = vkray("render --validate --width 64 --height 48", dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const Image image = read_png(dir / "cornell.png");
+  EXPECT_EQ(image.width, 64u);
+  EXPECT_EQ(image.height, 48u);
+  // stderr reports the device, every phase and the ray rate.
+  for (const char* word : {"device ", "load ", "compile ", "upload ", "trace ", "read back ", "write ", "Mrays/s", "wrote cornell.png"})
+    EXPECT_NE(run.err.find(word), std::string::npos) << word << " missing from:\n" << run.err;
+}
+
+TEST(CliTest, QuietPrintsNothing) {
+  TempDir dir;
+  const Result run = vkray("render --validate " + kScenes + "/cornell-spheres.json -q -o s.pfm --width 32 --height 32 --spp 4", dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  EXPECT_EQ(read_pfm(dir / "s.pfm").width, 32u);
+}
+
+TEST(CliTest, BadSceneExitsOneNamingFileAndKeyAndWritesNothing) {
+  TempDir dir;
+  std::ofstream(dir / "bad.json") << R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "focal_length": 1},
+    "materials": {"m": {"albedo": [1, 1, 1]}},
+    "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": -2, "material": "m"}]})";
+  const Result run = vkray("render --validate bad.json -o out.png", dir.path());
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("bad.json: /objects/0/radius: expected a number > 0"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.png"));
+  std::filesystem::remove(dir / "bad.json");
+  EXPECT_FALSE(has_image_files(dir.path()));
+}
+
+TEST(CliTest, MissingSceneExitsOne) {
+  TempDir dir;
+  const Result run = vkray("render nowhere.json", dir.path());
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("nowhere.json"), std::string::npos) << run.err;
+}
+
+TEST(CliTest, BrokenShaderExitsOneWithFileAndLineAndWritesNothing) {
+  TempDir dir;
+  std::filesystem::copy(VKRAY_SHADER_DIR, dir / "shaders", std::filesystem::copy_options::recursive);
+  {
+    std::ofstream(dir / "shaders" / "shade.glsl", std::ios::app) << "\nthis is not glsl;\n";
+  }
+  const Result run = vkray("render --validate --shader-dir shaders -o out.png", dir.path());
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("shaders/shade.glsl:"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.png"));
+}
+
+TEST(CliTest, UsageErrorsExitTwo) {
+  TempDir dir;
+  EXPECT_EQ(vkray("", dir.path()).exit_code, 2);
+  EXPECT_EQ(vkray("frobnicate", dir.path()).exit_code, 2);
+  EXPECT_EQ(vkray("render --spp 0", dir.path()).exit_code, 2);
+  EXPECT_EQ(vkray("render --width -3", dir.path()).exit_code, 2);
+  EXPECT_EQ(vkray("render --no-such-flag", dir.path()).exit_code, 2);
+  EXPECT_FALSE(has_image_files(dir.path()));
+}
+
+TEST(CliTest, UnknownOutputTypeExitsOneBeforeRendering) {
+  TempDir dir;
+  const Result run = vkray("render -o out.jpg", dir.path());
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("out.jpg"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("device "), std::string::npos) << "should fail before touching the device";
+}
+
+TEST(CliTest, UnknownDeviceExitsThreeAndListsDevices) {
+  TempDir dir;
+  const Result run = vkray("render --device no-such-gpu", dir.path());
+  EXPECT_EQ(run.exit_code, 3);
+  EXPECT_NE(run.err.find("no Vulkan device matches --device \"no-such-gpu\""), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("0: "), std::string::npos) << run.err;
+}
+
+TEST(CliTest, DevicesListsEachDevice) {
+  TempDir dir;
+  const Result run = vkray("devices", dir.path());
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("0: "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("max texel buffer elements"), std::string::npos) << run.out;
+}
+
+TEST(CliTest, HelpDocumentsExitCodes) {
+  TempDir dir;
+  const Result run = vkray("render --help", dir.path());
+  EXPECT_EQ(run.exit_code, 0);
+  EXPECT_NE(run.out.find("Exit codes"), std::string::npos) << run.out;
+}
+
+}  // namespace
+}  // namespace vkray::test

@@ -1,0 +1,88 @@
+// Image encoding and files: the contract's sRGB rule, PFM layout, atomic writes.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "errors.h"
+#include "image.h"
+
+namespace vkray {
+namespace {
+
+class ImageFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("vkray-image-test-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  static Image gradient() {
+    Image image(5, 3);
+    for (uint32_t y = 0; y < 3; ++y)
+      for (uint32_t x = 0; x < 5; ++x) image.at(x, y) = {float(x) * 0.25f, float(y) * 0.5f, 0.125f + float(x * y) * 0.01f};
+    return image;
+  }
+  std::filesystem::path dir_;
+};
+
+TEST(SrgbTest, EncodesAsTheContractSays) {
+  EXPECT_EQ(encode_srgb8(0.0f), 0);
+  EXPECT_EQ(encode_srgb8(1.0f), 255);
+  EXPECT_EQ(encode_srgb8(0.5f), 188);     // 255 * (1.055 * 0.5^(1/2.4) - 0.055) = 187.5
+  EXPECT_EQ(encode_srgb8(0.001f), 3);     // linear segment: 255 * 12.92 * 0.001 = 3.29
+  EXPECT_EQ(encode_srgb8(0.25f), 137);     // 255 * 0.5371 = 136.96
+  EXPECT_EQ(encode_srgb8(7.0f), 255);     // clamped
+  EXPECT_EQ(encode_srgb8(-1.0f), 0);
+  EXPECT_EQ(encode_srgb8(std::numeric_limits<float>::quiet_NaN()), 0);
+  EXPECT_EQ(encode_srgb8(std::numeric_limits<float>::infinity()), 255);
+}
+
+TEST(SrgbTest, DecodeInvertsEncode) {
+  for (int v = 0; v < 256; ++v) EXPECT_EQ(encode_srgb8(decode_srgb8(uint8_t(v))), v);
+}
+
+TEST_F(ImageFileTest, PfmRoundTripsExactlyWithTheTopRowFirstInMemory) {
+  const Image image = gradient();
+  write_image(image, dir_ / "g.pfm");
+  const Image back = read_pfm(dir_ / "g.pfm");
+  ASSERT_EQ(back.width, 5u);
+  ASSERT_EQ(back.height, 3u);
+  EXPECT_EQ(back.pixels, image.pixels);
+  // On disk the bottom row comes first: the first float after the header is the bottom-left red.
+  std::ifstream in(dir_ / "g.pfm", std::ios::binary);
+  std::string header;
+  for (int i = 0; i < 3; ++i) std::getline(in, header);
+  EXPECT_EQ(header, "-1.0");
+  float first[3];
+  in.read(reinterpret_cast<char*>(first), sizeof first);
+  EXPECT_EQ(first[1], image.at(0, 2).g);
+}
+
+TEST_F(ImageFileTest, PngRoundTripsThroughEightBitSrgb) {
+  const Image image = gradient();
+  write_image(image, dir_ / "g.png");
+  const Image back = read_png(dir_ / "g.png");
+  ASSERT_EQ(back.width, 5u);
+  for (size_t i = 0; i < image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(encode_srgb8(back.pixels[i][c]), encode_srgb8(image.pixels[i][c]));
+}
+
+TEST_F(ImageFileTest, FailedWritesLeaveNoFile) {
+  EXPECT_THROW(write_image(gradient(), dir_ / "missing-folder" / "x.png"), OutputError);
+  EXPECT_THROW(write_image(gradient(), dir_ / "x.jpg"), OutputError);
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));  // no partial file, no temporary left behind
+}
+
+TEST_F(ImageFileTest, WriteReplacesAnExistingFile) {
+  write_image(Image(2, 2), dir_ / "r.pfm");
+  write_image(gradient(), dir_ / "r.pfm");
+  EXPECT_EQ(read_pfm(dir_ / "r.pfm").width, 5u);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_), {}), 1);
+}
+
+}  // namespace
+}  // namespace vkray

@@ -1,0 +1,258 @@
+// Scene files: the contract's keys, their defaults, transforms, and every error a user can make.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <glm/gtc/constants.hpp>
+
+#include "errors.h"
+#include "scene.h"
+
+namespace vkray {
+namespace {
+
+constexpr const char* kCamera = R"("camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "focal_length": 1})";
+
+std::string with_camera(const std::string& rest) { return std::string("{") + kCamera + (rest.empty() ? "" : ", ") + rest + "}"; }
+
+// Parsing `json` throws a SceneError whose message starts with "test.json" and contains `where`.
+void expect_error(const std::string& json, const std::string& where, const std::string& what = "") {
+  try {
+    parse_scene(json, "test.json");
+    ADD_FAILURE() << "no error for: " << json;
+  } catch (const SceneError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind("test.json", 0), 0u) << message;
+    EXPECT_NE(message.find(where), std::string::npos) << "expected \"" << where << "\" in: " << message;
+    EXPECT_NE(message.find(what), std::string::npos) << "expected \"" << what << "\" in: " << message;
+  }
+}
+
+TEST(SceneTest, CornellBoxLoads) {
+  const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
+  EXPECT_EQ(scene.name, "cornell");
+  EXPECT_EQ(scene.triangles.size(), 30u);
+  EXPECT_EQ(scene.materials.size(), 7u);
+  ASSERT_EQ(scene.lights.size(), 1u);
+  EXPECT_NEAR(scene.lights[0].intensity.r, 14.0f / (4.0f * glm::pi<float>()), 1e-6f);
+  EXPECT_EQ(scene.camera.forward, glm::vec3(0, 0, 1));
+  EXPECT_EQ(scene.camera.focal_length, 1.0f);
+  EXPECT_TRUE(scene.warnings.empty());
+  // The lab's scaling: raw (555, 0, 0) -> (-1, 1, -1). Every room vertex lands on the [-1, 1] cube.
+  for (const Triangle& t : scene.triangles)
+    for (const glm::vec3& v : t.v)
+      for (int c = 0; c < 3; ++c) EXPECT_LE(std::abs(v[c]), 1.0f + 1e-6f);
+}
+
+TEST(SceneTest, DefaultsWhenKeysAreLeftOut) {
+  const Scene scene = parse_scene(with_camera(""), "test.json");
+  EXPECT_EQ(scene.image.width, 512u);
+  EXPECT_EQ(scene.image.height, 512u);
+  EXPECT_EQ(scene.image.samples_per_pixel, 1u);
+  EXPECT_EQ(scene.background, glm::vec3(0));
+  EXPECT_EQ(scene.ambient, glm::vec3(0));
+  EXPECT_EQ(scene.camera.up, glm::vec3(0, 1, 0));
+  EXPECT_TRUE(scene.triangles.empty());
+}
+
+TEST(SceneTest, CameraLookAtAndFieldOfView) {
+  const Scene scene = parse_scene(
+      R"({"camera": {"position": [1, 2, 3], "look_at": [1, 2, 7], "up": [0, 1, 0], "vertical_fov": 90}})", "t.json");
+  EXPECT_EQ(scene.camera.forward, glm::vec3(0, 0, 1));
+  EXPECT_NEAR(scene.camera.focal_length, 0.5f, 1e-6f);  // (H/2) / tan(45 deg) = H/2
+}
+
+TEST(SceneTest, PowerIsConvertedToIntensity) {
+  const Scene scene = parse_scene(
+      with_camera(R"("lights": [{"type": "point", "position": [0, 0, 0], "power": [4, 8, 0]}])"), "t.json");
+  EXPECT_NEAR(scene.lights[0].intensity.r, 1.0f / glm::pi<float>(), 1e-6f);
+  EXPECT_NEAR(scene.lights[0].intensity.g, 2.0f / glm::pi<float>(), 1e-6f);
+}
+
+TEST(SceneTest, TransformOrderIsTranslateRotateZYXScale) {
+  // Point (1, 0, 0): scale 2 -> (2, 0, 0); Rx(90) keeps it; Ry(0); Rz(90) -> (0, 2, 0); translate -> (10, 2, 0).
+  const Scene scene = parse_scene(with_camera(R"(
+    "materials": {"m": {"albedo": [1, 1, 1]}},
+    "objects": [{"type": "triangles", "material": "m", "positions": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+                 "indices": [[0, 1, 2]], "transform": {"translate": [10, 0, 0], "rotate": [90, 0, 90], "scale": 2}}])"),
+                                  "t.json");
+  const glm::vec3 p = scene.triangles[0].v[0];
+  EXPECT_NEAR(p.x, 10.0f, 1e-5f);
+  EXPECT_NEAR(p.y, 2.0f, 1e-5f);
+  EXPECT_NEAR(p.z, 0.0f, 1e-5f);
+  // (0, 1, 0): scale -> (0, 2, 0); Rx(90) -> (0, 0, 2); Rz(90) keeps it; translate -> (10, 0, 2).
+  const glm::vec3 q = scene.triangles[0].v[1];
+  EXPECT_NEAR(q.x, 10.0f, 1e-5f);
+  EXPECT_NEAR(q.y, 0.0f, 1e-5f);
+  EXPECT_NEAR(q.z, 2.0f, 1e-5f);
+}
+
+TEST(SceneTest, SphereTakesUniformScaleAndMatrix) {
+  const Scene scene = parse_scene(with_camera(R"(
+    "materials": {"m": {"albedo": [1, 1, 1]}},
+    "objects": [{"type": "sphere", "center": [1, 0, 0], "radius": 0.5, "material": "m",
+                 "transform": {"translate": [0, 0, 5], "rotate": [0, 0, 90], "scale": 3}},
+                {"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m",
+                 "transform": {"matrix": [0, -2, 0, 1,  2, 0, 0, 2,  0, 0, 2, 3,  0, 0, 0, 1]}}])"),
+                                  "t.json");
+  ASSERT_EQ(scene.spheres.size(), 2u);
+  EXPECT_NEAR(scene.spheres[0].center.x, 0.0f, 1e-5f);
+  EXPECT_NEAR(scene.spheres[0].center.y, 3.0f, 1e-5f);
+  EXPECT_NEAR(scene.spheres[0].center.z, 5.0f, 1e-5f);
+  EXPECT_NEAR(scene.spheres[0].radius, 1.5f, 1e-6f);
+  EXPECT_EQ(scene.spheres[1].center, glm::vec3(1, 2, 3));
+  EXPECT_NEAR(scene.spheres[1].radius, 2.0f, 1e-6f);
+}
+
+TEST(SceneTest, NoLightsAndNoAmbientWarns) {
+  const Scene scene = parse_scene(with_camera(R"("materials": {"m": {"albedo": [1, 1, 1]}},
+    "objects": [{"type": "triangles", "material": "m", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [[0, 1, 2]]}])"),
+                                  "t.json");
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  EXPECT_NE(scene.warnings[0].find("no lights and no ambient"), std::string::npos) << scene.warnings[0];
+}
+
+TEST(SceneTest, CommentsAreAllowed) {
+  EXPECT_NO_THROW(parse_scene("{ // a comment\n" + std::string(kCamera) + " /* another */ }", "t.json"));
+}
+
+TEST(SceneTest, UnknownKeysWarnWithTheirPath) {
+  const Scene scene = parse_scene(with_camera(R"("lihgts": [], "image": {"widht": 3})"), "t.json");
+  ASSERT_EQ(scene.warnings.size(), 2u);
+  EXPECT_NE(scene.warnings[0].find("t.json: /lihgts: unknown key"), std::string::npos) << scene.warnings[0];
+  EXPECT_NE(scene.warnings[1].find("/image/widht"), std::string::npos) << scene.warnings[1];
+}
+
+TEST(SceneTest, DegenerateTrianglesAreDroppedWithAWarning) {
+  const Scene scene = parse_scene(with_camera(R"(
+    "materials": {"m": {"albedo": [1, 1, 1]}},
+    "objects": [{"type": "triangles", "material": "m", "positions": [[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]],
+                 "indices": [[0, 1, 2], [0, 1, 3]]}])"),
+                                  "t.json");
+  EXPECT_EQ(scene.triangles.size(), 1u);
+  ASSERT_FALSE(scene.warnings.empty());
+  EXPECT_NE(scene.warnings[0].find("/objects/0/indices: 1 degenerate"), std::string::npos) << scene.warnings[0];
+}
+
+TEST(SceneTest, SyntaxErrorsNameLineAndColumn) {
+  expect_error("{\n  \"camera\": {\n    \"position\": [0, 0, 0],\n  }\n}", "test.json:4:3:", "syntax error");
+  expect_error("", "test.json:1:1:");
+  expect_error("{\"camera\": {\"position\": [0, 0", "test.json:1:");
+}
+
+TEST(SceneTest, FileErrors) {
+  EXPECT_THROW(load_scene("/nonexistent/scene.json"), SceneError);
+  EXPECT_THROW(load_scene(VKRAY_SCENE_DIR), SceneError);  // a directory
+}
+
+TEST(SceneTest, StructureErrors) {
+  expect_error("[]", "top level", "expected an object");
+  expect_error("{}", "top level", "missing required key \"camera\"");
+  expect_error(R"({"camera": []})", "/camera", "expected an object, got array");
+  expect_error(with_camera(R"("objects": {})"), "/objects", "expected an array");
+  expect_error(with_camera(R"("lights": [3])"), "/lights/0", "expected an object");
+  expect_error(with_camera(R"("materials": [])"), "/materials", "expected an object");
+}
+
+TEST(SceneTest, CameraErrors) {
+  expect_error(R"({"camera": {"direction": [0, 0, 1], "focal_length": 1}})", "/camera", "\"position\"");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "focal_length": 1}})", "/camera", "\"look_at\" (or \"direction\")");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "look_at": [0, 0, 1], "direction": [0, 0, 1], "focal_length": 1}})",
+               "/camera", "not both");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 0], "focal_length": 1}})", "/camera/direction",
+               "zero length");
+  expect_error(R"({"camera": {"position": [1, 1, 1], "look_at": [1, 1, 1], "focal_length": 1}})", "/camera/look_at",
+               "equals the camera position");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "up": [0, 0, -2], "focal_length": 1}})",
+               "/camera/up", "parallel");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 1, 0], "focal_length": 1}})", "/camera",
+               "default up");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "up": [0, 0, 0], "focal_length": 1}})",
+               "/camera/up", "zero length");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1]}})", "/camera", "vertical_fov");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "vertical_fov": 180}})",
+               "/camera/vertical_fov", "(0, 180)");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "focal_length": 0}})",
+               "/camera/focal_length", "> 0");
+  expect_error(R"({"camera": {"position": [0, 0], "direction": [0, 0, 1], "focal_length": 1}})", "/camera/position",
+               "3 numbers");
+  expect_error(R"({"camera": {"position": [0, "0", 0], "direction": [0, 0, 1], "focal_length": 1}})",
+               "/camera/position/1", "expected a number, got string");
+  expect_error(R"({"camera": {"position": [0, 1e39, 0], "direction": [0, 0, 1], "focal_length": 1}})",
+               "/camera/position/1", "out of range");
+}
+
+TEST(SceneTest, ImageErrors) {
+  expect_error(with_camera(R"("image": {"width": 0})"), "/image/width", "1 to 16384");
+  expect_error(with_camera(R"("image": {"height": 100000})"), "/image/height", "1 to 16384");
+  expect_error(with_camera(R"("image": {"width": 12.5})"), "/image/width");
+  expect_error(with_camera(R"("image": {"samples_per_pixel": 0})"), "/image/samples_per_pixel");
+  expect_error(with_camera(R"("image": {"samples_per_pixel": 1000000000})"), "/image/samples_per_pixel");
+}
+
+TEST(SceneTest, MaterialAndColourErrors) {
+  expect_error(with_camera(R"("materials": {"m": {}})"), "/materials/m", "\"albedo\"");
+  expect_error(with_camera(R"("materials": {"m": {"albedo": [1, -0.5, 1]}})"), "/materials/m/albedo", "non-negative");
+  expect_error(with_camera(R"("ambient": [1, 1])"), "/ambient", "3 numbers");
+  expect_error(with_camera(R"("background": "black")"), "/background");
+}
+
+TEST(SceneTest, LightErrors) {
+  expect_error(with_camera(R"("lights": [{"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1]}])"),
+               "/lights/0/type", "unknown light type");
+  expect_error(with_camera(R"("lights": [{"position": [0, 0, 0], "intensity": [1, 1, 1]}])"), "/lights/0", "\"type\"");
+  expect_error(with_camera(R"("lights": [{"type": "point", "position": [0, 0, 0]}])"), "/lights/0", "\"intensity\"");
+  expect_error(with_camera(R"("lights": [{"type": "point", "position": [0, 0, 0], "intensity": [1, 1, 1], "power": [1, 1, 1]}])"),
+               "/lights/0", "not both");
+  expect_error(with_camera(R"("lights": [{"type": "point", "position": [0, 0, 0], "intensity": [1, -1, 1]}])"),
+               "/lights/0/intensity", "non-negative");
+}
+
+TEST(SceneTest, ObjectErrors) {
+  const std::string m = R"("materials": {"m": {"albedo": [1, 1, 1]}}, )";
+  expect_error(with_camera(m + R"("objects": [{"center": [0, 0, 0]}])"), "/objects/0", "\"type\"");
+  expect_error(with_camera(m + R"("objects": [{"type": "cube"}])"), "/objects/0/type", "unknown object type");
+  expect_error(with_camera(m + R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": -1, "material": "m"}])"),
+               "/objects/0/radius", "> 0");
+  expect_error(with_camera(m + R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 0, "material": "m"}])"),
+               "/objects/0/radius", "> 0");
+  expect_error(with_camera(m + R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "x"}])"),
+               "/objects/0/material", "undefined material \"x\"");
+  expect_error(with_camera(m + R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}])"), "/objects/0",
+               "\"material\"");
+  expect_error(with_camera(m + R"("objects": [{"type": "triangles", "material": "m", "positions": [[0, 0, 0]], "indices": [[0, 0, 1]]}])"),
+               "/objects/0/indices/0/2", "out of range");
+  expect_error(with_camera(m + R"("objects": [{"type": "triangles", "material": "m", "positions": [[0, 0, 0]], "indices": [[0, -1, 0]]}])"),
+               "/objects/0/indices/0/1", "out of range");
+  expect_error(with_camera(m + R"("objects": [{"type": "triangles", "material": "m", "positions": [[0, 0, 0]], "indices": [[0, 0]]}])"),
+               "/objects/0/indices/0", "3 vertex indices");
+  expect_error(with_camera(m + R"("objects": [{"type": "triangles", "material": "m", "positions": [[0, 0]], "indices": []}])"),
+               "/objects/0/positions/0", "3 numbers");
+  expect_error(with_camera(m + R"("objects": [{"type": "triangles", "material": "m", "indices": []}])"), "/objects/0",
+               "\"positions\"");
+}
+
+TEST(SceneTest, TransformErrors) {
+  const std::string m = R"("materials": {"m": {"albedo": [1, 1, 1]}}, )";
+  const std::string sphere = R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m", "transform": )";
+  expect_error(with_camera(m + R"("objects": [)" + sphere + R"({"scale": [1, 2, 1]}}])"), "/objects/0/transform",
+               "uniform scale");
+  expect_error(with_camera(m + R"("objects": [)" + sphere + R"({"matrix": [1, 0, 0, 0,  0, 2, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]}}])"),
+               "/objects/0/transform", "uniform scale");
+  expect_error(with_camera(m + R"("objects": [)" + sphere + R"({"scale": 0}}])"), "/objects/0/transform/scale", "non-zero");
+  expect_error(with_camera(m + R"("objects": [)" + sphere + R"({"matrix": [1, 0, 0]}}])"), "/objects/0/transform/matrix",
+               "16 numbers");
+  expect_error(with_camera(m + R"("objects": [)" + sphere + R"({"matrix": [1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 1, 0,  0, 0, 1, 1]}}])"),
+               "/objects/0/transform/matrix", "affine");
+  expect_error(with_camera(m + R"("objects": [)" + sphere + R"({"matrix": [1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 0, 0,  0, 0, 0, 1]}}])"),
+               "/objects/0/transform/matrix", "singular");
+  expect_error(with_camera(m + R"("objects": [)" + sphere + R"({"matrix": [1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1], "translate": [1, 0, 0]}}])"),
+               "/objects/0/transform", "not both");
+  expect_error(with_camera(m + R"("objects": [)" + sphere + R"({"rotate": [0, 0]}}])"), "/objects/0/transform/rotate",
+               "3 numbers");
+}
+
+}  // namespace
+}  // namespace vkray
