@@ -9,17 +9,34 @@
 
 namespace vkray {
 
-struct RenderCommand {
-  std::filesystem::path scene;   // empty: the default scene
-  std::filesystem::path output;  // empty: <scene name>.png in the current folder
+// Options shared by every command that renders.
+struct RenderFlags {
+  std::filesystem::path scene;  // empty: the default scene
   std::optional<uint32_t> width, height, spp;
   std::string device;
   std::filesystem::path shader_dir;  // empty: the installed (or source-tree) shaders
   bool validate = false;
+  unsigned threads = 0;  // CPU reference threads; 0: one per hardware thread
+};
+
+struct RenderCommand {
+  RenderFlags flags;
+  std::filesystem::path output;  // empty: <scene name>.png in the current folder
+  std::string renderer = "gpu";  // "gpu" or "cpu"
   bool quiet = false;
 };
 
+struct ParityCommand {
+  RenderFlags flags;
+  std::filesystem::path diff;  // where to write the difference heatmap; empty: none
+  bool json = false;
+};
+
 int run_render(const RenderCommand& command);
+int run_parity(const ParityCommand& command);
 int run_devices();
+
+// `vkray parity` exits with this when the images differ beyond the tolerance.
+constexpr int kExitParityFailed = 4;
 
 }  // namespace vkray

@@ -15,7 +15,22 @@ constexpr const char* kExitCodes =
     "  0  success\n"
     "  1  bad input: scene, mesh or shader file, or an output file that cannot be written\n"
     "  2  usage: unknown command or option, bad option value\n"
-    "  3  Vulkan or device failure (no device, failed call, timeout, validation message)\n";
+    "  3  Vulkan or device failure (no device, failed call, timeout, validation message)\n"
+    "  4  parity: the GPU and CPU images differ beyond the documented tolerance\n";
+
+// Flags every rendering command takes.
+void add_render_flags(CLI::App* cmd, vkray::RenderFlags& flags) {
+  cmd->add_option("scene", flags.scene, "Scene file (default: the Cornell box, scenes/cornell.json)");
+  cmd->add_option("--width", flags.width, "Image width in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", flags.height, "Image height in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--spp", flags.spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1, 65536));
+  cmd->add_option("--device", flags.device, "Vulkan device: index or part of its name (see `vkray devices`)");
+  cmd->add_option("--shader-dir", flags.shader_dir, "Folder with trace.comp and its includes");
+  cmd->add_flag("--validate", flags.validate, "Enable the Khronos validation layer; any message is an error");
+  cmd->add_option("--threads", flags.threads, "CPU reference threads (default: one per hardware thread)")
+      ->check(CLI::Range(1, 256));
+  cmd->footer(kExitCodes);
+}
 
 }  // namespace
 
@@ -28,17 +43,20 @@ int main(int argc, char** argv) {
 
   RenderCommand render;
   auto* render_cmd = app.add_subcommand("render", "Render a scene to a PNG or PFM image.");
-  render_cmd->add_option("scene", render.scene, "Scene file (default: the Cornell box, scenes/cornell.json)");
+  add_render_flags(render_cmd, render.flags);
   render_cmd->add_option("-o,--output", render.output, "Output image, .png (8-bit sRGB) or .pfm (float, linear); "
                                                        "default: <scene name>.png in the current folder");
-  render_cmd->add_option("--width", render.width, "Image width in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
-  render_cmd->add_option("--height", render.height, "Image height in pixels (overrides the scene)")->check(CLI::Range(1, 16384));
-  render_cmd->add_option("--spp", render.spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1, 65536));
-  render_cmd->add_option("--device", render.device, "Vulkan device: index or part of its name (see `vkray devices`)");
-  render_cmd->add_option("--shader-dir", render.shader_dir, "Folder with trace.comp and its includes");
-  render_cmd->add_flag("--validate", render.validate, "Enable the Khronos validation layer; any message is an error");
+  render_cmd->add_option("--renderer", render.renderer, "gpu (Vulkan compute shader) or cpu (the CPU reference)")
+      ->check(CLI::IsMember({"gpu", "cpu"}));
   render_cmd->add_flag("-q,--quiet", render.quiet, "Print only warnings and errors");
-  render_cmd->footer(kExitCodes);
+
+  ParityCommand parity;
+  auto* parity_cmd = app.add_subcommand(
+      "parity", "Render a scene on the GPU and with the CPU reference, compare, and exit 4 if they differ "
+                "beyond the tolerance.");
+  add_render_flags(parity_cmd, parity.flags);
+  parity_cmd->add_option("--diff", parity.diff, "Write a heatmap of the per-pixel difference (.png or .pfm)");
+  parity_cmd->add_flag("--json", parity.json, "Print the metrics as one JSON object on stdout (and nothing else)");
 
   auto* devices_cmd = app.add_subcommand("devices", "List Vulkan devices with the properties that matter to vkray.");
 
@@ -53,6 +71,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*render_cmd) return run_render(render);
+    if (*parity_cmd) return run_parity(parity);
     if (*devices_cmd) return run_devices();
   } catch (const ShaderError& e) {
     std::cerr << "vkray: shader compilation failed:\n" << e.what() << "\n";

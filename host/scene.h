@@ -2,6 +2,7 @@
 // transform already applied, so renderers only see world-space primitives.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -62,6 +63,10 @@ struct Scene {
 
   // Largest absolute coordinate of anything in the scene (geometry, lights, camera).
   float extent() const;
+
+  // The contract's epsilon: the offset of shadow-ray origins and the smallest accepted t. 1e-5 of
+  // the scene's extent: far above float rounding at that scale (~1e-7 relative), far below any feature.
+  float epsilon() const { return std::max(extent(), 1e-30f) * 1e-5f; }
 };
 
 // Reads and validates a scene file. Throws SceneError naming the file and the key (as a JSON

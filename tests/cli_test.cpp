@@ -7,6 +7,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "image.h"
 #include "support/temp_dir.h"
@@ -130,6 +131,54 @@ TEST(CliTest, DevicesListsEachDevice) {
   EXPECT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("0: "), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("max texel buffer elements"), std::string::npos) << run.out;
+}
+
+TEST(CliTest, CpuRendererWritesTheSameKindOfImage) {
+  TempDir dir;
+  const Result run = vkray("render --renderer cpu --threads 2 -o c.pfm --width 40 --height 30", dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(read_pfm(dir / "c.pfm").width, 40u);
+  EXPECT_NE(run.err.find("CPU reference, 2 threads"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("Mrays/s"), std::string::npos) << run.err;
+  EXPECT_EQ(vkray("render --renderer fpga", dir.path()).exit_code, 2);
+}
+
+TEST(CliTest, ParityPassesAndPrintsJson) {
+  TempDir dir;
+  const Result run = vkray("parity --validate --width 96 --height 96 --json --diff d.png", dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  const auto j = nlohmann::json::parse(run.out);  // stdout is exactly one JSON object
+  EXPECT_TRUE(j.at("pass").get<bool>());
+  EXPECT_EQ(j.at("width").get<int>(), 96);
+  for (const char* key : {"max_abs_diff", "mean_abs_diff", "psnr_db", "share_over_1", "share_over_2", "worst_pixel",
+                          "gpu_trace_seconds", "cpu_trace_seconds"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(read_png(dir / "d.png").width, 96u);
+}
+
+TEST(CliTest, ParityPrintsReadableMetrics) {
+  TempDir dir;
+  const Result run = vkray("parity --validate --width 64 --height 64", dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  for (const char* text : {"max |GPU - CPU|", "PSNR", "8-bit sRGB differences: > 1 on", "tolerance", "PASS"})
+    EXPECT_NE(run.out.find(text), std::string::npos) << text << " missing from:\n" << run.out;
+}
+
+TEST(CliTest, ParityCatchesAPerturbedShader) {
+  // A shader that renders 2% too bright must fail parity with exit code 4.
+  TempDir dir;
+  std::filesystem::copy(VKRAY_SHADER_DIR, dir / "shaders", std::filesystem::copy_options::recursive);
+  const auto entry = dir / "shaders" / "trace.comp";
+  std::ifstream in(entry);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::string from = "sum * frame.inv_samples_per_pixel";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), from + " * 1.02");
+  std::ofstream(entry) << text;
+  const Result run = vkray("parity --validate --shader-dir shaders --width 64 --height 64 --diff d.png", dir.path());
+  EXPECT_EQ(run.exit_code, 4) << run.err << run.out;
+  EXPECT_NE(run.out.find("FAIL"), std::string::npos) << run.out;
+  EXPECT_TRUE(std::filesystem::exists(dir / "d.png"));
 }
 
 TEST(CliTest, HelpDocumentsExitCodes) {

@@ -12,8 +12,6 @@ float bits(uint32_t v) { return std::bit_cast<float>(v); }
 
 }  // namespace
 
-float scene_epsilon(const Scene& scene) { return std::max(scene.extent(), 1e-30f) * 1e-5f; }
-
 PackedScene pack_scene(const Scene& scene, const ImageSettings& image) {
   PackedScene packed;
   FrameUniforms& f = packed.frame;
@@ -36,7 +34,7 @@ PackedScene pack_scene(const Scene& scene, const ImageSettings& image) {
   f.inv_strata_x = strata.inv_x;
   f.inv_strata_y = strata.inv_y;
   f.inv_samples_per_pixel = 1.0f / static_cast<float>(image.samples_per_pixel);
-  f.epsilon = scene_epsilon(scene);
+  f.epsilon = scene.epsilon();
 
   packed.triangles.reserve(scene.triangles.size() * VKRAY_TEXELS_PER_TRIANGLE);
   for (const Triangle& t : scene.triangles) {

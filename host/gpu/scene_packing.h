@@ -33,8 +33,4 @@ struct PackedScene {
 // `image` is the resolution actually rendered (the scene's, or the command line's).
 PackedScene pack_scene(const Scene& scene, const ImageSettings& image);
 
-// The offset applied to secondary-ray origins and the smallest accepted t: 1e-5 of the scene's
-// extent, far above float rounding at that scale (~1e-7 relative) and far below any feature.
-float scene_epsilon(const Scene& scene);
-
 }  // namespace vkray::gpu

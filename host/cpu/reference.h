@@ -1,0 +1,32 @@
+// The CPU reference renderer: an independent second implementation of the scene and shading
+// contract, against which the GPU path is checked (vkray parity). It shares only the scene loader,
+// the camera basis and the sample pattern with the GPU path; its intersection and shading code is
+// its own, written the plain way the lecture writes it, in double precision.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "image.h"
+#include "scene.h"
+
+namespace vkray::cpu {
+
+struct ReferenceOptions {
+  unsigned threads = 0;  // 0: one per hardware thread. The image does not depend on it.
+  std::function<void(uint32_t rows_done, uint32_t rows)> progress;  // called under a lock
+};
+
+struct ReferenceResult {
+  Image image;
+  // Per pixel, a hash of what each sample saw (the primitive hit and the lights that lit it). Two
+  // neighbouring pixels with different signatures straddle a silhouette or shadow edge.
+  std::vector<uint64_t> signatures;
+  uint64_t rays = 0;  // camera rays + shadow rays
+  double seconds = 0;
+};
+
+ReferenceResult render_reference(const Scene& scene, const ImageSettings& image, const ReferenceOptions& options = {});
+
+}  // namespace vkray::cpu

@@ -1,0 +1,106 @@
+#include "parity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+
+namespace vkray {
+namespace {
+
+int srgb_step_difference(glm::vec3 a, glm::vec3 b) {
+  int worst = 0;
+  for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(encode_srgb8(a[c])) - int(encode_srgb8(b[c]))));
+  return worst;
+}
+
+bool on_edge(const std::vector<uint64_t>& s, uint32_t w, uint32_t h, uint32_t x, uint32_t y) {
+  const uint64_t here = s[size_t(y) * w + x];
+  return (x > 0 && s[size_t(y) * w + x - 1] != here) || (x + 1 < w && s[size_t(y) * w + x + 1] != here) ||
+         (y > 0 && s[size_t(y - 1) * w + x] != here) || (y + 1 < h && s[size_t(y + 1) * w + x] != here);
+}
+
+// Display-space colour for t in [0, 1]: dark purple, red, orange, pale yellow.
+glm::vec3 heat(double t) {
+  static const glm::vec3 stops[] = {{0.20f, 0.02f, 0.35f}, {0.80f, 0.10f, 0.25f}, {1.0f, 0.55f, 0.05f}, {1.0f, 1.0f, 0.6f}};
+  const double x = std::clamp(t, 0.0, 1.0) * 3.0;
+  const int i = std::min(int(x), 2);
+  return glm::mix(stops[i], stops[i + 1], float(x - i));
+}
+
+}  // namespace
+
+ParityMetrics compare_images(const Image& gpu, const Image& reference, const std::vector<uint64_t>& signatures,
+                             const ParityTolerance& tolerance) {
+  ParityMetrics m;
+  m.width = reference.width;
+  m.height = reference.height;
+  double sum_abs = 0, sum_sq = 0;
+  for (uint32_t y = 0; y < m.height; ++y) {
+    for (uint32_t x = 0; x < m.width; ++x) {
+      const glm::vec3 a = gpu.at(x, y), b = reference.at(x, y);
+      for (int c = 0; c < 3; ++c) {
+        const double d = std::abs(double(a[c]) - double(b[c]));
+        if (d > m.max_abs || std::isnan(d)) {
+          m.max_abs = std::isnan(d) ? std::numeric_limits<double>::infinity() : d;
+          m.worst_x = x;
+          m.worst_y = y;
+        }
+        sum_abs += d;
+        const double dc = std::clamp(double(a[c]), 0.0, 1.0) - std::clamp(double(b[c]), 0.0, 1.0);
+        sum_sq += dc * dc;
+      }
+      const bool edge = on_edge(signatures, m.width, m.height, x, y);
+      m.edge_pixels += edge;
+      const int steps = srgb_step_difference(a, b);
+      m.over_1 += steps > 1;
+      m.over_2 += steps > 2;
+      m.interior_over_1 += !edge && steps > 1;
+      m.interior_over_2 += !edge && steps > 2;
+      m.edge_over_1 += edge && steps > 1;
+    }
+  }
+  const double samples = double(m.pixels()) * 3.0;
+  m.mean_abs = sum_abs / samples;
+  const double mse = sum_sq / samples;
+  m.psnr = mse > 0 ? 10.0 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
+  m.pass = m.edge_share_over_1() <= tolerance.max_edge_share_over_1 && m.interior_over_1 <= tolerance.max_interior_over_1;
+  return m;
+}
+
+Image difference_heatmap(const Image& a, const Image& reference, int& max_steps) {
+  max_steps = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i) max_steps = std::max(max_steps, srgb_step_difference(a.pixels[i], reference.pixels[i]));
+  Image heatmap(reference.width, reference.height);
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
+    const int steps = srgb_step_difference(a.pixels[i], reference.pixels[i]);
+    glm::vec3 display;
+    if (steps == 0) {  // a faint grey copy of the reference, for orientation
+      const glm::vec3 r = reference.pixels[i];
+      const float luminance = std::clamp(0.2126f * r.r + 0.7152f * r.g + 0.0722f * r.b, 0.0f, 1.0f);
+      display = glm::vec3(0.05f + 0.2f * float(encode_srgb8(luminance)) / 255.0f);
+    } else {
+      display = heat(max_steps > 1 ? double(steps - 1) / double(max_steps - 1) : 0.0);
+    }
+    for (int c = 0; c < 3; ++c) heatmap.pixels[i][c] = decode_srgb8(uint8_t(std::lround(display[c] * 255.0f)));
+  }
+  return heatmap;
+}
+
+Image absolute_difference(const Image& a, const Image& b) {
+  Image diff(b.width, b.height);
+  for (size_t i = 0; i < b.pixels.size(); ++i) diff.pixels[i] = glm::abs(a.pixels[i] - b.pixels[i]);
+  return diff;
+}
+
+std::string describe_tolerance(const ParityTolerance& t) {
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "8-bit sRGB values differ by more than 1 on at most %llu pixels away from silhouette and shadow edges, "
+                "and on at most %.3g%% of the pixels on them",
+                static_cast<unsigned long long>(t.max_interior_over_1), t.max_edge_share_over_1 * 100.0);
+  return text;
+}
+
+}  // namespace vkray

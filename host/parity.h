@@ -1,0 +1,57 @@
+// Comparing the GPU image with the CPU reference: metrics, the tolerance, and a heatmap a person
+// can read at a glance.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "image.h"
+
+namespace vkray {
+
+// What may legitimately differ (README, "Parity"): a pixel whose samples straddle a silhouette or
+// shadow edge can flip, since GPU and CPU decide a ray that grazes an edge with different rounding.
+// Everywhere else the two agree to float precision, i.e. to within one step of 8-bit sRGB. The
+// edge allowance is a share of edge pixels, not of all pixels: edges are lines, so their share of
+// an image shrinks as its resolution grows, while the share of edge pixels that flip does not.
+struct ParityTolerance {
+  double max_edge_share_over_1 = 0.02;  // edge pixels whose 8-bit sRGB values differ by more than 1
+  uint64_t max_interior_over_1 = 0;     // such pixels away from edges
+};
+
+struct ParityMetrics {
+  uint32_t width = 0, height = 0;
+  double max_abs = 0;       // largest |GPU - CPU| over pixels and channels, linear radiance
+  double mean_abs = 0;      // mean over pixels and channels, linear
+  double psnr = 0;          // dB, of the images clamped to [0, 1] (what a PNG shows); infinite when equal
+  uint64_t over_1 = 0;      // pixels whose 8-bit sRGB values differ by more than 1 (in any channel)
+  uint64_t over_2 = 0;      //   ... by more than 2
+  uint64_t edge_pixels = 0; // pixels on a silhouette or shadow edge (from the reference's signatures)
+  uint64_t interior_over_1 = 0, interior_over_2 = 0;  // over_1 / over_2 away from edges
+  uint64_t edge_over_1 = 0;                            // over_1 on edges
+  uint32_t worst_x = 0, worst_y = 0;                   // where max_abs is
+  bool pass = false;
+
+  uint64_t pixels() const { return uint64_t(width) * height; }
+  double share_over_1() const { return pixels() ? double(over_1) / double(pixels()) : 0; }
+  double share_over_2() const { return pixels() ? double(over_2) / double(pixels()) : 0; }
+  double edge_share_over_1() const { return edge_pixels ? double(edge_over_1) / double(edge_pixels) : 0; }
+};
+
+// `signatures` (one per pixel, from the CPU reference) mark edges: a pixel is on an edge when its
+// signature differs from one of its 4 neighbours'.
+ParityMetrics compare_images(const Image& gpu, const Image& reference, const std::vector<uint64_t>& signatures,
+                             const ParityTolerance& tolerance = {});
+
+// What a person can see: per pixel, the largest difference of the 8-bit sRGB values over the
+// channels. 0 shows as a faint grey copy of `reference`; 1 step is dark purple, rising through red
+// and orange to pale yellow at the largest difference in the image, returned in `max_steps`.
+Image difference_heatmap(const Image& a, const Image& reference, int& max_steps);
+
+// |a - b| per channel in linear radiance, for a quantitative look (written as PFM).
+Image absolute_difference(const Image& a, const Image& b);
+
+std::string describe_tolerance(const ParityTolerance& tolerance);
+
+}  // namespace vkray

@@ -1,0 +1,193 @@
+// GPU vs CPU reference parity: every shipped scene, adversarial cases, and proof that the
+// comparison catches a wrong image.
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <glm/gtc/constants.hpp>
+
+#include "support/parity_run.h"
+
+namespace vkray::test {
+namespace {
+
+Scene cornell() { return load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json"); }
+
+// The same image at another scale: lengths times k, intensities times k^2 (radiance goes as I / r^2).
+Scene scaled(Scene s, float k) {
+  for (auto& t : s.triangles)
+    for (auto& v : t.v) v *= k;
+  for (auto& sphere : s.spheres) {
+    sphere.center *= k;
+    sphere.radius *= k;
+  }
+  for (auto& l : s.lights) {
+    l.position *= k;
+    l.intensity *= k * k;
+  }
+  s.camera.position *= k;
+  return s;
+}
+
+// ---- Every scene in scenes/, at 1 and 16 samples per pixel ----------------------------------------
+struct SceneCase {
+  std::string file;
+  uint32_t spp;
+};
+void PrintTo(const SceneCase& c, std::ostream* os) { *os << c.file << " at " << c.spp << " spp"; }
+
+class SceneParityTest : public ParityTest, public ::testing::WithParamInterface<SceneCase> {};
+
+TEST_P(SceneParityTest, WithinTolerance) {
+  const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / GetParam().file);
+  const ParityRun r = run(scene, {256, 256, GetParam().spp});
+  expect_parity(r, scene.name + "-" + std::to_string(GetParam().spp) + "spp");
+  EXPECT_EQ(r.metrics.interior_over_2, 0u);
+}
+
+std::vector<SceneCase> scene_cases() {
+  std::vector<SceneCase> cases;
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(VKRAY_SCENE_DIR))
+    if (entry.path().extension() == ".json") files.push_back(entry.path().filename().string());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files)
+    for (uint32_t spp : {1u, 16u}) cases.push_back({f, spp});
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, SceneParityTest, ::testing::ValuesIn(scene_cases()),
+                         [](const ::testing::TestParamInfo<SceneCase>& param) {
+                           std::string name = param.param.file.substr(0, param.param.file.size() - 5);
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name + "_" + std::to_string(param.param.spp) + "spp";
+                         });
+
+// ---- Adversarial cases -------------------------------------------------------------------------------
+class AdversarialParityTest : public ParityTest {
+ protected:
+  ParityRun check(const Scene& scene, const std::string& name, ImageSettings image = {128, 128, 1}) {
+    ParityRun r = run(scene, image);
+    expect_parity(r, name);
+    return r;
+  }
+};
+
+TEST_F(AdversarialParityTest, GrazingRaysAlongAWall) {
+  Scene s = cornell();
+  s.camera.position = {-0.995f, 0.0f, -0.99f};  // 5 thousandths from the left wall, looking along it
+  s.camera.focal_length = 0.6f;
+  check(s, "grazing-along-wall");
+}
+
+TEST_F(AdversarialParityTest, SharedEdgesHaveNoCracks) {
+  // A 40 x 40 grid of quads (3200 triangles sharing edges) filling the view; background magenta.
+  Scene s = cornell();
+  s.triangles.clear();
+  s.background = {1, 0, 1};
+  const int n = 40;
+  auto p = [&](int i, int j) { return glm::vec3(-3.0f + 6.0f * float(i) / n, -3.0f + 6.0f * float(j) / n, 0.3f * std::sin(float(i + j))); };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      s.triangles.push_back({{p(i, j), p(i + 1, j), p(i + 1, j + 1)}, 6});
+      s.triangles.push_back({{p(i, j), p(i + 1, j + 1), p(i, j + 1)}, 6});
+    }
+  s.camera.position = {0.13f, -0.07f, -3.0f};
+  const ParityRun r = check(s, "shared-edges");
+  for (const Image* image : {&r.gpu, &r.cpu.image}) {
+    size_t background = 0;
+    for (const auto& px : image->pixels) background += (px == glm::vec3(1, 0, 1));
+    EXPECT_EQ(background, 0u) << (image == &r.gpu ? "GPU" : "CPU") << " image has cracks";
+  }
+}
+
+TEST_F(AdversarialParityTest, LightExactlyOnASurface) {
+  Scene s = cornell();
+  s.lights[0].position = {0.0f, -1.0f, -0.3f};  // on the ceiling plane
+  check(s, "light-on-surface");
+}
+
+TEST_F(AdversarialParityTest, LightInThePlaneOfATriangle) {
+  Scene s = cornell();
+  // Level with the short block's top face (triangle 18), beside the block: shadow rays graze the face.
+  s.lights[0].position = {0.9f, s.triangles[18].v[0].y, -0.5f};
+  check(s, "light-in-triangle-plane");
+}
+
+TEST_F(AdversarialParityTest, CameraInThePlaneOfTheFloor) {
+  Scene s = cornell();
+  s.camera.position = {0.0f, s.triangles[0].v[0].y, -0.9f};
+  check(s, "camera-in-floor-plane");
+}
+
+TEST_F(AdversarialParityTest, CameraInsideASphere) {
+  Scene s = cornell();
+  s.triangles.clear();
+  s.spheres = {{{0, 0, 0}, 3.0f, 6}, {{0.3f, 0.2f, 1.2f}, 0.5f, 0}};
+  s.camera.position = {0, 0, -1};
+  s.lights[0].position = {0, -1.5f, 0};
+  check(s, "camera-inside-sphere");
+}
+
+TEST_F(AdversarialParityTest, SmallSceneScale) { check(scaled(cornell(), 1e-3f), "scale-1e-3"); }
+
+TEST_F(AdversarialParityTest, LargeSceneScale) { check(scaled(cornell(), 1e4f), "scale-1e4"); }
+
+TEST_F(AdversarialParityTest, LightBehindASurface) {
+  Scene s = cornell();
+  s.lights[0].position = {0.0f, -0.5f, 1.5f};  // behind the back wall: only ambient reaches the room
+  const ParityRun r = check(s, "light-behind-surface");
+  EXPECT_NEAR(r.cpu.image.at(64, 40).r, 0.75f * 0.1f, 1e-6f);  // the back wall, ambient only
+  EXPECT_NEAR(r.gpu.at(64, 40).r, 0.75f * 0.1f, 1e-6f);
+}
+
+TEST_F(AdversarialParityTest, SixteenLights) {
+  Scene s = cornell();
+  const PointLight base = s.lights[0];
+  s.lights.clear();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      s.lights.push_back({{-0.75f + 0.5f * float(i), -0.9f, -0.75f + 0.5f * float(j)}, base.intensity / 16.0f});
+  check(s, "sixteen-lights");
+}
+
+// ---- The comparison itself can fail -------------------------------------------------------------------
+class ComparisonTest : public ParityTest {
+ protected:
+  void SetUp() override {
+    ParityTest::SetUp();
+    run_ = run(cornell(), {128, 128, 1});
+    ASSERT_TRUE(run_.metrics.pass);
+  }
+  ParityMetrics compare(const Image& gpu) { return compare_images(gpu, run_.cpu.image, run_.cpu.signatures); }
+  ParityRun run_;
+};
+
+TEST_F(ComparisonTest, CatchesImageTwoPercentTooBright) {
+  Image brighter = run_.gpu;
+  for (auto& p : brighter.pixels) p *= 1.02f;
+  const ParityMetrics m = compare(brighter);
+  EXPECT_FALSE(m.pass);
+  EXPECT_GT(m.interior_over_1, 100u);
+}
+
+TEST_F(ComparisonTest, CatchesOneWrongPixelAwayFromEdges) {
+  Image one = run_.gpu;
+  one.at(64, 40) += glm::vec3(0.5f);  // the back wall, far from any edge
+  const ParityMetrics m = compare(one);
+  EXPECT_FALSE(m.pass);
+  EXPECT_EQ(m.interior_over_1, 1u);
+  EXPECT_EQ(m.worst_x, 64u);
+  EXPECT_EQ(m.worst_y, 40u);
+}
+
+TEST_F(ComparisonTest, AcceptsNoiseBelowOneStep) {
+  Image noisy = run_.gpu;
+  for (auto& p : noisy.pixels) p += glm::vec3(1e-6f);
+  EXPECT_TRUE(compare(noisy).pass);
+}
+
+}  // namespace
+}  // namespace vkray::test
