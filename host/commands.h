@@ -32,7 +32,14 @@ struct ParityCommand {
   bool json = false;
 };
 
+struct WatchCommand {
+  RenderFlags flags;
+  std::filesystem::path output;         // empty: <scene name>.png in the current folder
+  std::optional<uint32_t> exit_after;   // test hook: stop after this many reloads
+};
+
 int run_render(const RenderCommand& command);
+int run_watch(const WatchCommand& command);
 int run_parity(const ParityCommand& command);
 int run_devices();
 

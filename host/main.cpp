@@ -58,6 +58,16 @@ int main(int argc, char** argv) {
   parity_cmd->add_option("--diff", parity.diff, "Write a heatmap of the per-pixel difference (.png or .pfm)");
   parity_cmd->add_flag("--json", parity.json, "Print the metrics as one JSON object on stdout (and nothing else)");
 
+  WatchCommand watch;
+  auto* watch_cmd = app.add_subcommand(
+      "watch", "Render, then re-render whenever the shaders, the scene or a file it uses changes. A broken "
+               "shader or scene is reported as file:line and the last good image is kept. Ctrl-C stops it.");
+  add_render_flags(watch_cmd, watch.flags);
+  watch_cmd->add_option("-o,--output", watch.output, "Output image (default: <scene name>.png in the current folder)");
+  watch_cmd->add_option("--exit-after", watch.exit_after,
+                        "Stop after N reloads (each change that was acted on counts, failed or not); for tests and scripts")
+      ->check(CLI::Range(1, 1000000));
+
   auto* devices_cmd = app.add_subcommand("devices", "List Vulkan devices with the properties that matter to vkray.");
 
   try {
@@ -72,6 +82,7 @@ int main(int argc, char** argv) {
   try {
     if (*render_cmd) return run_render(render);
     if (*parity_cmd) return run_parity(parity);
+    if (*watch_cmd) return run_watch(watch);
     if (*devices_cmd) return run_devices();
   } catch (const ShaderError& e) {
     std::cerr << "vkray: shader compilation failed:\n" << e.what() << "\n";

@@ -60,6 +60,8 @@ struct Scene {
   std::vector<Sphere> spheres;
   std::vector<Triangle> triangles;
   std::vector<std::string> warnings;  // odd but valid input, e.g. unknown keys
+  // Files the scene reads besides itself (none yet; meshes will be): `vkray watch` watches them.
+  std::vector<std::filesystem::path> referenced_files;
 
   // Largest absolute coordinate of anything in the scene (geometry, lights, camera).
   float extent() const;

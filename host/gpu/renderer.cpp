@@ -47,7 +47,7 @@ TexelBuffer make_texel_buffer(const Context& ctx, std::vector<glm::vec4> texels,
 
 }  // namespace
 
-TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv) {
+TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv, const vk::raii::PipelineCache* cache) {
   using S = vk::ShaderStageFlagBits;
   const vk::DescriptorSetLayoutBinding bindings[] = {
       {VKRAY_BINDING_FRAME, vk::DescriptorType::eUniformBuffer, 1, S::eCompute},
@@ -63,7 +63,8 @@ TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& sp
   layout_ = vk::raii::PipelineLayout(ctx.device(), vk::PipelineLayoutCreateInfo({}, set_layout, push));
   const vk::raii::ShaderModule module(ctx.device(), vk::ShaderModuleCreateInfo({}, spirv));
   const vk::PipelineShaderStageCreateInfo stage({}, S::eCompute, *module, "main");
-  pipeline_ = vk::raii::Pipeline(ctx.device(), nullptr, vk::ComputePipelineCreateInfo({}, stage, *layout_));
+  pipeline_ = vk::raii::Pipeline(ctx.device(), cache ? vk::Optional<const vk::raii::PipelineCache>(*cache) : nullptr,
+                                 vk::ComputePipelineCreateInfo({}, stage, *layout_));
 }
 
 uint32_t tile_side(const Scene& scene, const ImageSettings& image) {
@@ -150,6 +151,7 @@ Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, co
     ctx.wait(fence, options.tile_timeout, "a render tile");
     device.resetFences(*fence);
     if (options.progress) options.progress(tile_index + 1, tile_count);
+    if (options.cancel && tile_index + 1 < tile_count && options.cancel()) throw Cancelled{};
   }
   stats.trace_seconds = seconds_since(start);
   stats.tiles = tile_count;

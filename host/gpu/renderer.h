@@ -18,7 +18,8 @@ namespace vkray::gpu {
 // Descriptor set layout, pipeline layout and pipeline for shaders/trace.comp's interface.
 class TracePipeline {
  public:
-  TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv);
+  // `cache` (optional) makes re-creating a pipeline from SPIR-V seen before in this process cheap.
+  TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv, const vk::raii::PipelineCache* cache = nullptr);
 
   const vk::raii::DescriptorSetLayout& set_layout() const { return set_layout_; }
   const vk::raii::PipelineLayout& layout() const { return layout_; }
@@ -45,7 +46,12 @@ struct RenderOptions {
   uint32_t tile_side = 0;
   // Called after each tile with (tiles done, tiles in all).
   std::function<void(uint32_t, uint32_t)> progress;
+  // Asked between tiles; when it returns true the render stops and throws Cancelled.
+  std::function<bool()> cancel;
 };
+
+// A render stopped by RenderOptions::cancel; no work is left in flight.
+struct Cancelled {};
 
 // Renders `scene` at `image` resolution and sample count. Throws DeviceError (and vk::SystemError
 // from failing Vulkan calls).

@@ -1,0 +1,204 @@
+// `vkray watch` driven the way a shader developer uses it, synchronised on the lines it prints.
+#include <signal.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "image.h"
+#include "support/child_process.h"
+#include "support/temp_dir.h"
+
+namespace vkray::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class WatchTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::filesystem::copy(VKRAY_SHADER_DIR, dir_ / "shaders", std::filesystem::copy_options::recursive);
+    std::filesystem::copy(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json", dir_ / "cornell.json");
+  }
+
+  void start(std::vector<std::string> extra = {}, bool validate = true) {
+    std::vector<std::string> argv = {VKRAY_EXECUTABLE, "watch", "cornell.json", "--shader-dir", "shaders",
+                                     "-o", "out.pfm", "--width", "64", "--height", "64"};
+    if (validate) argv.push_back("--validate");
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    child_ = std::make_unique<ChildProcess>(argv, dir_.path().string());
+    ASSERT_TRUE(expect_line("watching")) << child_->all_output();
+  }
+
+  std::optional<std::string> expect_line(const std::string& text) {
+    auto line = child_->wait_for_line(text, 60s);
+    EXPECT_TRUE(line.has_value()) << "no line with \"" << text << "\"; output so far:\n" << child_->all_output();
+    return line;
+  }
+
+  // Saves like an editor that writes a new file and renames it over the old one.
+  void save_by_rename(const std::string& file, const std::string& text) {
+    const auto temp = dir_ / (file + ".swp");
+    std::ofstream(temp, std::ios::binary) << text;
+    std::filesystem::rename(temp, dir_ / file);
+  }
+  // Saves in place, like `echo >` or an editor that overwrites.
+  void save_in_place(const std::string& file, const std::string& text) { std::ofstream(dir_ / file, std::ios::binary) << text; }
+
+  std::string replaced(const std::string& file, const std::string& from, const std::string& to) {
+    std::string text = read_text(dir_ / file);
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return text.replace(at, from.size(), to);
+  }
+
+  Image image() { return read_pfm(dir_ / "out.pfm"); }
+
+  // 20 reloads, each with a new scale factor so that every one builds a new pipeline. Returns the
+  // process's RSS (KiB) after reload 5 and after reload 20.
+  std::pair<long, long> twenty_reloads();
+
+  TempDir dir_;
+  std::unique_ptr<ChildProcess> child_;
+};
+
+const std::string kScale = "sum * frame.inv_samples_per_pixel";
+
+TEST_F(WatchTest, ValidShaderEditChangesTheImage) {
+  start();
+  const Image before = image();
+  save_by_rename("shaders/trace.comp", replaced("shaders/trace.comp", kScale, kScale + " * 0.5"));
+  const auto line = expect_line("reload 1");
+  ASSERT_TRUE(line);
+  EXPECT_NE(line->find("trace.comp changed"), std::string::npos) << *line;
+  EXPECT_NE(line->find("compile"), std::string::npos) << *line;
+  EXPECT_NE(line->find("render"), std::string::npos) << *line;
+  EXPECT_NE(line->find("out.pfm"), std::string::npos) << *line;
+  const Image after = image();
+  ASSERT_EQ(after.pixels.size(), before.pixels.size());
+  for (size_t i = 0; i < before.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(after.pixels[i][c], 0.5f * before.pixels[i][c], 1e-6f) << "pixel " << i;
+}
+
+TEST_F(WatchTest, ErrorInAnIncludedFileKeepsTheImageAndRecovers) {
+  start();
+  const std::string good_image = read_text(dir_ / "out.pfm");
+  const std::string original = read_text(dir_ / "shaders/shade.glsl");
+  const int bad_line = 1 + int(std::count(original.begin(), original.end(), '\n'));
+  save_in_place("shaders/shade.glsl", original + "this is not glsl;\n");
+
+  const auto error = expect_line(": error:");
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->find("shaders/shade.glsl:" + std::to_string(bad_line) + ": error:"), std::string::npos) << *error;
+  const auto line = expect_line("reload 1");
+  ASSERT_TRUE(line);
+  EXPECT_NE(line->find("shader has errors"), std::string::npos) << *line;
+  EXPECT_NE(line->find("not rendered"), std::string::npos) << *line;
+  EXPECT_TRUE(child_->running());
+  EXPECT_EQ(read_text(dir_ / "out.pfm"), good_image) << "the last good image must stay";
+
+  save_in_place("shaders/shade.glsl", original);
+  const auto fixed = expect_line("reload 2");
+  ASSERT_TRUE(fixed);
+  EXPECT_NE(fixed->find("render"), std::string::npos) << *fixed;
+  EXPECT_EQ(read_text(dir_ / "out.pfm"), good_image) << "the same shader must give the same image";
+}
+
+TEST_F(WatchTest, SceneEditsRerenderAndABrokenSceneIsSurvived) {
+  start();
+  const Image before = image();
+  save_by_rename("cornell.json", replaced("cornell.json", "\"ambient\": [0.1, 0.1, 0.1]", "\"ambient\": [0.3, 0.3, 0.3]"));
+  const auto line = expect_line("reload 1");
+  ASSERT_TRUE(line);
+  EXPECT_NE(line->find("cornell.json changed): scene"), std::string::npos) << *line;
+  const Image brighter = image();
+  EXPECT_NEAR(brighter.at(15, 50).r, 3.0f * before.at(15, 50).r, 1e-4f) << "a pixel in shadow has ambient light only";
+
+  const std::string good_image = read_text(dir_ / "out.pfm");
+  save_in_place("cornell.json", replaced("cornell.json", "\"focal_length\": 1.0", "\"focal_length\": -1"));
+  const auto error = expect_line("error:");
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->find("cornell.json: /camera/focal_length"), std::string::npos) << *error;
+  ASSERT_TRUE(expect_line("reload 2"));
+  EXPECT_TRUE(child_->running());
+  EXPECT_EQ(read_text(dir_ / "out.pfm"), good_image);
+
+  save_in_place("cornell.json", replaced("cornell.json", "\"focal_length\": -1", "\"focal_length\": 1.0"));
+  const auto fixed = expect_line("reload 3");
+  ASSERT_TRUE(fixed);
+  EXPECT_NE(fixed->find("render"), std::string::npos) << *fixed;
+}
+
+std::pair<long, long> WatchTest::twenty_reloads() {
+  const std::string original = read_text(dir_ / "shaders/trace.comp");
+  long after_5 = 0;
+  for (int reload = 1; reload <= 20; ++reload) {
+    std::string text = original;
+    text.replace(text.find(kScale), kScale.size(), kScale + " * " + std::to_string(0.5 + reload / 100.0));
+    save_by_rename("shaders/trace.comp", text);
+    const auto line = expect_line("reload " + std::to_string(reload) + " ");
+    if (!line || line->find("render") == std::string::npos) {
+      ADD_FAILURE() << "reload " << reload << " did not render: " << line.value_or("(no line)");
+      break;
+    }
+    if (reload == 5) after_5 = child_->rss_kib();
+  }
+  return {after_5, child_->rss_kib()};
+}
+
+TEST_F(WatchTest, TwentyReloadsLeakNoVulkanObjects) {
+  // With --validate, any object still alive at vkDestroyDevice is reported and fails the command
+  // (checked by planting a leak: exit 3, 60 messages).
+  start();
+  twenty_reloads();
+  child_->signal(SIGTERM);
+  const auto code = child_->wait_exit(30s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0) << child_->all_output();
+  for (const char* message : {"validation error", "validation warning", "validation message"})
+    EXPECT_EQ(child_->all_output().find(message), std::string::npos) << child_->all_output();
+  EXPECT_NE(child_->all_output().find("stopped"), std::string::npos);
+}
+
+TEST_F(WatchTest, TwentyReloadsLeakNoMemory) {
+  // Without the validation layer, whose own bookkeeping grows with every object it has seen.
+  // Measured: RSS identical from reload 20 to reload 100; a planted pipeline leak grows it by MBs.
+  start({}, /*validate=*/false);
+  const auto [after_5, after_20] = twenty_reloads();
+  RecordProperty("rss_kib_after_reload_5", std::to_string(after_5));
+  RecordProperty("rss_kib_after_reload_20", std::to_string(after_20));
+  EXPECT_LE(after_20 - after_5, 4 * 1024) << "RSS grew from " << after_5 << " to " << after_20 << " KiB over 15 reloads";
+}
+
+TEST_F(WatchTest, SigintStopsItCleanly) {
+  start();
+  child_->signal(SIGINT);
+  const auto code = child_->wait_exit(30s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0) << child_->all_output();
+  EXPECT_NE(child_->all_output().find("stopped"), std::string::npos) << child_->all_output();
+}
+
+TEST_F(WatchTest, ExitAfterStopsByItself) {
+  start({"--exit-after", "1"});
+  save_in_place("shaders/ray.glsl", read_text(dir_ / "shaders/ray.glsl") + "// a comment\n");
+  const auto line = expect_line("reload 1");
+  ASSERT_TRUE(line);
+  EXPECT_NE(line->find("SPIR-V unchanged"), std::string::npos) << *line;
+  const auto code = child_->wait_exit(30s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0) << child_->all_output();
+}
+
+}  // namespace
+}  // namespace vkray::test
