@@ -20,21 +20,10 @@
 #include "parity.h"
 #include "paths.h"
 #include "scene.h"
+#include "timing.h"
 
 namespace vkray {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-std::string format_ms(double ms) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, ms < 10 ? "%.2f ms" : "%.0f ms", ms);
-  return buffer;
-}
 
 std::string format_rate(uint64_t rays, double seconds) {
   char buffer[64];
@@ -80,10 +69,7 @@ LoadedScene load(const RenderFlags& flags) {
   loaded.file = flags.scene.empty() ? default_scene() : flags.scene;
   loaded.scene = load_scene(loaded.file);
   for (const auto& warning : loaded.scene.warnings) std::cerr << "vkray: warning: " << warning << "\n";
-  loaded.image = loaded.scene.image;
-  if (flags.width) loaded.image.width = *flags.width;
-  if (flags.height) loaded.image.height = *flags.height;
-  if (flags.spp) loaded.image.samples_per_pixel = *flags.spp;
+  loaded.image = image_settings(loaded.scene, flags);
   loaded.load_ms = ms_since(start);
   return loaded;
 }
@@ -157,6 +143,14 @@ std::string describe(const LoadedScene& loaded) {
 }
 
 }  // namespace
+
+ImageSettings image_settings(const Scene& scene, const RenderFlags& flags) {
+  ImageSettings image = scene.image;
+  if (flags.width) image.width = *flags.width;
+  if (flags.height) image.height = *flags.height;
+  if (flags.spp) image.samples_per_pixel = *flags.spp;
+  return image;
+}
 
 int run_render(const RenderCommand& cmd) {
   const auto total_start = Clock::now();

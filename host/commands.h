@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "scene.h"
+
 namespace vkray {
 
 // Options shared by every command that renders.
@@ -37,6 +39,9 @@ struct WatchCommand {
   std::filesystem::path output;         // empty: <scene name>.png in the current folder
   std::optional<uint32_t> exit_after;   // test hook: stop after this many reloads
 };
+
+// The scene's image settings with the command line's overrides applied.
+ImageSettings image_settings(const Scene& scene, const RenderFlags& flags);
 
 int run_render(const RenderCommand& command);
 int run_watch(const WatchCommand& command);

@@ -21,21 +21,10 @@
 #include "image.h"
 #include "paths.h"
 #include "scene.h"
+#include "timing.h"
 
 namespace vkray {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-std::string ms(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, value < 10 ? "%.1f ms" : "%.0f ms", value);
-  return text;
-}
 
 // SIGINT and SIGTERM, delivered through a file descriptor so the watch loop can wait on them
 // together with file changes. Restores the signal mask when destroyed.
@@ -109,7 +98,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
       for (const auto& warning : loaded.warnings) std::cerr << "vkray: warning: " << warning << "\n";
       scene = std::move(loaded);
       scene_broken = false;
-      return "scene " + ms(ms_since(start));
+      return "scene " + format_ms(ms_since(start));
     } catch (const SceneError& e) {
       std::cerr << "vkray: error: " << e.what() << "\n";
       scene_broken = true;
@@ -122,14 +111,14 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
       gpu::CompiledShader compiled = gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir});
       shader_sources = compiled.sources;
       shader_broken = false;
-      if (pipeline && compiled.spirv == spirv) return "compile " + ms(ms_since(start)) + " (SPIR-V unchanged)";
+      if (pipeline && compiled.spirv == spirv) return "compile " + format_ms(ms_since(start)) + " (SPIR-V unchanged)";
       // Renders wait for their last tile, so no work uses the old pipeline now; wait anyway, so
       // that stays true if rendering ever overlaps with reloading.
       ctx.queue().waitIdle();
       pipeline = std::make_unique<gpu::TracePipeline>(ctx, compiled.spirv, &pipeline_cache);
       spirv = std::move(compiled.spirv);
       ctx.check_validation("pipeline creation");
-      return "compile " + ms(ms_since(start));
+      return "compile " + format_ms(ms_since(start));
     } catch (const ShaderError& e) {
       std::cerr << e.what() << "\n";
       shader_broken = true;
@@ -145,10 +134,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
       if ((shader_broken || !pipeline) && (scene_broken || !scene)) broken = "shader and the scene";
       return "not rendered while the " + broken + " still has errors; " + output.string() + " is unchanged";
     }
-    ImageSettings image = scene->image;
-    if (cmd.flags.width) image.width = *cmd.flags.width;
-    if (cmd.flags.height) image.height = *cmd.flags.height;
-    if (cmd.flags.spp) image.samples_per_pixel = *cmd.flags.spp;
+    const ImageSettings image = image_settings(*scene, cmd.flags);
     gpu::RenderOptions render_options;
     render_options.cancel = [&] { return stop.pending(); };
     const auto start = Clock::now();
@@ -156,7 +142,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
     const double render_ms = ms_since(start);
     ctx.check_validation("render");
     write_image(result, output);
-    return "render " + ms(render_ms) + " -> " + output.string();
+    return "render " + format_ms(render_ms) + " -> " + output.string();
   };
 
   FileWatcher watcher;
