@@ -21,6 +21,9 @@ struct InputError : std::runtime_error {
 struct SceneError : InputError {
   using InputError::InputError;
 };
+struct MeshError : InputError {
+  using InputError::InputError;
+};
 struct ShaderError : InputError {
   using InputError::InputError;
 };

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "errors.h"
+#include "mesh.h"
 #include "transform.h"
 
 namespace vkray {
@@ -113,10 +114,14 @@ class SceneParser {
   void parse_object(const Value& v);
   glm::mat4 parse_transform(const Value& v);
   uint32_t material_ref(const Value& v) const;
+  void parse_mesh(const Value& v, const glm::mat4& transform);
+  // Appends triangles, leaving out zero-area ones (they have no normal and are never hit).
+  void add_triangles(const Value& where, std::vector<Triangle>& triangles);
 
   const std::filesystem::path& file_;
   Scene& scene_;
   std::map<std::string, uint32_t> material_index_;
+  std::map<std::filesystem::path, Mesh> meshes_;  // each file loaded once, however often it is used
 };
 
 void SceneParser::parse(const json& root_json) {
@@ -278,7 +283,8 @@ void SceneParser::parse_object(const Value& v) {
     const uint32_t material = material_ref(require(v, "material"));
     const Value indices = require(v, "indices");
     expect_array(indices);
-    size_t degenerate = 0;
+    std::vector<Triangle> triangles;
+    triangles.reserve(indices.j.size());
     for (size_t i = 0; i < indices.j.size(); ++i) {
       const Value tri = indices[i];
       if (!tri.j.is_array() || tri.j.size() != 3) fail(tri, "expected an array of 3 vertex indices, got " + tri.j.dump());
@@ -292,17 +298,80 @@ void SceneParser::parse_object(const Value& v) {
                         std::to_string(points.size()) + " positions)");
         t.v[k] = points[idx.j.get<size_t>()];
       }
-      // A zero-area triangle has no normal and can never be hit; leave it out.
-      if (glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f) {
-        ++degenerate;
-        continue;
-      }
-      scene_.triangles.push_back(t);
+      triangles.push_back(t);
     }
-    if (degenerate > 0) warn(indices, std::to_string(degenerate) + " degenerate (zero-area) triangles left out");
+    add_triangles(indices, triangles);
+  } else if (type == "mesh") {
+    check_keys(v, {"type", "file", "material", "transform", "smooth"});
+    parse_mesh(v, transform);
   } else {
-    fail(type_value, "unknown object type \"" + type + "\" (expected \"sphere\" or \"triangles\")");
+    fail(type_value, "unknown object type \"" + type + "\" (expected \"sphere\", \"triangles\" or \"mesh\")");
   }
+}
+
+void SceneParser::add_triangles(const Value& where, std::vector<Triangle>& triangles) {
+  size_t degenerate = 0;
+  for (const Triangle& t : triangles) {
+    if (glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f) {
+      ++degenerate;
+      continue;
+    }
+    scene_.triangles.push_back(t);
+  }
+  if (degenerate > 0) warn(where, std::to_string(degenerate) + " degenerate (zero-area) triangles left out");
+}
+
+void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
+  const Value file_value = require(v, "file");
+  const std::filesystem::path file = (file_.parent_path() / string(file_value)).lexically_normal();
+  const uint32_t material = material_ref(require(v, "material"));
+  bool smooth = false;
+  if (v.has("smooth")) {
+    if (!v["smooth"].j.is_boolean()) fail(v["smooth"], std::string("expected true or false, got ") + v["smooth"].j.type_name());
+    smooth = v["smooth"].j.get<bool>();
+  }
+  auto cached = meshes_.find(file);
+  if (cached == meshes_.end()) {
+    try {
+      cached = meshes_.emplace(file, load_mesh(file)).first;
+    } catch (const MeshError& e) {
+      throw MeshError(file_.string() + ": " + file_value.path + ": " + e.what());
+    }
+    scene_.referenced_files.push_back(file);
+    if (cached->second.polygons_split > 0)
+      warn(file_value, file.filename().string() + ": " + std::to_string(cached->second.polygons_split) +
+                           " faces with more than 3 vertices split into triangles");
+  }
+  const Mesh& mesh = cached->second;
+
+  std::vector<glm::vec3> points(mesh.positions.size());
+  for (size_t i = 0; i < points.size(); ++i) points[i] = transform_point(transform, mesh.positions[i]);
+  std::vector<Triangle> triangles(mesh.triangles.size());
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    triangles[i].material = material;
+    for (int k = 0; k < 3; ++k) triangles[i].v[size_t(k)] = points[mesh.triangles[i][size_t(k)]];
+  }
+  if (smooth) {
+    if (!mesh.corner_normals.empty()) {
+      // Normals transform by the inverse transpose.
+      const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(transform)));
+      for (size_t i = 0; i < triangles.size(); ++i)
+        for (size_t k = 0; k < 3; ++k) triangles[i].normals[k] = glm::normalize(normal_matrix * mesh.corner_normals[i][k]);
+    } else {
+      std::vector<std::array<glm::vec3, 3>> corners(triangles.size());
+      for (size_t i = 0; i < triangles.size(); ++i) corners[i] = triangles[i].v;
+      const auto normals = area_weighted_normals(corners);
+      for (size_t i = 0; i < triangles.size(); ++i) triangles[i].normals = normals[i];
+    }
+    for (Triangle& t : triangles) {
+      t.smooth = true;
+      // A zero normal (a vertex only on degenerate faces, or a zero normal in the file) cannot be
+      // interpolated meaningfully: shade that triangle flat.
+      for (const glm::vec3& n : t.normals)
+        if (!std::isfinite(n.x) || glm::length(n) < 0.5f) t.smooth = false;
+    }
+  }
+  add_triangles(file_value, triangles);
 }
 
 // "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error ..." -> "syntax error ..."

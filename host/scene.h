@@ -46,6 +46,8 @@ struct Sphere {
 struct Triangle {
   std::array<glm::vec3, 3> v;
   uint32_t material = 0;
+  bool smooth = false;                 // shade with `normals` interpolated, not the face normal
+  std::array<glm::vec3, 3> normals{};  // unit vertex normals, when smooth
 };
 
 struct Scene {
@@ -60,7 +62,7 @@ struct Scene {
   std::vector<Sphere> spheres;
   std::vector<Triangle> triangles;
   std::vector<std::string> warnings;  // odd but valid input, e.g. unknown keys
-  // Files the scene reads besides itself (none yet; meshes will be): `vkray watch` watches them.
+  // Files the scene reads besides itself (meshes): `vkray watch` watches them.
   std::vector<std::filesystem::path> referenced_files;
 
   // Largest absolute coordinate of anything in the scene (geometry, lights, camera).

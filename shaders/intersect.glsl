@@ -75,4 +75,33 @@ float intersect_sphere(Ray ray, vec3 center, float radius, float t_min, float t_
   return -1.0;
 }
 
+// Barycentric coordinates (u, v) of a point in the triangle's plane: p = v0 + u (v1 - v0) + v (v2 - v0).
+vec2 triangle_barycentrics(vec3 p, vec3 v0, vec3 v1, vec3 v2) {
+  vec3 e1 = v1 - v0, e2 = v2 - v0, d = p - v0;
+  float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), d1 = dot(d, e1), d2 = dot(d, e2);
+  float inv = 1.0 / (d11 * d22 - d12 * d12);
+  return vec2((d22 * d1 - d12 * d2) * inv, (d11 * d2 - d12 * d1) * inv);
+}
+
+// ---- Ray-box ------------------------------------------------------------------------------------------
+// 1 / d, with zero components replaced by a tiny number of the same sign, so that no slab test can
+// compute 0 * inf = NaN.
+vec3 safe_inverse(vec3 d) {
+  vec3 magnitude = max(abs(d), vec3(1e-30));
+  return vec3(d.x < 0.0 ? -1.0 : 1.0, d.y < 0.0 ? -1.0 : 1.0, d.z < 0.0 ? -1.0 : 1.0) / magnitude;
+}
+
+// The slab test: (t_enter, t_exit) of the ray against the box, clipped to (t_min, t_max); it hits
+// when t_enter <= t_exit. t_exit is scaled by 1 + 2 gamma(3) (Ize, "Robust BVH Ray Traversal",
+// JCGT 2013) so float rounding can never reject a box the ray touches, flat boxes included (the
+// box of an axis-aligned wall has zero thickness).
+vec2 intersect_box(vec3 origin, vec3 inv_dir, vec3 box_min, vec3 box_max, float t_min, float t_max) {
+  vec3 t0 = (box_min - origin) * inv_dir;
+  vec3 t1 = (box_max - origin) * inv_dir;
+  vec3 near = min(t0, t1), far = max(t0, t1);
+  float enter = max(max(near.x, near.y), max(near.z, t_min));
+  float exit = min(min(far.x, far.y), min(far.z, t_max)) * 1.0000004;
+  return vec2(enter, exit);
+}
+
 #endif

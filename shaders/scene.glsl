@@ -1,5 +1,5 @@
-// Scene access and the two traversals every ray needs: closest hit (camera rays) and any hit
-// (shadow rays). Brute force over all primitives for now; a BVH replaces these loops later.
+// Scene access and the traversal every ray needs: the BVH (host/bvh.h) walked front to back for
+// the closest hit (camera rays), or until any hit (shadow rays).
 #ifndef VKRAY_SCENE_GLSL
 #define VKRAY_SCENE_GLSL
 
@@ -7,66 +7,113 @@
 #include "intersect.glsl"
 
 layout(std140, set = 0, binding = VKRAY_BINDING_FRAME) uniform Frame { FrameUniforms frame; };
-layout(set = 0, binding = VKRAY_BINDING_TRIANGLES) uniform samplerBuffer triangles;
-layout(set = 0, binding = VKRAY_BINDING_SPHERES) uniform samplerBuffer spheres;
+layout(set = 0, binding = VKRAY_BINDING_PRIMITIVES) uniform samplerBuffer primitives;
+layout(set = 0, binding = VKRAY_BINDING_NORMALS) uniform samplerBuffer normals;
+layout(set = 0, binding = VKRAY_BINDING_NODES) uniform samplerBuffer nodes;
 layout(set = 0, binding = VKRAY_BINDING_MATERIALS) uniform samplerBuffer materials;
 layout(set = 0, binding = VKRAY_BINDING_LIGHTS) uniform samplerBuffer lights;
 
-// ---- Closest hit ---------------------------------------------------------------------------------
-Hit trace_closest(Ray ray, float t_min, float t_max) {
-  RayShear shear = ray_shear(ray.dir);
+// ---- Primitives ---------------------------------------------------------------------------------------
+uint primitive_flags(uint prim) {
+  return floatBitsToUint(texelFetch(primitives, int(prim) * VKRAY_TEXELS_PER_PRIMITIVE).w);
+}
+
+// t of the nearest intersection with primitive `prim` in (t_min, t_max), or -1.
+float intersect_primitive(Ray ray, RayShear shear, uint prim, float t_min, float t_max) {
+  int base = int(prim) * VKRAY_TEXELS_PER_PRIMITIVE;
+  vec4 a = texelFetch(primitives, base);
+  if ((floatBitsToUint(a.w) & VKRAY_PRIM_SPHERE) != 0u)
+    return intersect_sphere(ray, a.xyz, texelFetch(primitives, base + 1).x, t_min, t_max);
+  return intersect_triangle(ray, shear, a.xyz, texelFetch(primitives, base + 1).xyz, texelFetch(primitives, base + 2).xyz,
+                            t_min, t_max);
+}
+
+uint primitive_index(uint prim) {  // its place in the scene, for ties
+  return floatBitsToUint(texelFetch(primitives, int(prim) * VKRAY_TEXELS_PER_PRIMITIVE + 1).w);
+}
+
+// ---- Traversal ------------------------------------------------------------------------------------------
+// Closest hit in (t_min, t_max); with any_hit, the first hit found (for shadow rays).
+Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   Hit hit = Hit(t_max, NO_HIT);
-  for (uint i = 0u; i < frame.triangle_count; ++i) {
-    int base = int(i) * VKRAY_TEXELS_PER_TRIANGLE;
-    float t = intersect_triangle(ray, shear, texelFetch(triangles, base).xyz, texelFetch(triangles, base + 1).xyz,
-                                 texelFetch(triangles, base + 2).xyz, t_min, hit.t);
-    if (t > 0.0) hit = Hit(t, i);
-  }
-  for (uint i = 0u; i < frame.sphere_count; ++i) {
-    vec4 sphere = texelFetch(spheres, int(i) * VKRAY_TEXELS_PER_SPHERE);
-    float t = intersect_sphere(ray, sphere.xyz, sphere.w, t_min, hit.t);
-    if (t > 0.0) hit = Hit(t, frame.triangle_count + i);
+  if (frame.primitive_count == 0u) return hit;
+  RayShear shear = ray_shear(ray.dir);
+  vec3 inv_dir = safe_inverse(ray.dir);
+
+  uint stack[VKRAY_TRAVERSAL_STACK];
+  int depth = 0;
+  uint node = 0u;
+  for (;;) {
+    // Anything up to a tie with the best hit so far is still a candidate.
+    float t_limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
+    int base = int(node) * VKRAY_TEXELS_PER_NODE;
+    vec4 left_min = texelFetch(nodes, base), left_max = texelFetch(nodes, base + 1);
+    vec2 left = intersect_box(ray.origin, inv_dir, left_min.xyz, left_max.xyz, t_min, t_limit);
+    vec2 right = intersect_box(ray.origin, inv_dir, texelFetch(nodes, base + 2).xyz, texelFetch(nodes, base + 3).xyz,
+                               t_min, t_limit);
+    uint link[2] = uint[2](floatBitsToUint(left_min.w), floatBitsToUint(left_max.w));
+    bool enter[2] = bool[2](left.x <= left.y, right.x <= right.y);
+
+    // Leaves are intersected right away; inner children are visited near one first.
+    for (int c = 0; c < 2; ++c) {
+      if (!enter[c] || (link[c] & VKRAY_LEAF_BIT) == 0u) continue;
+      enter[c] = false;
+      uint first = (link[c] & ~VKRAY_LEAF_BIT) >> VKRAY_LEAF_COUNT_BITS;
+      uint end = first + (link[c] & ((1u << VKRAY_LEAF_COUNT_BITS) - 1u));
+      for (uint prim = first; prim < end; ++prim) {
+        float limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
+        float t = intersect_primitive(ray, shear, prim, t_min, limit);
+        if (t <= 0.0) continue;
+        if (any_hit) return Hit(t, prim);
+        if (hit.prim == NO_HIT || t < hit.t * (1.0 - VKRAY_TIE) || primitive_index(prim) < primitive_index(hit.prim))
+          hit = Hit(t, prim);
+      }
+    }
+    if (enter[0] && enter[1]) {
+      bool right_first = right.x < left.x;
+      stack[depth++] = right_first ? link[0] : link[1];
+      node = right_first ? link[1] : link[0];
+    } else if (enter[0] || enter[1]) {
+      node = enter[0] ? link[0] : link[1];
+    } else {
+      if (depth == 0) break;
+      node = stack[--depth];
+    }
   }
   return hit;
 }
 
-// ---- Any hit: stops at the first occluder ----------------------------------------------------------
-bool trace_any(Ray ray, float t_min, float t_max) {
-  RayShear shear = ray_shear(ray.dir);
-  for (uint i = 0u; i < frame.triangle_count; ++i) {
-    int base = int(i) * VKRAY_TEXELS_PER_TRIANGLE;
-    if (intersect_triangle(ray, shear, texelFetch(triangles, base).xyz, texelFetch(triangles, base + 1).xyz,
-                           texelFetch(triangles, base + 2).xyz, t_min, t_max) > 0.0)
-      return true;
-  }
-  for (uint i = 0u; i < frame.sphere_count; ++i) {
-    vec4 sphere = texelFetch(spheres, int(i) * VKRAY_TEXELS_PER_SPHERE);
-    if (intersect_sphere(ray, sphere.xyz, sphere.w, t_min, t_max) > 0.0) return true;
-  }
-  return false;
-}
+Hit trace_closest(Ray ray, float t_min, float t_max) { return traverse(ray, t_min, t_max, false); }
 
-// ---- Surface data at a hit ---------------------------------------------------------------------------
-// Geometric unit normal, not yet oriented toward the ray.
-vec3 hit_normal(Hit hit, vec3 position) {
-  if (hit.prim < frame.triangle_count) {
-    int base = int(hit.prim) * VKRAY_TEXELS_PER_TRIANGLE;
-    vec3 v0 = texelFetch(triangles, base).xyz;
-    return normalize(cross(texelFetch(triangles, base + 1).xyz - v0, texelFetch(triangles, base + 2).xyz - v0));
-  }
-  vec4 sphere = texelFetch(spheres, int(hit.prim - frame.triangle_count) * VKRAY_TEXELS_PER_SPHERE);
-  return (position - sphere.xyz) / sphere.w;
-}
+bool trace_any(Ray ray, float t_min, float t_max) { return traverse(ray, t_min, t_max, true).prim != NO_HIT; }
 
-vec3 hit_albedo(Hit hit) {
-  uint material;
-  if (hit.prim < frame.triangle_count) {
-    material = floatBitsToUint(texelFetch(triangles, int(hit.prim) * VKRAY_TEXELS_PER_TRIANGLE).w);
-  } else {
-    int base = int(hit.prim - frame.triangle_count) * VKRAY_TEXELS_PER_SPHERE;
-    material = floatBitsToUint(texelFetch(spheres, base + 1).x);
+// ---- Surface data at a hit --------------------------------------------------------------------------
+struct Surface {
+  vec3 geometric_normal;  // unit, not yet oriented toward the ray
+  vec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal
+  vec3 albedo;
+};
+
+Surface hit_surface(Hit hit, vec3 position) {
+  int base = int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE;
+  vec4 a = texelFetch(primitives, base);
+  uint flags = floatBitsToUint(a.w);
+  Surface s;
+  s.albedo = texelFetch(materials, int(flags & VKRAY_PRIM_MATERIAL_MASK)).rgb;
+  if ((flags & VKRAY_PRIM_SPHERE) != 0u) {
+    s.geometric_normal = (position - a.xyz) / texelFetch(primitives, base + 1).x;
+    s.shading_normal = s.geometric_normal;
+    return s;
   }
-  return texelFetch(materials, int(material)).rgb;
+  vec3 v1 = texelFetch(primitives, base + 1).xyz, v2 = texelFetch(primitives, base + 2).xyz;
+  s.geometric_normal = normalize(cross(v1 - a.xyz, v2 - a.xyz));
+  s.shading_normal = s.geometric_normal;
+  if ((flags & VKRAY_PRIM_SMOOTH) != 0u) {
+    vec2 uv = triangle_barycentrics(position, a.xyz, v1, v2);
+    s.shading_normal = normalize((1.0 - uv.x - uv.y) * texelFetch(normals, base).xyz + uv.x * texelFetch(normals, base + 1).xyz +
+                                 uv.y * texelFetch(normals, base + 2).xyz);
+  }
+  return s;
 }
 
 #endif

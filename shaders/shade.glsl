@@ -1,7 +1,8 @@
 // Direct Lambertian shading from point lights plus an ambient term, exactly the scene contract:
 //   L = albedo * (A + sum_lights V * I * max(0, n . w) / (pi r^2))
-// with n the geometric normal facing the incoming ray, w the unit vector to the light, r its
-// distance, and V = 0 when a shadow ray finds anything closer than the light.
+// with n the normal facing the incoming ray (the interpolated vertex normal for smooth meshes, the
+// geometric normal otherwise), w the unit vector to the light, r its distance, and V = 0 when a
+// shadow ray finds anything closer than the light.
 #ifndef VKRAY_SHADE_GLSL
 #define VKRAY_SHADE_GLSL
 
@@ -13,11 +14,14 @@ const float PI = 3.14159265358979;
 // to `rays`.
 vec3 shade(Ray ray, Hit hit, inout uint rays) {
   vec3 x = ray_at(ray, hit.t);
-  vec3 n = hit_normal(hit, x);
-  if (dot(n, ray.dir) > 0.0) n = -n;
+  Surface surface = hit_surface(hit, x);
+  // Both normals face the incoming ray, decided by the geometric one.
+  bool flip = dot(surface.geometric_normal, ray.dir) > 0.0;
+  vec3 n_geometric = flip ? -surface.geometric_normal : surface.geometric_normal;
+  vec3 n = flip ? -surface.shading_normal : surface.shading_normal;
 
-  // Shadow rays start a little off the surface, on the side the light must be on to count.
-  vec3 shadow_origin = x + frame.epsilon * n;
+  // Shadow rays start a little off the surface, on the side the ray came from.
+  vec3 shadow_origin = x + frame.epsilon * n_geometric;
   vec3 irradiance = frame.ambient.rgb;
   for (uint i = 0u; i < frame.light_count; ++i) {
     int base = int(i) * VKRAY_TEXELS_PER_LIGHT;
@@ -36,7 +40,7 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
       continue;
     irradiance += texelFetch(lights, base + 1).rgb * (cos_theta / (PI * r2));
   }
-  return hit_albedo(hit) * irradiance;
+  return surface.albedo * irradiance;
 }
 
 #endif

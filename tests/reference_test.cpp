@@ -20,6 +20,19 @@ TEST(ReferenceTest, ImageDoesNotDependOnThreadCount) {
   EXPECT_EQ(a.rays, b.rays);
 }
 
+TEST(ReferenceTest, BvhTraversalFindsWhatBruteForceFinds) {
+  for (const char* file : {"transforms.json", "teapot.json", "cornell-spheres.json"}) {
+    SCOPED_TRACE(file);
+    const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / file);
+    cpu::ReferenceOptions brute;
+    brute.use_bvh = false;
+    const auto a = cpu::render_reference(scene, {48, 36, 1});
+    const auto b = cpu::render_reference(scene, {48, 36, 1}, brute);
+    EXPECT_EQ(a.signatures, b.signatures);  // same primitive and lights for every sample
+    EXPECT_EQ(a.image.pixels, b.image.pixels);
+  }
+}
+
 TEST(ReferenceTest, CountsCameraAndShadowRays) {
   // One sphere filling the view, one light in front of it: every camera ray hits and casts one shadow ray.
   const Scene scene = parse_scene(R"({

@@ -15,6 +15,7 @@ namespace vkray::cpu {
 
 struct ReferenceOptions {
   unsigned threads = 0;  // 0: one per hardware thread. The image does not depend on it.
+  bool use_bvh = true;   // false: test every primitive (slow; checks the traversal)
   std::function<void(uint32_t rows_done, uint32_t rows)> progress;  // called under a lock
 };
 
@@ -24,7 +25,8 @@ struct ReferenceResult {
   // neighbouring pixels with different signatures straddle a silhouette or shadow edge.
   std::vector<uint64_t> signatures;
   uint64_t rays = 0;  // camera rays + shadow rays
-  double seconds = 0;
+  double seconds = 0;       // tracing, BVH build included
+  double bvh_seconds = 0;   // building the BVH
 };
 
 ReferenceResult render_reference(const Scene& scene, const ImageSettings& image, const ReferenceOptions& options = {});

@@ -7,6 +7,7 @@
 
 #include "errors.h"
 #include "gpu/buffer.h"
+#include "bvh.h"
 #include "gpu/scene_packing.h"
 
 namespace vkray::gpu {
@@ -51,8 +52,9 @@ TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& sp
   using S = vk::ShaderStageFlagBits;
   const vk::DescriptorSetLayoutBinding bindings[] = {
       {VKRAY_BINDING_FRAME, vk::DescriptorType::eUniformBuffer, 1, S::eCompute},
-      {VKRAY_BINDING_TRIANGLES, kTexel, 1, S::eCompute},
-      {VKRAY_BINDING_SPHERES, kTexel, 1, S::eCompute},
+      {VKRAY_BINDING_PRIMITIVES, kTexel, 1, S::eCompute},
+      {VKRAY_BINDING_NORMALS, kTexel, 1, S::eCompute},
+      {VKRAY_BINDING_NODES, kTexel, 1, S::eCompute},
       {VKRAY_BINDING_MATERIALS, kTexel, 1, S::eCompute},
       {VKRAY_BINDING_LIGHTS, kTexel, 1, S::eCompute},
       {VKRAY_BINDING_OUTPUT, vk::DescriptorType::eStorageBuffer, 1, S::eCompute},
@@ -68,8 +70,9 @@ TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& sp
 }
 
 uint32_t tile_side(const Scene& scene, const ImageSettings& image) {
+  // With the BVH a ray visits on the order of log2(N) nodes and a few leaves.
   const double primitives = double(scene.triangles.size() + scene.spheres.size()) + 1.0;
-  const double tests_per_sample = primitives * (1.0 + double(scene.lights.size()));
+  const double tests_per_sample = (8.0 + 4.0 * std::log2(primitives)) * (1.0 + double(scene.lights.size()));
   const double pixels = kTestsPerTile / (tests_per_sample * image.samples_per_pixel);
   const uint32_t side = static_cast<uint32_t>(std::sqrt(pixels)) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
   const uint32_t largest = (std::max(image.width, image.height) + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
@@ -83,14 +86,17 @@ Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, co
 
   // ---- upload ----
   auto start = Clock::now();
-  const PackedScene packed = pack_scene(scene, image);
+  const Bvh bvh = build_bvh(primitive_boxes(scene));
+  stats.bvh_seconds = bvh.build_seconds;
+  const PackedScene packed = pack_scene(scene, bvh, image);
   const vk::DeviceSize pixel_bytes = vk::DeviceSize(image.width) * image.height * sizeof(glm::vec4);
   if (pixel_bytes > ctx.limits().maxStorageBufferRange)
     throw DeviceError("image too large for " + ctx.device_name() + ": " + std::to_string(pixel_bytes) +
                       " bytes of output, maxStorageBufferRange is " + std::to_string(ctx.limits().maxStorageBufferRange));
   Buffer frame = upload_buffer(ctx, &packed.frame, sizeof(packed.frame), vk::BufferUsageFlagBits::eUniformBuffer);
-  const TexelBuffer triangles = make_texel_buffer(ctx, packed.triangles, "triangle");
-  const TexelBuffer spheres = make_texel_buffer(ctx, packed.spheres, "sphere");
+  const TexelBuffer primitives = make_texel_buffer(ctx, packed.primitives, "primitive");
+  const TexelBuffer normals = make_texel_buffer(ctx, packed.normals, "normal");
+  const TexelBuffer nodes = make_texel_buffer(ctx, packed.nodes, "BVH node");
   const TexelBuffer materials = make_texel_buffer(ctx, packed.materials, "material");
   const TexelBuffer lights = make_texel_buffer(ctx, packed.lights, "light");
   using M = vk::MemoryPropertyFlagBits;
@@ -98,7 +104,7 @@ Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, co
                                       M::eHostCached);
 
   const vk::DescriptorPoolSize pool_sizes[] = {{vk::DescriptorType::eUniformBuffer, 1},
-                                               {kTexel, 4},
+                                               {kTexel, 5},
                                                {vk::DescriptorType::eStorageBuffer, 1}};
   // eFreeDescriptorSet: vk::raii::DescriptorSets frees its set when destroyed.
   const vk::raii::DescriptorPool pool(device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, pool_sizes));
@@ -107,13 +113,14 @@ Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, co
   const vk::DescriptorSet set = *sets[0];
   const vk::DescriptorBufferInfo frame_info(*frame.buffer, 0, VK_WHOLE_SIZE);
   const vk::DescriptorBufferInfo output_info(*output.buffer, 0, VK_WHOLE_SIZE);
-  const vk::BufferView views[] = {*triangles.view, *spheres.view, *materials.view, *lights.view};
+  const vk::BufferView views[] = {*primitives.view, *normals.view, *nodes.view, *materials.view, *lights.view};
   const vk::WriteDescriptorSet writes[] = {
       {set, VKRAY_BINDING_FRAME, 0, vk::DescriptorType::eUniformBuffer, {}, frame_info},
-      {set, VKRAY_BINDING_TRIANGLES, 0, kTexel, {}, {}, views[0]},
-      {set, VKRAY_BINDING_SPHERES, 0, kTexel, {}, {}, views[1]},
-      {set, VKRAY_BINDING_MATERIALS, 0, kTexel, {}, {}, views[2]},
-      {set, VKRAY_BINDING_LIGHTS, 0, kTexel, {}, {}, views[3]},
+      {set, VKRAY_BINDING_PRIMITIVES, 0, kTexel, {}, {}, views[0]},
+      {set, VKRAY_BINDING_NORMALS, 0, kTexel, {}, {}, views[1]},
+      {set, VKRAY_BINDING_NODES, 0, kTexel, {}, {}, views[2]},
+      {set, VKRAY_BINDING_MATERIALS, 0, kTexel, {}, {}, views[3]},
+      {set, VKRAY_BINDING_LIGHTS, 0, kTexel, {}, {}, views[4]},
       {set, VKRAY_BINDING_OUTPUT, 0, vk::DescriptorType::eStorageBuffer, {}, output_info},
   };
   device.updateDescriptorSets(writes, {});

@@ -32,6 +32,7 @@ class TracePipeline {
 };
 
 struct RenderStats {
+  double bvh_seconds = 0;  // building the BVH (part of upload_seconds)
   double upload_seconds = 0;
   double trace_seconds = 0;
   double readback_seconds = 0;

@@ -12,7 +12,7 @@ float bits(uint32_t v) { return std::bit_cast<float>(v); }
 
 }  // namespace
 
-PackedScene pack_scene(const Scene& scene, const ImageSettings& image) {
+PackedScene pack_scene(const Scene& scene, const Bvh& bvh, const ImageSettings& image) {
   PackedScene packed;
   FrameUniforms& f = packed.frame;
   const CameraBasis cam = camera_basis(scene.camera, image.height);
@@ -25,8 +25,8 @@ PackedScene pack_scene(const Scene& scene, const ImageSettings& image) {
   f.width = image.width;
   f.height = image.height;
   f.samples_per_pixel = image.samples_per_pixel;
-  f.triangle_count = static_cast<uint32_t>(scene.triangles.size());
-  f.sphere_count = static_cast<uint32_t>(scene.spheres.size());
+  f.primitive_count = static_cast<uint32_t>(bvh.order.size());
+  f.node_count = static_cast<uint32_t>(bvh.nodes.size());
   f.light_count = static_cast<uint32_t>(scene.lights.size());
   const SampleStrata strata = sample_strata(image.samples_per_pixel);
   f.strata_x = strata.x;
@@ -36,15 +36,32 @@ PackedScene pack_scene(const Scene& scene, const ImageSettings& image) {
   f.inv_samples_per_pixel = 1.0f / static_cast<float>(image.samples_per_pixel);
   f.epsilon = scene.epsilon();
 
-  packed.triangles.reserve(scene.triangles.size() * VKRAY_TEXELS_PER_TRIANGLE);
-  for (const Triangle& t : scene.triangles) {
-    packed.triangles.emplace_back(t.v[0], bits(t.material));
-    packed.triangles.emplace_back(t.v[1], 0.0f);
-    packed.triangles.emplace_back(t.v[2], 0.0f);
+  const size_t triangle_count = scene.triangles.size();
+  const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
+  packed.primitives.reserve(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);
+  if (any_smooth) packed.normals.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
+  for (size_t slot = 0; slot < bvh.order.size(); ++slot) {
+    const uint32_t p = bvh.order[slot];
+    if (p < triangle_count) {
+      const Triangle& t = scene.triangles[p];
+      packed.primitives.emplace_back(t.v[0], bits(t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u)));
+      packed.primitives.emplace_back(t.v[1], bits(p));
+      packed.primitives.emplace_back(t.v[2], 0.0f);
+      if (t.smooth)
+        for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
+    } else {
+      const Sphere& s = scene.spheres[p - triangle_count];
+      packed.primitives.emplace_back(s.center, bits(s.material | VKRAY_PRIM_SPHERE));
+      packed.primitives.emplace_back(s.radius, 0.0f, 0.0f, bits(p));
+      packed.primitives.emplace_back(0.0f);
+    }
   }
-  for (const Sphere& s : scene.spheres) {
-    packed.spheres.emplace_back(s.center, s.radius);
-    packed.spheres.emplace_back(bits(s.material), 0.0f, 0.0f, 0.0f);
+  packed.nodes.reserve(bvh.nodes.size() * VKRAY_TEXELS_PER_NODE);
+  for (const BvhNode& n : bvh.nodes) {
+    packed.nodes.emplace_back(n.child[0].min, bits(n.link[0]));
+    packed.nodes.emplace_back(n.child[0].max, bits(n.link[1]));
+    packed.nodes.emplace_back(n.child[1].min, 0.0f);
+    packed.nodes.emplace_back(n.child[1].max, 0.0f);
   }
   for (const Material& m : scene.materials) packed.materials.emplace_back(m.albedo, 0.0f);
   for (const PointLight& l : scene.lights) {

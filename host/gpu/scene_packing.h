@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include "bvh.h"
 #include "scene.h"
 #include "../shaders/shared/types.h"
 
@@ -17,6 +18,7 @@ static_assert(offsetof(FrameUniforms, origin) == 0);
 static_assert(offsetof(FrameUniforms, forward) == 48);
 static_assert(offsetof(FrameUniforms, ambient) == 80);
 static_assert(offsetof(FrameUniforms, width) == 96);
+static_assert(offsetof(FrameUniforms, primitive_count) == 108);
 static_assert(offsetof(FrameUniforms, strata_y) == 124);
 static_assert(offsetof(FrameUniforms, epsilon) == 140);
 static_assert(sizeof(FrameUniforms) == 144);
@@ -24,13 +26,14 @@ static_assert(sizeof(TileConstants) == 16);
 
 struct PackedScene {
   FrameUniforms frame{};
-  std::vector<glm::vec4> triangles;  // VKRAY_TEXELS_PER_TRIANGLE texels each
-  std::vector<glm::vec4> spheres;    // VKRAY_TEXELS_PER_SPHERE texels each
-  std::vector<glm::vec4> materials;  // one texel each
-  std::vector<glm::vec4> lights;     // VKRAY_TEXELS_PER_LIGHT texels each
+  std::vector<glm::vec4> primitives;  // VKRAY_TEXELS_PER_PRIMITIVE texels each, in BVH leaf order
+  std::vector<glm::vec4> normals;     // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when nothing is smooth
+  std::vector<glm::vec4> nodes;       // VKRAY_TEXELS_PER_NODE texels each
+  std::vector<glm::vec4> materials;   // one texel each
+  std::vector<glm::vec4> lights;      // VKRAY_TEXELS_PER_LIGHT texels each
 };
 
 // `image` is the resolution actually rendered (the scene's, or the command line's).
-PackedScene pack_scene(const Scene& scene, const ImageSettings& image);
+PackedScene pack_scene(const Scene& scene, const Bvh& bvh, const ImageSettings& image);
 
 }  // namespace vkray::gpu

@@ -16,21 +16,37 @@ using glm::vec4;
 #endif
 
 // ---- Descriptor bindings (set 0) -------------------------------------------------------------
-#define VKRAY_BINDING_FRAME 0      // uniform buffer: FrameUniforms
-#define VKRAY_BINDING_TRIANGLES 1  // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_TRIANGLE each
-#define VKRAY_BINDING_SPHERES 2    // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_SPHERE each
-#define VKRAY_BINDING_MATERIALS 3  // uniform texel buffer, RGBA32F, one texel (albedo) each
-#define VKRAY_BINDING_LIGHTS 4     // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_LIGHT each
-#define VKRAY_BINDING_OUTPUT 5     // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
+#define VKRAY_BINDING_FRAME 0       // uniform buffer: FrameUniforms
+#define VKRAY_BINDING_PRIMITIVES 1  // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_PRIMITIVE each, in BVH order
+#define VKRAY_BINDING_NORMALS 2     // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_PRIMITIVE each (smooth triangles)
+#define VKRAY_BINDING_NODES 3       // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_NODE each
+#define VKRAY_BINDING_MATERIALS 4   // uniform texel buffer, RGBA32F, one texel (albedo) each
+#define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_LIGHT each
+#define VKRAY_BINDING_OUTPUT 6      // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
 
 // Texel buffers rather than storage buffers: with the triangles in a storage buffer instead, a
 // 1024x1024 render on Mesa 22.3.6 lavapipe (2 cores) took 1.8-2.3x as long (README, "How the GPU
 // path works").
-// Triangle: (v0.xyz, material bits), (v1.xyz, 0), (v2.xyz, 0). Vertices, not edges: the watertight
-// test needs every triangle sharing a vertex to see bitwise the same coordinates.
-#define VKRAY_TEXELS_PER_TRIANGLE 3
-// Sphere: (center.xyz, radius), (material bits, 0, 0, 0).
-#define VKRAY_TEXELS_PER_SPHERE 2
+//
+// Primitive, in BVH leaf order: a triangle is (v0.xyz, flags), (v1.xyz, index), (v2.xyz, 0), vertices
+// rather than edges, since the watertight test needs every triangle sharing a vertex to see bitwise
+// the same coordinates; a sphere is (center.xyz, flags), (radius, 0, 0, index), (0). `index` is the
+// primitive's place in the scene (bits of a uint), which decides ties (VKRAY_TIE).
+// flags = material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH.
+#define VKRAY_TEXELS_PER_PRIMITIVE 3
+#define VKRAY_PRIM_SPHERE 0x80000000u
+#define VKRAY_PRIM_SMOOTH 0x40000000u  // a triangle with vertex normals in the normals buffer
+#define VKRAY_PRIM_MATERIAL_MASK 0x3fffffffu
+// BVH node: (left.min.xyz, left link), (left.max.xyz, right link), (right.min.xyz, 0), (right.max.xyz, 0).
+// A link is an inner node's index, or VKRAY_LEAF_BIT | first << VKRAY_LEAF_COUNT_BITS | count.
+#define VKRAY_TEXELS_PER_NODE 4
+#define VKRAY_LEAF_BIT 0x80000000u
+#define VKRAY_LEAF_COUNT_BITS 4u
+#define VKRAY_TRAVERSAL_STACK 64
+// Two hits whose distances differ by less than this fraction are a tie (that is below float
+// precision: a ray along the line where two walls meet, coplanar surfaces); the primitive that
+// comes first in the scene wins, so the result does not depend on traversal order.
+#define VKRAY_TIE 1e-5
 // Light: (position.xyz, 0), (intensity.rgb, 0).
 #define VKRAY_TEXELS_PER_LIGHT 2
 
@@ -50,8 +66,8 @@ struct FrameUniforms {
   uint width;       // image size in pixels
   uint height;
   uint samples_per_pixel;
-  uint triangle_count;
-  uint sphere_count;
+  uint primitive_count;  // 0: the scene has no geometry (no BVH to traverse)
+  uint node_count;
   uint light_count;
   uint strata_x;    // sample pattern: strata_x * strata_y >= samples_per_pixel
   uint strata_y;

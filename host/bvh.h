@@ -1,0 +1,65 @@
+// A bounding volume hierarchy over the scene's primitives, built on the host with binned SAH and
+// laid out as the GPU reads it: binary nodes that hold both children's boxes, so one node fetch
+// tests two boxes. The GPU path and the CPU reference traverse it with their own code.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene.h"
+#include "../shaders/shared/types.h"
+
+namespace vkray {
+
+struct Aabb {
+  glm::vec3 min{1e30f};
+  glm::vec3 max{-1e30f};  // empty: min > max
+  void grow(const glm::vec3& p) {
+    min = glm::min(min, p);
+    max = glm::max(max, p);
+  }
+  void grow(const Aabb& b) {
+    min = glm::min(min, b.min);
+    max = glm::max(max, b.max);
+  }
+  float half_area() const {
+    const glm::vec3 d = glm::max(max - min, glm::vec3(0.0f));
+    return d.x * d.y + d.y * d.z + d.z * d.x;
+  }
+};
+
+// A child link: an inner node's index, or a leaf (kLeafBit | first << kLeafCountBits | count),
+// where first is the index of its first primitive in Bvh::order and count is 1..kMaxLeafSize.
+constexpr uint32_t kLeafBit = VKRAY_LEAF_BIT;
+constexpr uint32_t kLeafCountBits = VKRAY_LEAF_COUNT_BITS;
+constexpr uint32_t kMaxLeafSize = (1u << kLeafCountBits) - 1;
+constexpr uint32_t kMaxPrimitives = 1u << (31 - kLeafCountBits);
+// The traversal stacks hold this many entries; the builder keeps the depth below it.
+constexpr uint32_t kMaxDepth = VKRAY_TRAVERSAL_STACK;
+
+inline bool is_leaf(uint32_t link) { return (link & kLeafBit) != 0; }
+inline uint32_t leaf_first(uint32_t link) { return (link & ~kLeafBit) >> kLeafCountBits; }
+inline uint32_t leaf_count(uint32_t link) { return link & kMaxLeafSize; }
+
+struct BvhNode {
+  Aabb child[2];
+  uint32_t link[2] = {0, 0};
+};
+
+struct Bvh {
+  std::vector<BvhNode> nodes;   // nodes[0] is the root; empty when there are no primitives
+  std::vector<uint32_t> order;  // order[i]: the original index of the i-th primitive in leaf order
+  uint32_t depth = 0;           // levels of inner nodes
+  double build_seconds = 0;
+};
+
+// Builds over primitives given by their bounding boxes. Throws std::length_error beyond kMaxPrimitives.
+Bvh build_bvh(const std::vector<Aabb>& boxes);
+
+// A scene's primitives are numbered triangles first, then spheres: primitive i < triangles.size()
+// is triangles[i], the rest are spheres[i - triangles.size()].
+std::vector<Aabb> primitive_boxes(const Scene& scene);
+
+}  // namespace vkray

@@ -1,0 +1,87 @@
+// The BVH builder's invariants: every primitive once, boxes that contain what is below them,
+// bounded depth even for the worst input.
+#include <random>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "bvh.h"
+
+namespace vkray {
+namespace {
+
+bool contains(const Aabb& outer, const Aabb& inner) {
+  return glm::all(glm::lessThanEqual(outer.min, inner.min)) && glm::all(glm::greaterThanEqual(outer.max, inner.max));
+}
+
+// Checks the subtree under `link` against `box` and collects its primitives.
+void check(const Bvh& bvh, const std::vector<Aabb>& boxes, uint32_t link, const Aabb& box, std::multiset<uint32_t>& seen,
+           uint32_t depth) {
+  ASSERT_LE(depth, kMaxDepth);
+  if (is_leaf(link)) {
+    ASSERT_GE(leaf_count(link), 1u);
+    for (uint32_t slot = leaf_first(link); slot < leaf_first(link) + leaf_count(link); ++slot) {
+      ASSERT_LT(slot, bvh.order.size());
+      seen.insert(bvh.order[slot]);
+      EXPECT_TRUE(contains(box, boxes[bvh.order[slot]])) << "primitive " << bvh.order[slot] << " outside its leaf";
+    }
+    return;
+  }
+  ASSERT_LT(link, bvh.nodes.size());
+  const BvhNode& node = bvh.nodes[link];
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_TRUE(contains(box, node.child[c])) << "child box outside its parent";
+    check(bvh, boxes, node.link[c], node.child[c], seen, depth + 1);
+  }
+}
+
+void check_tree(const std::vector<Aabb>& boxes) {
+  const Bvh bvh = build_bvh(boxes);
+  ASSERT_FALSE(bvh.nodes.empty());
+  std::multiset<uint32_t> seen;
+  Aabb all;
+  for (const auto& b : boxes) all.grow(b);
+  const BvhNode& root = bvh.nodes[0];
+  for (int c = 0; c < 2; ++c) {
+    if (is_leaf(root.link[c]) && leaf_count(root.link[c]) == 0) continue;  // the empty side of a one-leaf tree
+    EXPECT_TRUE(contains(all, root.child[c]));
+    check(bvh, boxes, root.link[c], root.child[c], seen, 1);
+  }
+  ASSERT_EQ(seen.size(), boxes.size());
+  for (uint32_t i = 0; i < boxes.size(); ++i) EXPECT_EQ(seen.count(i), 1u) << "primitive " << i;
+  EXPECT_LT(bvh.depth, kMaxDepth);
+}
+
+std::vector<Aabb> random_boxes(size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> pos(-100, 100), size(0, 2);
+  std::vector<Aabb> boxes(n);
+  for (auto& b : boxes) {
+    const glm::vec3 p(pos(rng), pos(rng), pos(rng));
+    b = {p, p + glm::vec3(size(rng), size(rng), size(rng))};
+  }
+  return boxes;
+}
+
+TEST(BvhTest, RandomBoxes) {
+  for (size_t n : {1u, 2u, 3u, 15u, 16u, 17u, 1000u, 50000u}) {
+    SCOPED_TRACE(n);
+    check_tree(random_boxes(n, unsigned(n)));
+  }
+}
+
+TEST(BvhTest, NoPrimitivesNoNodes) { EXPECT_TRUE(build_bvh({}).nodes.empty()); }
+
+TEST(BvhTest, IdenticalBoxesStillGiveABoundedTree) {
+  // SAH cannot split these at all: the builder must fall back to median splits, not recurse forever.
+  check_tree(std::vector<Aabb>(20000, Aabb{glm::vec3(1), glm::vec3(2)}));
+}
+
+TEST(BvhTest, FlatBoxesOfAxisAlignedWalls) {
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 64; ++i) boxes.push_back({glm::vec3(float(i), 0, 0), glm::vec3(float(i) + 1, 1, 0)});
+  check_tree(boxes);
+}
+
+}  // namespace
+}  // namespace vkray
