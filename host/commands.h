@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "scene.h"
 
@@ -43,7 +44,18 @@ struct WatchCommand {
 // The scene's image settings with the command line's overrides applied.
 ImageSettings image_settings(const Scene& scene, const RenderFlags& flags);
 
+struct BenchCommand {
+  std::vector<std::string> scenes{"cornell", "bunny", "dragon", "dragon-field"};  // in scenes/
+  uint32_t width = 1024, height = 1024;
+  unsigned repeat = 3;
+  unsigned threads = 0;  // CPU reference and Embree threads; 0: one per hardware thread
+  std::string device;
+  bool cpu_reference = true;
+  bool json = false;
+};
+
 int run_render(const RenderCommand& command);
+int run_bench(const BenchCommand& command);
 int run_watch(const WatchCommand& command);
 int run_parity(const ParityCommand& command);
 int run_devices();

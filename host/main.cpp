@@ -68,6 +68,20 @@ int main(int argc, char** argv) {
                         "Stop after N reloads (each change that was acted on counts, failed or not); for tests and scripts")
       ->check(CLI::Range(1, 1000000));
 
+  BenchCommand bench;
+  auto* bench_cmd = app.add_subcommand(
+      "bench", "Measure rays per second of the GPU path, the CPU reference and Intel Embree (when built with it) on "
+               "fixed scenes, alternately in one run. Prints a table (or --json); never fails on the numbers.");
+  bench_cmd->add_option("--scenes", bench.scenes, "Scene names in scenes/ (default: cornell bunny dragon dragon-field)")
+      ->delimiter(',');
+  bench_cmd->add_option("--width", bench.width, "Image width")->check(CLI::Range(8, 16384));
+  bench_cmd->add_option("--height", bench.height, "Image height")->check(CLI::Range(8, 16384));
+  bench_cmd->add_option("--repeat", bench.repeat, "Rounds per scene; the median is reported")->check(CLI::Range(1, 100));
+  bench_cmd->add_option("--threads", bench.threads, "Threads for the CPU reference and Embree")->check(CLI::Range(1, 256));
+  bench_cmd->add_option("--device", bench.device, "Vulkan device: index or part of its name");
+  bench_cmd->add_flag("!--no-cpu-reference", bench.cpu_reference, "Leave the (slow) CPU reference out");
+  bench_cmd->add_flag("--json", bench.json, "Print the results as JSON");
+
   auto* devices_cmd = app.add_subcommand("devices", "List Vulkan devices with the properties that matter to vkray.");
 
   try {
@@ -83,6 +97,7 @@ int main(int argc, char** argv) {
     if (*render_cmd) return run_render(render);
     if (*parity_cmd) return run_parity(parity);
     if (*watch_cmd) return run_watch(watch);
+    if (*bench_cmd) return run_bench(bench);
     if (*devices_cmd) return run_devices();
   } catch (const ShaderError& e) {
     std::cerr << "vkray: shader compilation failed:\n" << e.what() << "\n";

@@ -34,10 +34,12 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
 
     vec3 shadow_dir = light_pos - shadow_origin;
     float shadow_dist = length(shadow_dir);
-    rays += 1u;
-    // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
-    if (trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon))
-      continue;
+    if ((frame.options & VKRAY_OPTION_NO_SHADOWS) == 0u) {
+      rays += 1u;
+      // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
+      if (trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon))
+        continue;
+    }
     irradiance += texelFetch(lights, base + 1).rgb * (cos_theta / (PI * r2));
   }
   return surface.albedo * irradiance;

@@ -181,6 +181,21 @@ TEST(CliTest, ParityCatchesAPerturbedShader) {
   EXPECT_TRUE(std::filesystem::exists(dir / "d.png"));
 }
 
+TEST(CliTest, BenchPrintsJsonForEachScene) {
+  // A benchmark is not a test: this checks the command runs and reports, never how fast.
+  TempDir dir;
+  const Result run = vkray("bench --scenes cornell,teapot --width 32 --height 32 --repeat 1 --json", dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto j = nlohmann::json::parse(run.out);
+  ASSERT_EQ(j.size(), 2u);
+  EXPECT_EQ(j[1].at("scene"), "teapot");
+  EXPECT_EQ(j[1].at("triangles"), 6322);
+  for (const char* mode : {"primary", "primary_shadow"}) {
+    EXPECT_GT(j[0].at(mode).at("gpu_mrays").get<double>(), 0.0);
+    EXPECT_GT(j[0].at(mode).at("cpu_reference_mrays").get<double>(), 0.0);
+  }
+}
+
 TEST(CliTest, HelpDocumentsExitCodes) {
   TempDir dir;
   const Result run = vkray("render --help", dir.path());

@@ -37,7 +37,8 @@ struct Hit {
 
 class Tracer {
  public:
-  Tracer(const Scene& scene, const Bvh* bvh) : scene_(scene), bvh_(bvh), epsilon_(scene.epsilon()) {}
+  Tracer(const Scene& scene, const Bvh* bvh, bool shadows)
+      : scene_(scene), bvh_(bvh), shadows_(shadows), epsilon_(scene.epsilon()) {}
 
   // Closest intersection with t in (t_min, t_max); with any_hit, the first one found.
   Hit closest(const Ray& ray, double t_min, double t_max, bool any_hit = false) const {
@@ -92,10 +93,12 @@ class Tracer {
       const double r2 = glm::dot(to_light, to_light);
       const double cos_theta = glm::dot(shading_n, to_light / std::sqrt(r2));
       if (!(cos_theta > 0)) continue;
-      ++rays;
-      const dvec3 shadow = light - shadow_origin;
-      const double distance = glm::length(shadow);
-      if (closest({shadow_origin, shadow / distance}, epsilon_, distance - epsilon_, true).primitive >= 0) continue;
+      if (shadows_) {
+        ++rays;
+        const dvec3 shadow = light - shadow_origin;
+        const double distance = glm::length(shadow);
+        if (closest({shadow_origin, shadow / distance}, epsilon_, distance - epsilon_, true).primitive >= 0) continue;
+      }
       mix(signature, 0x8000000000000000ull | l);
       irradiance += dvec3(scene_.lights[l].intensity) * (cos_theta / (std::numbers::pi * r2));
     }
@@ -190,6 +193,7 @@ class Tracer {
 
   const Scene& scene_;
   const Bvh* bvh_;  // null: brute force
+  bool shadows_;
   double epsilon_;
 };
 
@@ -201,9 +205,13 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
   result.image = Image(settings.width, settings.height);
   result.signatures.assign(size_t(settings.width) * settings.height, 0);
 
-  const Bvh bvh = options.use_bvh ? build_bvh(primitive_boxes(scene)) : Bvh{};
-  result.bvh_seconds = bvh.build_seconds;
-  const Tracer tracer(scene, options.use_bvh ? &bvh : nullptr);
+  Bvh built;
+  if (options.use_bvh && !options.bvh) {
+    built = build_bvh(primitive_boxes(scene));
+    result.bvh_seconds = built.build_seconds;
+  }
+  const Bvh* bvh = options.use_bvh ? (options.bvh ? options.bvh : &built) : nullptr;
+  const Tracer tracer(scene, bvh, options.shadows);
   const CameraBasis cam = camera_basis(scene.camera, settings.height);
   const SampleStrata strata = sample_strata(settings.samples_per_pixel);
   const dvec3 origin(cam.origin), right(cam.right), up(cam.up), forward(cam.forward);

@@ -11,11 +11,17 @@
 #include "image.h"
 #include "scene.h"
 
+namespace vkray {
+struct Bvh;
+}
+
 namespace vkray::cpu {
 
 struct ReferenceOptions {
   unsigned threads = 0;  // 0: one per hardware thread. The image does not depend on it.
   bool use_bvh = true;   // false: test every primitive (slow; checks the traversal)
+  const Bvh* bvh = nullptr;  // a BVH already built for this scene; null: build one
+  bool shadows = true;   // false: no shadow rays, every light counts as visible (benchmarks)
   std::function<void(uint32_t rows_done, uint32_t rows)> progress;  // called under a lock
 };
 

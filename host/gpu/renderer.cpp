@@ -46,6 +46,20 @@ TexelBuffer make_texel_buffer(const Context& ctx, std::vector<glm::vec4> texels,
   return t;
 }
 
+// Refuses, before allocating anything, a scene whose buffers cannot fit the device's memory.
+void check_memory(const Context& ctx, const PackedScene& packed) {
+  const uint64_t bytes = (packed.primitives.size() + packed.normals.size() + packed.nodes.size() + packed.materials.size() +
+                          packed.lights.size()) * sizeof(glm::vec4);
+  const auto memory = ctx.physical_device().getMemoryProperties();
+  uint64_t largest_heap = 0;
+  for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
+    if (memory.memoryHeaps[h].flags & vk::MemoryHeapFlagBits::eDeviceLocal)
+      largest_heap = std::max<uint64_t>(largest_heap, memory.memoryHeaps[h].size);
+  if (bytes > largest_heap)
+    throw DeviceError("scene too large for " + ctx.device_name() + ": its buffers need " + std::to_string(bytes >> 20) +
+                      " MiB, the largest device-local memory heap has " + std::to_string(largest_heap >> 20) + " MiB");
+}
+
 }  // namespace
 
 TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv, const vk::raii::PipelineCache* cache) {
@@ -79,26 +93,56 @@ uint32_t tile_side(const Scene& scene, const ImageSettings& image) {
   return std::clamp<uint32_t>(side, VKRAY_WORKGROUP_X, largest);
 }
 
+struct GpuScene::Buffers {
+  TexelBuffer primitives, normals, nodes, materials, lights;
+};
+
+GpuScene::GpuScene(const Context& ctx, const Scene& scene, const Bvh* prebuilt) : scene_(&scene) {
+  const auto start = Clock::now();
+  Bvh built;
+  if (!prebuilt) built = build_bvh(primitive_boxes(scene));
+  const Bvh& bvh = prebuilt ? *prebuilt : built;
+  bvh_seconds_ = bvh.build_seconds;
+  primitive_count_ = uint32_t(bvh.order.size());
+  const PackedScene packed = pack_scene(scene, bvh, scene.image);
+  check_memory(ctx, packed);
+  buffers_ = std::make_unique<Buffers>(Buffers{make_texel_buffer(ctx, packed.primitives, "primitive"),
+                                               make_texel_buffer(ctx, packed.normals, "normal"),
+                                               make_texel_buffer(ctx, packed.nodes, "BVH node"),
+                                               make_texel_buffer(ctx, packed.materials, "material"),
+                                               make_texel_buffer(ctx, packed.lights, "light")});
+  upload_seconds_ = seconds_since(start);
+}
+
+GpuScene::~GpuScene() = default;
+GpuScene::GpuScene(GpuScene&&) noexcept = default;
+
 Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, const ImageSettings& image,
+             const RenderOptions& options, RenderStats* stats_out) {
+  const GpuScene gpu_scene(ctx, scene);
+  Image result = render(ctx, pipeline, gpu_scene, image, options, stats_out);
+  if (stats_out) {
+    stats_out->bvh_seconds = gpu_scene.bvh_seconds();
+    stats_out->upload_seconds += gpu_scene.upload_seconds();
+  }
+  return result;
+}
+
+Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_scene, const ImageSettings& image,
              const RenderOptions& options, RenderStats* stats_out) {
   RenderStats stats;
   const vk::raii::Device& device = ctx.device();
+  const Scene& scene = gpu_scene.scene();
 
-  // ---- upload ----
+  // ---- per-frame data: uniforms, output ----
   auto start = Clock::now();
-  const Bvh bvh = build_bvh(primitive_boxes(scene));
-  stats.bvh_seconds = bvh.build_seconds;
-  const PackedScene packed = pack_scene(scene, bvh, image);
+  FrameUniforms frame = pack_frame(scene, gpu_scene.primitive_count(), image);
+  if (!options.shadows) frame.options |= VKRAY_OPTION_NO_SHADOWS;
   const vk::DeviceSize pixel_bytes = vk::DeviceSize(image.width) * image.height * sizeof(glm::vec4);
   if (pixel_bytes > ctx.limits().maxStorageBufferRange)
     throw DeviceError("image too large for " + ctx.device_name() + ": " + std::to_string(pixel_bytes) +
                       " bytes of output, maxStorageBufferRange is " + std::to_string(ctx.limits().maxStorageBufferRange));
-  Buffer frame = upload_buffer(ctx, &packed.frame, sizeof(packed.frame), vk::BufferUsageFlagBits::eUniformBuffer);
-  const TexelBuffer primitives = make_texel_buffer(ctx, packed.primitives, "primitive");
-  const TexelBuffer normals = make_texel_buffer(ctx, packed.normals, "normal");
-  const TexelBuffer nodes = make_texel_buffer(ctx, packed.nodes, "BVH node");
-  const TexelBuffer materials = make_texel_buffer(ctx, packed.materials, "material");
-  const TexelBuffer lights = make_texel_buffer(ctx, packed.lights, "light");
+  Buffer frame_buffer = upload_buffer(ctx, &frame, sizeof(frame), vk::BufferUsageFlagBits::eUniformBuffer);
   using M = vk::MemoryPropertyFlagBits;
   const Buffer output = create_buffer(ctx, pixel_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible,
                                       M::eHostCached);
@@ -111,9 +155,10 @@ Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, co
   const vk::DescriptorSetLayout set_layout = *pipeline.set_layout();
   vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pool, set_layout));
   const vk::DescriptorSet set = *sets[0];
-  const vk::DescriptorBufferInfo frame_info(*frame.buffer, 0, VK_WHOLE_SIZE);
+  const vk::DescriptorBufferInfo frame_info(*frame_buffer.buffer, 0, VK_WHOLE_SIZE);
   const vk::DescriptorBufferInfo output_info(*output.buffer, 0, VK_WHOLE_SIZE);
-  const vk::BufferView views[] = {*primitives.view, *normals.view, *nodes.view, *materials.view, *lights.view};
+  const GpuScene::Buffers& b = *gpu_scene.buffers_;
+  const vk::BufferView views[] = {*b.primitives.view, *b.normals.view, *b.nodes.view, *b.materials.view, *b.lights.view};
   const vk::WriteDescriptorSet writes[] = {
       {set, VKRAY_BINDING_FRAME, 0, vk::DescriptorType::eUniformBuffer, {}, frame_info},
       {set, VKRAY_BINDING_PRIMITIVES, 0, kTexel, {}, {}, views[0]},

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <vulkan/vulkan_raii.hpp>
@@ -12,6 +13,10 @@
 #include "gpu/context.h"
 #include "image.h"
 #include "scene.h"
+
+namespace vkray {
+struct Bvh;
+}
 
 namespace vkray::gpu {
 
@@ -29,6 +34,29 @@ class TracePipeline {
   vk::raii::DescriptorSetLayout set_layout_{nullptr};
   vk::raii::PipelineLayout layout_{nullptr};
   vk::raii::Pipeline pipeline_{nullptr};
+};
+
+// A scene on the device: its BVH built and its buffers uploaded, ready for any number of renders.
+class GpuScene {
+ public:
+  // `bvh`: one already built for this scene; null builds one.
+  GpuScene(const Context& ctx, const Scene& scene, const Bvh* bvh = nullptr);
+  ~GpuScene();
+  GpuScene(GpuScene&&) noexcept;
+
+  const Scene& scene() const { return *scene_; }
+  double bvh_seconds() const { return bvh_seconds_; }
+  double upload_seconds() const { return upload_seconds_; }  // BVH build included
+  uint32_t primitive_count() const { return primitive_count_; }
+
+ private:
+  friend Image render(Context&, const TracePipeline&, const GpuScene&, const struct ImageSettings&,
+                      const struct RenderOptions&, struct RenderStats*);
+  struct Buffers;
+  const Scene* scene_;
+  std::unique_ptr<Buffers> buffers_;
+  uint32_t primitive_count_ = 0;
+  double bvh_seconds_ = 0, upload_seconds_ = 0;
 };
 
 struct RenderStats {
@@ -49,13 +77,19 @@ struct RenderOptions {
   std::function<void(uint32_t, uint32_t)> progress;
   // Asked between tiles; when it returns true the render stops and throws Cancelled.
   std::function<bool()> cancel;
+  // false: no shadow rays, every light counts as visible (benchmarks of camera rays alone).
+  bool shadows = true;
 };
 
 // A render stopped by RenderOptions::cancel; no work is left in flight.
 struct Cancelled {};
 
-// Renders `scene` at `image` resolution and sample count. Throws DeviceError (and vk::SystemError
-// from failing Vulkan calls).
+// Renders a scene already on the device at `image` resolution and sample count. Throws
+// DeviceError (and vk::SystemError from failing Vulkan calls).
+Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& scene, const ImageSettings& image,
+             const RenderOptions& options = {}, RenderStats* stats = nullptr);
+
+// The same for a scene not yet on the device: uploads it, renders, frees it (stats include the upload).
 Image render(Context& ctx, const TracePipeline& pipeline, const Scene& scene, const ImageSettings& image,
              const RenderOptions& options = {}, RenderStats* stats = nullptr);
 

@@ -12,9 +12,8 @@ float bits(uint32_t v) { return std::bit_cast<float>(v); }
 
 }  // namespace
 
-PackedScene pack_scene(const Scene& scene, const Bvh& bvh, const ImageSettings& image) {
-  PackedScene packed;
-  FrameUniforms& f = packed.frame;
+FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const ImageSettings& image) {
+  FrameUniforms f{};
   const CameraBasis cam = camera_basis(scene.camera, image.height);
   f.origin = glm::vec4(cam.origin, 0.0f);
   f.right = glm::vec4(cam.right, 0.0f);
@@ -25,8 +24,7 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh, const ImageSettings& 
   f.width = image.width;
   f.height = image.height;
   f.samples_per_pixel = image.samples_per_pixel;
-  f.primitive_count = static_cast<uint32_t>(bvh.order.size());
-  f.node_count = static_cast<uint32_t>(bvh.nodes.size());
+  f.primitive_count = primitive_count;
   f.light_count = static_cast<uint32_t>(scene.lights.size());
   const SampleStrata strata = sample_strata(image.samples_per_pixel);
   f.strata_x = strata.x;
@@ -35,7 +33,12 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh, const ImageSettings& 
   f.inv_strata_y = strata.inv_y;
   f.inv_samples_per_pixel = 1.0f / static_cast<float>(image.samples_per_pixel);
   f.epsilon = scene.epsilon();
+  return f;
+}
 
+PackedScene pack_scene(const Scene& scene, const Bvh& bvh, const ImageSettings& image) {
+  PackedScene packed;
+  packed.frame = pack_frame(scene, static_cast<uint32_t>(bvh.order.size()), image);
   const size_t triangle_count = scene.triangles.size();
   const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
   packed.primitives.reserve(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);

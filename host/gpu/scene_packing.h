@@ -36,4 +36,7 @@ struct PackedScene {
 // `image` is the resolution actually rendered (the scene's, or the command line's).
 PackedScene pack_scene(const Scene& scene, const Bvh& bvh, const ImageSettings& image);
 
+// The per-frame uniforms alone (camera, image, counts).
+FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const ImageSettings& image);
+
 }  // namespace vkray::gpu

@@ -67,7 +67,7 @@ struct FrameUniforms {
   uint height;
   uint samples_per_pixel;
   uint primitive_count;  // 0: the scene has no geometry (no BVH to traverse)
-  uint node_count;
+  uint options;          // VKRAY_OPTION_* bits
   uint light_count;
   uint strata_x;    // sample pattern: strata_x * strata_y >= samples_per_pixel
   uint strata_y;
@@ -76,6 +76,9 @@ struct FrameUniforms {
   float inv_samples_per_pixel;
   float epsilon;    // self-intersection offset, scaled to the scene's extent
 };
+
+// FrameUniforms::options
+#define VKRAY_OPTION_NO_SHADOWS 1u  // every light counts as visible: camera rays only (vkray bench)
 
 // ---- Push constants: the tile this dispatch covers ---------------------------------------------
 struct TileConstants {
