@@ -50,7 +50,9 @@ struct BenchCommand {
   unsigned repeat = 3;
   unsigned threads = 0;  // CPU reference and Embree threads; 0: one per hardware thread
   std::string device;
+  std::filesystem::path shader_dir;  // empty: the installed (or source-tree) shaders
   bool cpu_reference = true;
+  bool embree = true;
   bool json = false;
 };
 

@@ -79,7 +79,9 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--repeat", bench.repeat, "Rounds per scene; the median is reported")->check(CLI::Range(1, 100));
   bench_cmd->add_option("--threads", bench.threads, "Threads for the CPU reference and Embree")->check(CLI::Range(1, 256));
   bench_cmd->add_option("--device", bench.device, "Vulkan device: index or part of its name");
-  bench_cmd->add_flag("!--no-cpu-reference", bench.cpu_reference, "Leave the (slow) CPU reference out");
+  bench_cmd->add_option("--shader-dir", bench.shader_dir, "Folder with trace.comp and its includes (to measure a variant)");
+  bench_cmd->add_flag("!--no-cpu-reference", bench.cpu_reference, "Leave the CPU reference out");
+  bench_cmd->add_flag("!--no-embree", bench.embree, "Leave Embree out");
   bench_cmd->add_flag("--json", bench.json, "Print the results as JSON");
 
   auto* devices_cmd = app.add_subcommand("devices", "List Vulkan devices with the properties that matter to vkray.");

@@ -33,6 +33,25 @@ uint primitive_index(uint prim) {  // its place in the scene, for ties
 }
 
 // ---- Traversal ------------------------------------------------------------------------------------------
+// Tests the primitives of a leaf against the ray, keeping the closest hit (ties go to the primitive
+// that comes first in the scene, VKRAY_TIE). Returns true when any_hit and something was hit.
+bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max, bool any_hit, inout Hit hit) {
+  uint first = (link & ~VKRAY_LEAF_BIT) >> VKRAY_LEAF_COUNT_BITS;
+  uint end = first + (link & ((1u << VKRAY_LEAF_COUNT_BITS) - 1u));
+  for (uint prim = first; prim < end; ++prim) {
+    float limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
+    float t = intersect_primitive(ray, shear, prim, t_min, limit);
+    if (t <= 0.0) continue;
+    if (any_hit) {
+      hit = Hit(t, prim);
+      return true;
+    }
+    if (hit.prim == NO_HIT || t < hit.t * (1.0 - VKRAY_TIE) || primitive_index(prim) < primitive_index(hit.prim))
+      hit = Hit(t, prim);
+  }
+  return false;
+}
+
 // Closest hit in (t_min, t_max); with any_hit, the first hit found (for shadow rays).
 Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   Hit hit = Hit(t_max, NO_HIT);
@@ -51,30 +70,24 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
     vec2 left = intersect_box(ray.origin, inv_dir, left_min.xyz, left_max.xyz, t_min, t_limit);
     vec2 right = intersect_box(ray.origin, inv_dir, texelFetch(nodes, base + 2).xyz, texelFetch(nodes, base + 3).xyz,
                                t_min, t_limit);
-    uint link[2] = uint[2](floatBitsToUint(left_min.w), floatBitsToUint(left_max.w));
-    bool enter[2] = bool[2](left.x <= left.y, right.x <= right.y);
-
-    // Leaves are intersected right away; inner children are visited near one first.
-    for (int c = 0; c < 2; ++c) {
-      if (!enter[c] || (link[c] & VKRAY_LEAF_BIT) == 0u) continue;
-      enter[c] = false;
-      uint first = (link[c] & ~VKRAY_LEAF_BIT) >> VKRAY_LEAF_COUNT_BITS;
-      uint end = first + (link[c] & ((1u << VKRAY_LEAF_COUNT_BITS) - 1u));
-      for (uint prim = first; prim < end; ++prim) {
-        float limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
-        float t = intersect_primitive(ray, shear, prim, t_min, limit);
-        if (t <= 0.0) continue;
-        if (any_hit) return Hit(t, prim);
-        if (hit.prim == NO_HIT || t < hit.t * (1.0 - VKRAY_TIE) || primitive_index(prim) < primitive_index(hit.prim))
-          hit = Hit(t, prim);
-      }
+    uint left_link = floatBitsToUint(left_min.w), right_link = floatBitsToUint(left_max.w);
+    bool enter_left = left.x <= left.y, enter_right = right.x <= right.y;
+    // Leaves are intersected right away; inner children are visited near one first. (Written out
+    // for each child rather than over a 2-element array: llvmpipe runs this 8% faster.)
+    if (enter_left && (left_link & VKRAY_LEAF_BIT) != 0u) {
+      enter_left = false;
+      if (intersect_leaf(ray, shear, left_link, t_min, t_max, any_hit, hit)) return hit;
     }
-    if (enter[0] && enter[1]) {
+    if (enter_right && (right_link & VKRAY_LEAF_BIT) != 0u) {
+      enter_right = false;
+      if (intersect_leaf(ray, shear, right_link, t_min, t_max, any_hit, hit)) return hit;
+    }
+    if (enter_left && enter_right) {
       bool right_first = right.x < left.x;
-      stack[depth++] = right_first ? link[0] : link[1];
-      node = right_first ? link[1] : link[0];
-    } else if (enter[0] || enter[1]) {
-      node = enter[0] ? link[0] : link[1];
+      stack[depth++] = right_first ? left_link : right_link;
+      node = right_first ? right_link : left_link;
+    } else if (enter_left || enter_right) {
+      node = enter_left ? left_link : right_link;
     } else {
       if (depth == 0) break;
       node = stack[--depth];

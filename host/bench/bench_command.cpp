@@ -64,20 +64,19 @@ std::string fixed(double value, int decimals) {
 int run_bench(const BenchCommand& cmd) {
   const std::filesystem::path scene_dir = default_scene().parent_path();
   const unsigned threads = cmd.threads ? cmd.threads : std::max(1u, std::thread::hardware_concurrency());
-  const bool with_embree =
 #ifdef VKRAY_HAVE_EMBREE
-      true;
+  const bool with_embree = cmd.embree;
 #else
-      false;
+  const bool with_embree = false;
 #endif
 
   gpu::ContextOptions options;
   options.device = cmd.device;
   gpu::Context ctx(options);
-  const std::filesystem::path shader_dir = default_shader_dir();
+  const std::filesystem::path shader_dir = cmd.shader_dir.empty() ? default_shader_dir() : cmd.shader_dir;
   const gpu::TracePipeline pipeline(ctx, gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir}).spirv);
   std::cerr << "vkray bench: device " << ctx.device_name() << " (" << ctx.driver_name() << "); CPU reference and "
-            << embree_name()
+            << (with_embree ? embree_name() : std::string("no Embree"))
             << " on " << threads << " threads; " << cmd.width << "x" << cmd.height << ", 1 sample per pixel, "
             << cmd.repeat << " rounds\n";
 
@@ -93,8 +92,11 @@ int run_bench(const BenchCommand& cmd) {
     r.bvh_ms = bvh.build_seconds * 1e3;
     const gpu::GpuScene gpu_scene(ctx, scene, &bvh);
 #ifdef VKRAY_HAVE_EMBREE
-    const bench::EmbreeTracer embree(scene);
-    r.embree_build_ms = embree.build_seconds() * 1e3;
+    std::optional<bench::EmbreeTracer> embree;
+    if (with_embree) {
+      embree.emplace(scene);
+      r.embree_build_ms = embree->build_seconds() * 1e3;
+    }
 #endif
     const ImageSettings image{cmd.width, cmd.height, 1};
     gpu::render(ctx, pipeline, gpu_scene, {64, 64, 1});  // warm-up: lavapipe compiles on first dispatch
@@ -109,8 +111,10 @@ int run_bench(const BenchCommand& cmd) {
         r.rates[mode].gpu.push_back(double(stats.rays) / stats.trace_seconds * 1e-6);
         frame_ms[mode].push_back(stats.trace_seconds * 1e3);
 #ifdef VKRAY_HAVE_EMBREE
-        const auto e = embree.trace(cmd.width, cmd.height, shadows, threads);
-        r.rates[mode].embree.push_back(double(e.rays) / e.seconds * 1e-6);
+        if (embree) {
+          const auto e = embree->trace(cmd.width, cmd.height, shadows, threads);
+          r.rates[mode].embree.push_back(double(e.rays) / e.seconds * 1e-6);
+        }
 #endif
         if (cmd.cpu_reference) {
           cpu::ReferenceOptions reference_options;
