@@ -14,7 +14,7 @@ constexpr int kBins = 16;
 // depth stays below kMaxDepth for any count up to kMaxPrimitives (32 + 27 < 64).
 constexpr uint32_t kSahDepth = 32;
 // SAH costs, relative to one primitive test.
-constexpr float kTraversalCost = 1.0;
+constexpr float kTraversalCost = 1.0f;
 constexpr float kIntersectionCost = 1.0f;
 
 class Builder {

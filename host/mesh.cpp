@@ -122,6 +122,70 @@ Mesh load_obj(const std::filesystem::path& file) {
   return mesh;
 }
 
+// A PLY header declares its element counts; before assimp reads the file (and allocates for every
+// element it declares), check that the file is large enough to hold them, so a hostile header that
+// claims a billion faces is refused at once instead of after seconds of work.
+void check_ply_header(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string line;
+  if (!std::getline(in, line) || trim(line) != "ply") fail(file, "not a PLY file (no \"ply\" on the first line)");
+  bool ascii = false;
+  struct Element {
+    std::string name;
+    uint64_t count = 0;
+    uint64_t min_bytes = 0;  // per element: binary sizes, or one character and a separator per property (ASCII)
+  };
+  std::vector<Element> elements;
+  auto type_size = [&](const std::string& type) -> uint64_t {
+    static const std::pair<const char*, uint64_t> sizes[] = {
+        {"char", 1}, {"uchar", 1}, {"int8", 1}, {"uint8", 1}, {"short", 2}, {"ushort", 2}, {"int16", 2}, {"uint16", 2},
+        {"int", 4}, {"uint", 4}, {"int32", 4}, {"uint32", 4}, {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
+    for (const auto& [name, size] : sizes)
+      if (type == name) return size;
+    fail(file, "unknown PLY property type \"" + type + "\"");
+  };
+  size_t line_number = 1;
+  for (;;) {
+    if (!std::getline(in, line)) fail(file, "the PLY header has no end_header line");
+    ++line_number;
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "end_header") break;
+    if (keyword == "format") {
+      std::string format;
+      words >> format;
+      ascii = format == "ascii";
+    } else if (keyword == "element") {
+      Element e;
+      words >> e.name >> e.count;
+      if (!words) fail(file.string() + ":" + std::to_string(line_number), "bad element line \"" + trim(line) + "\"");
+      elements.push_back(e);
+    } else if (keyword == "property" && !elements.empty()) {
+      std::string type, count_type;
+      words >> type;
+      if (type == "list") {
+        words >> count_type;
+        elements.back().min_bytes += ascii ? 2 : type_size(count_type);  // the list's length; it may be empty
+      } else {
+        elements.back().min_bytes += ascii ? 2 : type_size(type);
+      }
+    }
+  }
+  const auto header_end = static_cast<uint64_t>(in.tellg());
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(file, ec);
+  const uint64_t available = size > header_end ? size - header_end : 0;
+  uint64_t needed = 0;
+  for (const Element& e : elements) {
+    const uint64_t per = std::max<uint64_t>(e.min_bytes, 1);
+    if (e.count > available / per || needed > available - e.count * per)
+      fail(file, "the header declares " + std::to_string(e.count) + " " + e.name + " elements, more than the " +
+                     std::to_string(available) + " bytes after the header can hold");
+    needed += e.count * per;
+  }
+}
+
 Mesh load_with_assimp(const std::filesystem::path& file) {
   Assimp::Importer importer;
   // Points and lines are dropped; everything else becomes triangles.
@@ -202,6 +266,7 @@ Mesh load_mesh(const std::filesystem::path& file) {
   if (ext == ".obj") {
     mesh = load_obj(file);
   } else if (ext == ".ply") {
+    check_ply_header(file);
     mesh = load_with_assimp(file);
   } else {
     fail(file, "unknown mesh format \"" + ext + "\" (expected .obj or .ply)");

@@ -407,6 +407,25 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& file)
     const size_t column = end - (last_newline == std::string_view::npos ? 0 : last_newline + 1) + 1;
     throw SceneError(file.string() + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
                      strip_json_prefix(e.what()));
+  } catch (const json::exception& e) {
+    // A number too large for a double ("number overflow parsing '1e400'"): no position is given,
+    // so point at the number's first occurrence.
+    std::string message = e.what();
+    const auto bracket = message.find("] ");
+    if (bracket != std::string::npos) message = message.substr(bracket + 2);
+    std::string where = file.string();
+    const auto quote = message.find('\'');
+    if (quote != std::string::npos) {
+      const auto end = message.find('\'', quote + 1);
+      const auto at = json_text.find(message.substr(quote + 1, end - quote - 1));
+      if (at != std::string_view::npos) {
+        const auto prefix = json_text.substr(0, at);
+        const size_t line = 1 + static_cast<size_t>(std::count(prefix.begin(), prefix.end(), '\n'));
+        const auto newline = prefix.rfind('\n');
+        where += ":" + std::to_string(line) + ":" + std::to_string(at - (newline == std::string_view::npos ? 0 : newline + 1) + 1);
+      }
+    }
+    throw SceneError(where + ": " + message);
   }
   Scene scene;
   scene.file = file;

@@ -1,6 +1,4 @@
 // The vkray command as a user runs it: outputs, messages and exit codes.
-#include <sys/wait.h>
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -10,40 +8,18 @@
 #include <nlohmann/json.hpp>
 
 #include "image.h"
+#include "support/run_vkray.h"
 #include "support/temp_dir.h"
 
 namespace vkray::test {
 namespace {
 
-struct Result {
-  int exit_code;
-  std::string out, err;
-};
+using Result = CommandResult;
 
-// Runs `vkray ARGS` in `cwd`, capturing stdout and stderr.
-Result vkray(const std::string& args, const std::filesystem::path& cwd) {
-  const auto out = cwd / ".stdout", err = cwd / ".stderr";
-  const std::string command = "cd '" + cwd.string() + "' && '" VKRAY_EXECUTABLE "' " + args + " >'" + out.string() +
-                              "' 2>'" + err.string() + "' </dev/null";
-  const int status = std::system(command.c_str());
-  auto slurp = [](const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  };
-  Result run{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-  std::filesystem::remove(out);
-  std::filesystem::remove(err);
-  return run;
-}
+Result vkray(const std::string& args, const std::filesystem::path& cwd) { return run_vkray(args, cwd); }
 
-bool has_image_files(const std::filesystem::path& dir) {
-  for (const auto& entry : std::filesystem::directory_iterator(dir))
-    if (entry.path().filename().string()[0] != '.' || entry.path().filename().string().find(".tmp-") != std::string::npos)
-      return true;
-  return false;
-}
+// Anything left in a folder: an image, or a temporary file a failed write did not remove.
+bool has_image_files(const std::filesystem::path& dir) { return !std::filesystem::is_empty(dir); }
 
 const std::string kScenes = VKRAY_SCENE_DIR;
 

@@ -1,0 +1,32 @@
+#include "support/run_vkray.h"
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "support/temp_dir.h"
+
+namespace vkray::test {
+namespace {
+
+std::string slurp(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+CommandResult run_vkray(const std::string& args, const std::filesystem::path& cwd) {
+  const TempDir capture;  // outside `cwd`, so tests can check that nothing was left there
+  const auto out = capture / "stdout", err = capture / "stderr";
+  const std::string command = "cd '" + cwd.string() + "' && '" VKRAY_EXECUTABLE "' " + args + " >'" + out.string() +
+                              "' 2>'" + err.string() + "' </dev/null";
+  const int status = std::system(command.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+}  // namespace vkray::test

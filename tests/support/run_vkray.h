@@ -1,0 +1,17 @@
+// Runs the vkray command as a user would and captures what it printed and its exit code.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace vkray::test {
+
+struct CommandResult {
+  int exit_code;  // -1 if it did not exit normally
+  std::string out, err;
+};
+
+// `vkray ARGS` in `cwd`, with no standard input.
+CommandResult run_vkray(const std::string& args, const std::filesystem::path& cwd);
+
+}  // namespace vkray::test
