@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <functional>
 #include <iostream>
@@ -20,6 +21,7 @@
 #include "parity.h"
 #include "paths.h"
 #include "scene.h"
+#include "stop_signals.h"
 #include "timing.h"
 
 namespace vkray {
@@ -93,7 +95,7 @@ struct GpuRun {
 // lives only inside: its teardown can itself raise validation messages (leaked objects, say), and
 // those must fail the command before anything is written.
 GpuRun render_gpu(const LoadedScene& loaded, const RenderFlags& flags, const std::function<void(const std::string&)>& log,
-                  bool show_progress) {
+                  bool show_progress, const StopSignals* stop = nullptr) {
   auto validation_log = std::make_shared<gpu::ValidationLog>();
   GpuRun run;
   {
@@ -114,7 +116,17 @@ GpuRun render_gpu(const LoadedScene& loaded, const RenderFlags& flags, const std
     Progress progress(show_progress, "tracing");
     gpu::RenderOptions render_options;
     render_options.progress = [&](uint32_t done, uint32_t total) { progress.update(done, total, "tiles"); };
-    run.image = gpu::render(ctx, pipeline, loaded.scene, loaded.image, render_options, &run.stats);
+    render_options.tile_timeout = std::chrono::milliseconds(flags.tile_timeout_ms);
+    if (stop) render_options.cancel = [stop] { return stop->pending(); };
+    try {
+      run.image = gpu::render(ctx, pipeline, loaded.scene, loaded.image, render_options, &run.stats);
+    } catch (const gpu::TimeoutError& e) {
+      // Work may still be running on the device: destroying what it uses could hang or worse, so
+      // report and leave at once. Nothing has been written.
+      std::cerr << "vkray: device error: " << e.what() << "\n";
+      std::cerr.flush();
+      std::_Exit(kExitDevice);
+    }
   }
   if (validation_log->count() > 0)
     throw DeviceError(std::to_string(validation_log->count()) + " validation message(s); the first:\n  " +
@@ -153,6 +165,7 @@ ImageSettings image_settings(const Scene& scene, const RenderFlags& flags) {
 }
 
 int run_render(const RenderCommand& cmd) {
+  const StopSignals stop;  // Ctrl-C stops the render between tiles, not in the middle of a Vulkan call
   const auto total_start = Clock::now();
   auto log = [&](const std::string& line) {
     if (!cmd.quiet) std::cerr << "vkray: " << line << "\n";
@@ -176,7 +189,13 @@ int run_render(const RenderCommand& cmd) {
     phases = "load " + format_ms(loaded.load_ms) + " | trace " + format_ms(result.seconds * 1e3);
   } else {
     log(describe(loaded));
-    GpuRun run = render_gpu(loaded, cmd.flags, log, !cmd.quiet);
+    GpuRun run;
+    try {
+      run = render_gpu(loaded, cmd.flags, log, !cmd.quiet, &stop);
+    } catch (const gpu::Cancelled&) {
+      std::cerr << "vkray: interrupted; no image written\n";
+      return kExitInterrupted;
+    }
     image = std::move(run.image);
     rays = run.stats.rays;
     trace_seconds = run.stats.trace_seconds;

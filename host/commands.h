@@ -20,6 +20,7 @@ struct RenderFlags {
   std::filesystem::path shader_dir;  // empty: the installed (or source-tree) shaders
   bool validate = false;
   unsigned threads = 0;  // CPU reference threads; 0: one per hardware thread
+  uint32_t tile_timeout_ms = 60000;  // longest one GPU submission may take
 };
 
 struct RenderCommand {
@@ -64,5 +65,7 @@ int run_devices();
 
 // `vkray parity` exits with this when the images differ beyond the tolerance.
 constexpr int kExitParityFailed = 4;
+// A render stopped by SIGINT or SIGTERM (the shell's convention for Ctrl-C); nothing was written.
+constexpr int kExitInterrupted = 130;
 
 }  // namespace vkray

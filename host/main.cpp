@@ -16,7 +16,8 @@ constexpr const char* kExitCodes =
     "  1  bad input: scene, mesh or shader file, or an output file that cannot be written\n"
     "  2  usage: unknown command or option, bad option value\n"
     "  3  Vulkan or device failure (no device, failed call, timeout, validation message)\n"
-    "  4  parity: the GPU and CPU images differ beyond the documented tolerance\n";
+    "  4  parity: the GPU and CPU images differ beyond the documented tolerance\n"
+    "  130  interrupted by SIGINT (Ctrl-C) or SIGTERM; nothing was written\n";
 
 // Flags every rendering command takes.
 void add_render_flags(CLI::App* cmd, vkray::RenderFlags& flags) {
@@ -29,6 +30,10 @@ void add_render_flags(CLI::App* cmd, vkray::RenderFlags& flags) {
   cmd->add_flag("--validate", flags.validate, "Enable the Khronos validation layer; any message is an error");
   cmd->add_option("--threads", flags.threads, "CPU reference threads (default: one per hardware thread)")
       ->check(CLI::Range(1, 256));
+  cmd->add_option("--tile-timeout", flags.tile_timeout_ms,
+                  "Longest one GPU submission (a tile) may run, in milliseconds, before the render fails with exit 3 "
+                  "(default 60000)")
+      ->check(CLI::Range(1, 3600000));
   cmd->footer(kExitCodes);
 }
 

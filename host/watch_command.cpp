@@ -21,41 +21,11 @@
 #include "image.h"
 #include "paths.h"
 #include "scene.h"
+#include "stop_signals.h"
 #include "timing.h"
 
 namespace vkray {
 namespace {
-
-// SIGINT and SIGTERM, delivered through a file descriptor so the watch loop can wait on them
-// together with file changes. Restores the signal mask when destroyed.
-class StopSignals {
- public:
-  StopSignals() {
-    sigemptyset(&set_);
-    sigaddset(&set_, SIGINT);
-    sigaddset(&set_, SIGTERM);
-    sigprocmask(SIG_BLOCK, &set_, &previous_);
-    fd_ = signalfd(-1, &set_, SFD_CLOEXEC | SFD_NONBLOCK);
-  }
-  ~StopSignals() {
-    // Consume the signals that stopped us: left pending, they would be delivered (and kill the
-    // process) the moment the mask is restored.
-    signalfd_siginfo info;
-    while (::read(fd_, &info, sizeof info) == sizeof info) {
-    }
-    ::close(fd_);
-    sigprocmask(SIG_SETMASK, &previous_, nullptr);
-  }
-  int fd() const { return fd_; }
-  bool pending() const {
-    pollfd p{fd_, POLLIN, 0};
-    return ::poll(&p, 1, 0) > 0;
-  }
-
- private:
-  sigset_t set_{}, previous_{};
-  int fd_ = -1;
-};
 
 std::string names(const std::vector<std::filesystem::path>& files) {
   std::string text;

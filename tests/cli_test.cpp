@@ -1,4 +1,7 @@
 // The vkray command as a user runs it: outputs, messages and exit codes.
+#include <signal.h>
+
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -8,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "image.h"
+#include "support/child_process.h"
 #include "support/run_vkray.h"
 #include "support/temp_dir.h"
 
@@ -170,6 +174,28 @@ TEST(CliTest, BenchPrintsJsonForEachScene) {
     EXPECT_GT(j[0].at(mode).at("gpu_mrays").get<double>(), 0.0);
     EXPECT_GT(j[0].at(mode).at("cpu_reference_mrays").get<double>(), 0.0);
   }
+}
+
+TEST(CliTest, TileTimeoutExitsThreeAndWritesNothing) {
+  TempDir dir;
+  const Result run = vkray("render --validate " + kScenes + "/teapot.json --spp 4 --tile-timeout 1 -o out.png", dir.path());
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_NE(run.err.find("VK_TIMEOUT"), std::string::npos) << run.err;
+  EXPECT_FALSE(has_image_files(dir.path()));
+}
+
+TEST(CliTest, SigintDuringARenderExitsCleanlyAndWritesNothing) {
+  TempDir dir;
+  ChildProcess child({VKRAY_EXECUTABLE, "render", kScenes + "/teapot.json", "--width", "2048", "--height", "2048", "--spp",
+                      "16", "-o", "out.png"},
+                     dir.path().string());
+  ASSERT_TRUE(child.wait_for_line("tracing", std::chrono::seconds(60))) << child.all_output();
+  child.signal(SIGINT);
+  const auto code = child.wait_exit(std::chrono::seconds(60));
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 130) << child.all_output();
+  EXPECT_NE(child.all_output().find("interrupted; no image written"), std::string::npos) << child.all_output();
+  EXPECT_FALSE(has_image_files(dir.path()));
 }
 
 TEST(CliTest, HelpDocumentsExitCodes) {

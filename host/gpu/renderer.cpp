@@ -200,7 +200,11 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
     cb.end();
     const vk::CommandBuffer raw = *cb;
     ctx.queue().submit(vk::SubmitInfo({}, {}, raw), *fence);
-    ctx.wait(fence, options.tile_timeout, "a render tile");
+    try {
+      ctx.wait(fence, options.tile_timeout, "a render tile");
+    } catch (const DeviceError& e) {
+      throw TimeoutError(e.what());
+    }
     device.resetFences(*fence);
     if (options.progress) options.progress(tile_index + 1, tile_count);
     if (options.cancel && tile_index + 1 < tile_count && options.cancel()) throw Cancelled{};

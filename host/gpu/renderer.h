@@ -10,6 +10,7 @@
 
 #include <vulkan/vulkan_raii.hpp>
 
+#include "errors.h"
 #include "gpu/context.h"
 #include "image.h"
 #include "scene.h"
@@ -83,6 +84,11 @@ struct RenderOptions {
 
 // A render stopped by RenderOptions::cancel; no work is left in flight.
 struct Cancelled {};
+
+// A tile did not finish within RenderOptions::tile_timeout; work may still be in flight.
+struct TimeoutError : DeviceError {
+  using DeviceError::DeviceError;
+};
 
 // Renders a scene already on the device at `image` resolution and sample count. Throws
 // DeviceError (and vk::SystemError from failing Vulkan calls).
