@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -22,6 +23,10 @@ struct Mesh {
 // the element ("face 12", "vertex 7") that is wrong: a missing or unreadable file, an unknown
 // format, an index out of range, a coordinate that is NaN or infinite.
 Mesh load_mesh(const std::filesystem::path& file);
+
+// The same from the file's bytes already in memory; `name` gives the format (by extension) and is
+// the file named in messages.
+Mesh parse_mesh(std::string_view bytes, const std::filesystem::path& name);
 
 // Area-weighted vertex normals per triangle corner, for meshes whose files have none. Vertices
 // are welded by position first, so a mesh saved with duplicated vertices (the Utah teapot's

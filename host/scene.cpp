@@ -63,7 +63,8 @@ class SceneParser {
   }
   // Warns about keys the contract does not define (most often a typo).
   void check_keys(const Value& obj, std::initializer_list<const char*> known) {
-    for (const auto& [key, unused] : obj.j.items()) {
+    for (const auto& item : obj.j.items()) {
+      const std::string& key = item.key();
       if (std::none_of(known.begin(), known.end(), [&](const char* k) { return key == k; }))
         warn(obj[key], "unknown key (ignored)");
     }

@@ -1,0 +1,15 @@
+// libFuzzer target: PLY meshes, ASCII and binary (vkray's header check, then assimp).
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "errors.h"
+#include "mesh.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  try {
+    vkray::parse_mesh(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.ply");
+  } catch (const vkray::InputError&) {
+  }
+  return 0;
+}
