@@ -104,7 +104,7 @@ GpuScene::GpuScene(const Context& ctx, const Scene& scene, const Bvh* prebuilt) 
   const Bvh& bvh = prebuilt ? *prebuilt : built;
   bvh_seconds_ = bvh.build_seconds;
   primitive_count_ = uint32_t(bvh.order.size());
-  const PackedScene packed = pack_scene(scene, bvh, scene.image);
+  const PackedScene packed = pack_scene(scene, bvh);
   check_memory(ctx, packed);
   buffers_ = std::make_unique<Buffers>(Buffers{make_texel_buffer(ctx, packed.primitives, "primitive"),
                                                make_texel_buffer(ctx, packed.normals, "normal"),

@@ -36,9 +36,8 @@ FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const Ima
   return f;
 }
 
-PackedScene pack_scene(const Scene& scene, const Bvh& bvh, const ImageSettings& image) {
+PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
   PackedScene packed;
-  packed.frame = pack_frame(scene, static_cast<uint32_t>(bvh.order.size()), image);
   const size_t triangle_count = scene.triangles.size();
   const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
   packed.primitives.reserve(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);

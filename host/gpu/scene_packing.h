@@ -24,8 +24,8 @@ static_assert(offsetof(FrameUniforms, epsilon) == 140);
 static_assert(sizeof(FrameUniforms) == 144);
 static_assert(sizeof(TileConstants) == 16);
 
+// The scene's buffers; the per-frame uniforms come from pack_frame().
 struct PackedScene {
-  FrameUniforms frame{};
   std::vector<glm::vec4> primitives;  // VKRAY_TEXELS_PER_PRIMITIVE texels each, in BVH leaf order
   std::vector<glm::vec4> normals;     // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when nothing is smooth
   std::vector<glm::vec4> nodes;       // VKRAY_TEXELS_PER_NODE texels each
@@ -33,10 +33,10 @@ struct PackedScene {
   std::vector<glm::vec4> lights;      // VKRAY_TEXELS_PER_LIGHT texels each
 };
 
-// `image` is the resolution actually rendered (the scene's, or the command line's).
-PackedScene pack_scene(const Scene& scene, const Bvh& bvh, const ImageSettings& image);
+PackedScene pack_scene(const Scene& scene, const Bvh& bvh);
 
-// The per-frame uniforms alone (camera, image, counts).
+// The per-frame uniforms (camera, image, counts). `image` is the resolution actually rendered (the
+// scene's, or the command line's).
 FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const ImageSettings& image);
 
 }  // namespace vkray::gpu
