@@ -117,18 +117,37 @@ Mesh parse_obj(const std::string& text, const std::filesystem::path& file) {
   return mesh;
 }
 
-// A PLY header declares its element counts; before assimp reads the file (and allocates for every
-// element it declares), check that the file is large enough to hold them, so a hostile header that
-// claims a billion faces is refused at once instead of after seconds of work.
+// vkray reads the PLY header itself before assimp sees the file, and refuses anything that is not
+// a well-formed header: assimp 5.2.5 (Debian 12's) has known memory-safety bugs on malformed PLY
+// (upstream #4306, #5310, #5717, #5739, #6620), and fuzz_ply corrupted the heap through a garbled
+// header. It also checks that the file is large enough for the elements the header declares, so a
+// header that claims a billion faces is refused at once instead of after seconds of allocation.
 void check_ply_header(std::string_view bytes, const std::filesystem::path& file) {
   std::istringstream in{std::string(bytes.substr(0, std::min<size_t>(bytes.size(), 1 << 16)))};
+  size_t line_number = 0;
   std::string line;
-  if (!std::getline(in, line) || trim(line) != "ply") fail(file, "not a PLY file (no \"ply\" on the first line)");
-  bool ascii = false;
+  auto next = [&]() -> bool {
+    if (!std::getline(in, line)) return false;
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  auto bad = [&](const std::string& what) { fail(file.string() + ":" + std::to_string(line_number), what); };
+  if (!next() || line != "ply") fail(file, "not a PLY file (no \"ply\" on the first line)");
+  if (!next()) bad("the PLY header ends early");
+  std::istringstream format_line(line);
+  std::string keyword, format, version;
+  format_line >> keyword >> format >> version;
+  if (keyword != "format" || (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") ||
+      version != "1.0")
+    bad("expected \"format ascii|binary_little_endian|binary_big_endian 1.0\", got \"" + line + "\"");
+  const bool ascii = format == "ascii";
+
   struct Element {
     std::string name;
     uint64_t count = 0;
     uint64_t min_bytes = 0;  // per element: binary sizes, or one character and a separator per property (ASCII)
+    std::vector<std::string> properties;
   };
   std::vector<Element> elements;
   auto type_size = [&](const std::string& type) -> uint64_t {
@@ -137,36 +156,54 @@ void check_ply_header(std::string_view bytes, const std::filesystem::path& file)
         {"int", 4}, {"uint", 4}, {"int32", 4}, {"uint32", 4}, {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
     for (const auto& [name, size] : sizes)
       if (type == name) return size;
-    fail(file, "unknown PLY property type \"" + type + "\"");
+    bad("unknown PLY property type \"" + type + "\"");
+    return 0;  // not reached: bad() throws
   };
-  size_t line_number = 1;
   for (;;) {
-    if (!std::getline(in, line)) fail(file, "the PLY header has no end_header line (in its first 64 KiB)");
-    ++line_number;
+    if (!next()) fail(file, "the PLY header has no end_header line (in its first 64 KiB)");
     std::istringstream words(line);
-    std::string keyword;
-    words >> keyword;
-    if (keyword == "end_header") break;
-    if (keyword == "format") {
-      std::string format;
-      words >> format;
-      ascii = format == "ascii";
-    } else if (keyword == "element") {
+    std::string word, extra;
+    words >> word;
+    if (word == "end_header") {
+      if (words >> extra) bad("unexpected text after end_header");
+      break;
+    }
+    if (word == "comment" || word == "obj_info") continue;
+    if (word == "element") {
       Element e;
-      words >> e.name >> e.count;
-      if (!words) fail(file.string() + ":" + std::to_string(line_number), "bad element line \"" + trim(line) + "\"");
+      std::string count;
+      words >> e.name >> count;
+      if (e.name.empty() || count.empty() || count.find_first_not_of("0123456789") != std::string::npos || count.size() > 18 ||
+          (words >> extra))
+        bad("expected \"element NAME COUNT\", got \"" + line + "\"");
+      e.count = std::stoull(count);
       elements.push_back(e);
-    } else if (keyword == "property" && !elements.empty()) {
-      std::string type, count_type;
+    } else if (word == "property") {
+      if (elements.empty()) bad("a property before any element");
+      std::string type, name;
       words >> type;
       if (type == "list") {
-        words >> count_type;
-        elements.back().min_bytes += ascii ? 2 : type_size(count_type);  // the list's length; it may be empty
+        std::string count_type, item_type;
+        words >> count_type >> item_type >> name;
+        const uint64_t count_size = type_size(count_type);
+        type_size(item_type);
+        elements.back().min_bytes += ascii ? 2 : count_size;  // the list's length; it may be empty
       } else {
+        words >> name;
         elements.back().min_bytes += ascii ? 2 : type_size(type);
       }
+      if (name.empty() || (words >> extra)) bad("expected \"property TYPE NAME\", got \"" + line + "\"");
+      elements.back().properties.push_back(name);
+    } else {
+      bad("unknown PLY header line \"" + line + "\"");
     }
   }
+  const auto vertex = std::find_if(elements.begin(), elements.end(), [](const Element& e) { return e.name == "vertex"; });
+  if (vertex == elements.end()) fail(file, "the PLY header declares no vertex element");
+  for (const char* axis : {"x", "y", "z"})
+    if (std::find(vertex->properties.begin(), vertex->properties.end(), axis) == vertex->properties.end())
+      fail(file, std::string("the vertex element has no \"") + axis + "\" property");
+
   const auto header_end = static_cast<uint64_t>(in.tellg());
   const uint64_t size = bytes.size();
   const uint64_t available = size > header_end ? size - header_end : 0;
