@@ -94,6 +94,21 @@ TEST_F(MeshFileTest, Errors) {
   expect_mesh_error(write("garbage.ply", std::string("ply\n\x01\x02\xff garbage", 15)), "garbage.ply");
 }
 
+TEST(MeshTest, InputsTheFuzzerFoundDoNotCrash) {
+  // Each of these once crashed or corrupted memory inside assimp (tests/bad-inputs/meshes/fuzz-*).
+  // Some are refused, some load as the (wrong) mesh assimp makes of them; none may crash.
+  size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(VKRAY_TEST_DIR) / "bad-inputs/meshes")) {
+    if (entry.path().filename().string().rfind("fuzz-", 0) != 0) continue;
+    ++files;
+    try {
+      load_mesh(entry.path());
+    } catch (const MeshError&) {
+    }
+  }
+  EXPECT_GE(files, 2u);
+}
+
 TEST(SmoothNormalsTest, AreaWeightedAndWelded) {
   // Two triangles of a tent, the second with its shared vertices duplicated (not welded), as in the teapot.
   const glm::vec3 a(0, 0, 0), b(0, 0, 1), c(1, 1, 0.5f), d(-1, 1, 0.5f);
