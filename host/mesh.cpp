@@ -25,6 +25,15 @@ namespace {
   throw MeshError(file.string() + ": " + what);
 }
 
+// Text from a file, fit to quote in a one-line message: control and non-ASCII bytes become '?',
+// and long text is shortened.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (const char c : text.substr(0, 60)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
+  if (text.size() > 60) out += "...";
+  return out;
+}
+
 std::string trim(std::string s) {
   while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
   return s;
@@ -59,7 +68,7 @@ void check_obj_vertices(const std::filesystem::path& file, std::string_view text
       if (token.empty() || ec != std::errc() || ptr != token.data() + token.size() || !std::isfinite(value) ||
           std::abs(value) > FLT_MAX)
         fail(file.string() + ":" + std::to_string(line_number),
-             "vertex coordinate \"" + std::string(token) + "\" is not a finite 32-bit number");
+             "vertex coordinate \"" + printable(token) + "\" is not a finite 32-bit number");
       line.remove_prefix(length);
     }
   }
@@ -140,7 +149,7 @@ void check_ply_header(std::string_view bytes, const std::filesystem::path& file)
   format_line >> keyword >> format >> version;
   if (keyword != "format" || (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") ||
       version != "1.0")
-    bad("expected \"format ascii|binary_little_endian|binary_big_endian 1.0\", got \"" + line + "\"");
+    bad("expected \"format ascii|binary_little_endian|binary_big_endian 1.0\", got \"" + printable(line) + "\"");
   const bool ascii = format == "ascii";
 
   struct Element {
@@ -156,7 +165,7 @@ void check_ply_header(std::string_view bytes, const std::filesystem::path& file)
         {"int", 4}, {"uint", 4}, {"int32", 4}, {"uint32", 4}, {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
     for (const auto& [name, size] : sizes)
       if (type == name) return size;
-    bad("unknown PLY property type \"" + type + "\"");
+    bad("unknown PLY property type \"" + printable(type) + "\"");
     return 0;  // not reached: bad() throws
   };
   for (;;) {
@@ -175,7 +184,7 @@ void check_ply_header(std::string_view bytes, const std::filesystem::path& file)
       words >> e.name >> count;
       if (e.name.empty() || count.empty() || count.find_first_not_of("0123456789") != std::string::npos || count.size() > 18 ||
           (words >> extra))
-        bad("expected \"element NAME COUNT\", got \"" + line + "\"");
+        bad("expected \"element NAME COUNT\", got \"" + printable(line) + "\"");
       e.count = std::stoull(count);
       elements.push_back(e);
     } else if (word == "property") {
@@ -190,12 +199,13 @@ void check_ply_header(std::string_view bytes, const std::filesystem::path& file)
         elements.back().min_bytes += ascii ? 2 : count_size;  // the list's length; it may be empty
       } else {
         words >> name;
-        elements.back().min_bytes += ascii ? 2 : type_size(type);
+        const uint64_t size = type_size(type);  // checked for ASCII files too
+        elements.back().min_bytes += ascii ? 2 : size;
       }
-      if (name.empty() || (words >> extra)) bad("expected \"property TYPE NAME\", got \"" + line + "\"");
+      if (name.empty() || (words >> extra)) bad("expected \"property TYPE NAME\", got \"" + printable(line) + "\"");
       elements.back().properties.push_back(name);
     } else {
-      bad("unknown PLY header line \"" + line + "\"");
+      bad("unknown PLY header line \"" + printable(line) + "\"");
     }
   }
   const auto vertex = std::find_if(elements.begin(), elements.end(), [](const Element& e) { return e.name == "vertex"; });
