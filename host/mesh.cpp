@@ -135,13 +135,22 @@ void check_ply_header(std::string_view bytes, const std::filesystem::path& file)
   std::istringstream in{std::string(bytes.substr(0, std::min<size_t>(bytes.size(), 1 << 16)))};
   size_t line_number = 0;
   std::string line;
+  auto bad = [&](const std::string& what) { fail(file.string() + ":" + std::to_string(line_number), what); };
+  // Every header line, comments included, must be printable ASCII: assimp mis-parses binary bytes
+  // in header lines (fuzz_ply found heap corruption through an obj_info line).
   auto next = [&]() -> bool {
     if (!std::getline(in, line)) return false;
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (std::any_of(line.begin(), line.end(), [](char c) { return (c < 0x20 && c != '\t') || c >= 0x7f; }))
+      bad("the PLY header has a non-printable byte: \"" + printable(line) + "\"");
     return true;
   };
-  auto bad = [&](const std::string& what) { fail(file.string() + ":" + std::to_string(line_number), what); };
+  // Element and property names: letters, digits, '_' and '-'.
+  auto check_name = [&](const std::string& name) {
+    if (name.empty() || !std::all_of(name.begin(), name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; }))
+      bad("bad PLY name \"" + printable(name) + "\"");
+  };
   if (!next() || line != "ply") fail(file, "not a PLY file (no \"ply\" on the first line)");
   if (!next()) bad("the PLY header ends early");
   std::istringstream format_line(line);
@@ -185,6 +194,7 @@ void check_ply_header(std::string_view bytes, const std::filesystem::path& file)
       if (e.name.empty() || count.empty() || count.find_first_not_of("0123456789") != std::string::npos || count.size() > 18 ||
           (words >> extra))
         bad("expected \"element NAME COUNT\", got \"" + printable(line) + "\"");
+      check_name(e.name);
       e.count = std::stoull(count);
       elements.push_back(e);
     } else if (word == "property") {
@@ -203,6 +213,7 @@ void check_ply_header(std::string_view bytes, const std::filesystem::path& file)
         elements.back().min_bytes += ascii ? 2 : size;
       }
       if (name.empty() || (words >> extra)) bad("expected \"property TYPE NAME\", got \"" + printable(line) + "\"");
+      check_name(name);
       elements.back().properties.push_back(name);
     } else {
       bad("unknown PLY header line \"" + printable(line) + "\"");
