@@ -76,13 +76,16 @@ LoadedScene load(const RenderFlags& flags) {
   return loaded;
 }
 
-// Fails before any rendering when the output cannot be written.
+}  // namespace
+
 void check_output_path(const std::filesystem::path& output) {
   if (!is_supported_image_path(output)) throw OutputError(output.string() + ": unknown image type (expected .png or .pfm)");
   const auto dir = output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) throw OutputError(output.string() + ": folder " + dir.string() + " does not exist");
 }
+
+namespace {
 
 struct GpuRun {
   Image image;

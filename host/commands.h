@@ -42,6 +42,10 @@ struct WatchCommand {
   std::optional<uint32_t> exit_after;   // test hook: stop after this many reloads
 };
 
+// Throws OutputError, before any rendering, when `output` cannot be written (unknown extension,
+// missing folder).
+void check_output_path(const std::filesystem::path& output);
+
 // The scene's image settings with the command line's overrides applied.
 ImageSettings image_settings(const Scene& scene, const RenderFlags& flags);
 

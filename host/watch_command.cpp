@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
-#include <optional>
 
 #include "commands.h"
 #include "errors.h"
@@ -41,7 +40,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
       std::filesystem::absolute(cmd.flags.shader_dir.empty() ? default_shader_dir() : cmd.flags.shader_dir).lexically_normal();
   const std::filesystem::path output =
       cmd.output.empty() ? std::filesystem::path(scene_file.stem().string() + ".png") : cmd.output;
-  if (!is_supported_image_path(output)) throw OutputError(output.string() + ": unknown image type (expected .png or .pfm)");
+  check_output_path(output);
 
   gpu::ContextOptions options;
   options.validation = cmd.flags.validate;
@@ -54,8 +53,10 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
   // compiler (Mesa also keeps its own on-disk shader cache across sessions).
   const vk::raii::PipelineCache pipeline_cache(ctx.device(), vk::PipelineCacheCreateInfo{});
 
-  // The last good state. A failed reload leaves it untouched.
-  std::optional<Scene> scene;
+  // The last good state. A failed reload leaves it untouched. The scene lives on the heap because
+  // its GpuScene (BVH and buffers, rebuilt only when the scene changes) points at it.
+  std::unique_ptr<Scene> scene;
+  std::unique_ptr<gpu::GpuScene> gpu_scene;
   std::unique_ptr<gpu::TracePipeline> pipeline;
   std::vector<uint32_t> spirv;
   std::vector<std::filesystem::path> shader_sources{shader_dir / "trace.comp"};
@@ -64,8 +65,11 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
   auto reload_scene = [&]() -> std::string {
     const auto start = Clock::now();
     try {
-      Scene loaded = load_scene(scene_file);
-      for (const auto& warning : loaded.warnings) std::cerr << "vkray: warning: " << warning << "\n";
+      auto loaded = std::make_unique<Scene>(load_scene(scene_file));
+      for (const auto& warning : loaded->warnings) std::cerr << "vkray: warning: " << warning << "\n";
+      auto uploaded = std::make_unique<gpu::GpuScene>(ctx, *loaded);
+      ctx.queue().waitIdle();  // renders wait for their tiles; keep it so if that ever changes
+      gpu_scene = std::move(uploaded);  // the old GpuScene goes first, while its scene still exists
       scene = std::move(loaded);
       scene_broken = false;
       return "scene " + format_ms(ms_since(start));
@@ -98,7 +102,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
   // Renders with the last good state and replaces the image; returns what to report.
   // `errors_reported` says whether this reload's report already named what is broken.
   auto render = [&](bool errors_reported) -> std::string {
-    if (scene_broken || shader_broken || !scene || !pipeline) {
+    if (scene_broken || shader_broken || !gpu_scene || !pipeline) {
       if (errors_reported) return "not rendered; " + output.string() + " is unchanged";
       std::string broken = shader_broken || !pipeline ? "shader" : "scene";
       if ((shader_broken || !pipeline) && (scene_broken || !scene)) broken = "shader and the scene";
@@ -108,7 +112,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
     gpu::RenderOptions render_options;
     render_options.cancel = [&] { return stop.pending(); };
     const auto start = Clock::now();
-    const Image result = gpu::render(ctx, *pipeline, *scene, image, render_options);
+    const Image result = gpu::render(ctx, *pipeline, *gpu_scene, image, render_options);
     const double render_ms = ms_since(start);
     ctx.check_validation("render");
     write_image(result, output);

@@ -97,6 +97,14 @@ TEST(CliTest, UnknownOutputTypeExitsOneBeforeRendering) {
   EXPECT_EQ(run.err.find("device "), std::string::npos) << "should fail before touching the device";
 }
 
+TEST(CliTest, WatchRefusesAnOutputItCannotWriteBeforeStarting) {
+  TempDir dir;
+  const Result run = vkray("watch -o no-such-folder/live.png", dir.path());
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("no-such-folder does not exist"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("device "), std::string::npos) << "should fail before touching the device";
+}
+
 TEST(CliTest, UnknownDeviceExitsThreeAndListsDevices) {
   TempDir dir;
   const Result run = vkray("render --device no-such-gpu", dir.path());
