@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bvh.h"
 #include "cpu/reference.h"
 #include "errors.h"
 #include "gpu/context.h"
@@ -97,8 +98,9 @@ struct GpuRun {
 // Creates the device, compiles the shader, renders, and tears the device down again. The device
 // lives only inside: its teardown can itself raise validation messages (leaked objects, say), and
 // those must fail the command before anything is written.
+// `bvh`: one already built for the scene (parity shares it with the CPU reference); null builds one.
 GpuRun render_gpu(const LoadedScene& loaded, const RenderFlags& flags, const std::function<void(const std::string&)>& log,
-                  bool show_progress, const StopSignals* stop = nullptr) {
+                  bool show_progress, const StopSignals* stop = nullptr, const Bvh* bvh = nullptr) {
   auto validation_log = std::make_shared<gpu::ValidationLog>();
   GpuRun run;
   {
@@ -122,7 +124,10 @@ GpuRun render_gpu(const LoadedScene& loaded, const RenderFlags& flags, const std
     render_options.tile_timeout = std::chrono::milliseconds(flags.tile_timeout_ms);
     if (stop) render_options.cancel = [stop] { return stop->pending(); };
     try {
-      run.image = gpu::render(ctx, pipeline, loaded.scene, loaded.image, render_options, &run.stats);
+      const gpu::GpuScene gpu_scene(ctx, loaded.scene, bvh);
+      run.image = gpu::render(ctx, pipeline, gpu_scene, loaded.image, render_options, &run.stats);
+      run.stats.bvh_seconds = gpu_scene.bvh_seconds();
+      run.stats.upload_seconds += gpu_scene.upload_seconds();
     } catch (const gpu::TimeoutError& e) {
       // Work may still be running on the device: destroying what it uses could hang or worse, so
       // report and leave at once. Nothing has been written.
@@ -137,10 +142,12 @@ GpuRun render_gpu(const LoadedScene& loaded, const RenderFlags& flags, const std
   return run;
 }
 
-cpu::ReferenceResult render_cpu(const LoadedScene& loaded, const RenderFlags& flags, bool show_progress) {
+cpu::ReferenceResult render_cpu(const LoadedScene& loaded, const RenderFlags& flags, bool show_progress,
+                                const Bvh* bvh = nullptr) {
   Progress progress(show_progress, "CPU reference");
   cpu::ReferenceOptions options;
   options.threads = flags.threads;
+  options.bvh = bvh;
   options.progress = [&](uint32_t done, uint32_t total) { progress.update(done, total, "rows"); };
   return cpu::render_reference(loaded.scene, loaded.image, options);
 }
@@ -225,8 +232,9 @@ int run_parity(const ParityCommand& cmd) {
   if (!cmd.diff.empty()) check_output_path(cmd.diff);
   log(describe(loaded));
 
-  const GpuRun gpu_run = render_gpu(loaded, cmd.flags, log, !cmd.json);
-  const cpu::ReferenceResult reference = render_cpu(loaded, cmd.flags, !cmd.json);
+  const Bvh bvh = build_bvh(primitive_boxes(loaded.scene));  // one hierarchy, traversed by both
+  const GpuRun gpu_run = render_gpu(loaded, cmd.flags, log, !cmd.json, nullptr, &bvh);
+  const cpu::ReferenceResult reference = render_cpu(loaded, cmd.flags, !cmd.json, &bvh);
   const ParityTolerance tolerance;
   const ParityMetrics m = compare_images(gpu_run.image, reference.image, reference.signatures, tolerance);
 

@@ -32,9 +32,9 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
     // Written as !(> 0) so a light exactly at x (0/0 = NaN) contributes nothing.
     if (!(cos_theta > 0.0)) continue;
 
-    vec3 shadow_dir = light_pos - shadow_origin;
-    float shadow_dist = length(shadow_dir);
     if ((frame.options & VKRAY_OPTION_NO_SHADOWS) == 0u) {
+      vec3 shadow_dir = light_pos - shadow_origin;
+      float shadow_dist = length(shadow_dir);
       rays += 1u;
       // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
       if (trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon))

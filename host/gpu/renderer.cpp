@@ -32,15 +32,16 @@ struct TexelBuffer {
   vk::raii::BufferView view{nullptr};
 };
 
-TexelBuffer make_texel_buffer(const Context& ctx, std::vector<glm::vec4> texels, const char* what) {
-  if (texels.empty()) texels.emplace_back(0.0f);
+TexelBuffer make_texel_buffer(const Context& ctx, const std::vector<glm::vec4>& texels, const char* what) {
   if (texels.size() > ctx.limits().maxTexelBufferElements)
     throw DeviceError(std::string("scene too large for ") + ctx.device_name() + ": " + std::to_string(texels.size()) +
                       " " + what + " texels, maxTexelBufferElements is " +
                       std::to_string(ctx.limits().maxTexelBufferElements));
+  static const glm::vec4 placeholder(0.0f);
+  const glm::vec4* data = texels.empty() ? &placeholder : texels.data();
   TexelBuffer t;
-  const vk::DeviceSize bytes = texels.size() * sizeof(glm::vec4);
-  t.buffer = upload_buffer(ctx, texels.data(), bytes, vk::BufferUsageFlagBits::eUniformTexelBuffer);
+  const vk::DeviceSize bytes = std::max<size_t>(texels.size(), 1) * sizeof(glm::vec4);
+  t.buffer = upload_buffer(ctx, data, bytes, vk::BufferUsageFlagBits::eUniformTexelBuffer);
   t.view = vk::raii::BufferView(ctx.device(), vk::BufferViewCreateInfo({}, *t.buffer.buffer,
                                                                        vk::Format::eR32G32B32A32Sfloat, 0, bytes));
   return t;

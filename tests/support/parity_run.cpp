@@ -1,5 +1,6 @@
 #include "support/parity_run.h"
 
+#include "bvh.h"
 #include "gpu/shader_compiler.h"
 
 namespace vkray::test {
@@ -15,8 +16,11 @@ ParityRun ParityTest::run(const Scene& scene, const ImageSettings& image) {
     pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), gpu::compile_compute_shader(dir / "trace.comp", {dir}).spirv);
   }
   ParityRun result;
-  result.gpu = gpu::render(ctx(), *pipeline_, scene, image);
-  result.cpu = cpu::render_reference(scene, image);
+  const Bvh bvh = build_bvh(primitive_boxes(scene));  // one hierarchy, traversed by both renderers
+  result.gpu = gpu::render(ctx(), *pipeline_, gpu::GpuScene(ctx(), scene, &bvh), image);
+  cpu::ReferenceOptions options;
+  options.bvh = &bvh;
+  result.cpu = cpu::render_reference(scene, image, options);
   result.metrics = compare_images(result.gpu, result.cpu.image, result.cpu.signatures);
   return result;
 }
