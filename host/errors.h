@@ -3,6 +3,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace vkray {
 
@@ -35,5 +36,14 @@ struct OutputError : InputError {
 struct DeviceError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// Text from a user's file, fit to quote in a one-line message: control and non-ASCII bytes become
+// '?', and long text is shortened.
+inline std::string printable(std::string_view text) {
+  std::string out;
+  for (const char c : text.substr(0, 60)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
+  if (text.size() > 60) out += "...";
+  return out;
+}
 
 }  // namespace vkray

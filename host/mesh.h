@@ -1,4 +1,4 @@
-// Triangle meshes from files: Wavefront OBJ (tinyobjloader) and PLY, ASCII or binary (assimp).
+// Triangle meshes from files: Wavefront OBJ (tinyobjloader) and PLY, ASCII or binary (ply.h).
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// libFuzzer target: PLY meshes, ASCII and binary (vkray's header check, then assimp).
+// libFuzzer target: PLY meshes, ASCII and binary (host/ply.cpp).
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
