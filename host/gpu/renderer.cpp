@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "checked.h"
 #include "errors.h"
 #include "gpu/buffer.h"
 #include "bvh.h"
@@ -40,7 +41,7 @@ TexelBuffer make_texel_buffer(const Context& ctx, const std::vector<glm::vec4>& 
   static const glm::vec4 placeholder(0.0f);
   const glm::vec4* data = texels.empty() ? &placeholder : texels.data();
   TexelBuffer t;
-  const vk::DeviceSize bytes = std::max<size_t>(texels.size(), 1) * sizeof(glm::vec4);
+  const vk::DeviceSize bytes = checked_mul(std::max<size_t>(texels.size(), 1), sizeof(glm::vec4), what);
   t.buffer = upload_buffer(ctx, data, bytes, vk::BufferUsageFlagBits::eUniformTexelBuffer);
   t.view = vk::raii::BufferView(ctx.device(), vk::BufferViewCreateInfo({}, *t.buffer.buffer,
                                                                        vk::Format::eR32G32B32A32Sfloat, 0, bytes));
@@ -49,8 +50,10 @@ TexelBuffer make_texel_buffer(const Context& ctx, const std::vector<glm::vec4>& 
 
 // Refuses, before allocating anything, a scene whose buffers cannot fit the device's memory.
 void check_memory(const Context& ctx, const PackedScene& packed) {
-  const uint64_t bytes = (packed.primitives.size() + packed.normals.size() + packed.nodes.size() + packed.materials.size() +
-                          packed.lights.size()) * sizeof(glm::vec4);
+  uint64_t texels = 0;
+  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.nodes, &packed.materials, &packed.lights})
+    texels = checked_add(texels, buffer->size(), "scene buffers");
+  const uint64_t bytes = checked_mul(texels, sizeof(glm::vec4), "scene buffers");
   const auto memory = ctx.physical_device().getMemoryProperties();
   uint64_t largest_heap = 0;
   for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
@@ -139,7 +142,8 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
   auto start = Clock::now();
   FrameUniforms frame = pack_frame(scene, gpu_scene.primitive_count(), image);
   if (!options.shadows) frame.options |= VKRAY_OPTION_NO_SHADOWS;
-  const vk::DeviceSize pixel_bytes = vk::DeviceSize(image.width) * image.height * sizeof(glm::vec4);
+  const vk::DeviceSize pixel_bytes =
+      checked_mul(checked_mul(image.width, image.height, "output image"), sizeof(glm::vec4), "output image");
   if (pixel_bytes > ctx.limits().maxStorageBufferRange)
     throw DeviceError("image too large for " + ctx.device_name() + ": " + std::to_string(pixel_bytes) +
                       " bytes of output, maxStorageBufferRange is " + std::to_string(ctx.limits().maxStorageBufferRange));
