@@ -1,5 +1,5 @@
 // Size arithmetic that cannot wrap: every count-times-size that reaches an allocation goes through
-// these. The scene's own caps (image side 16384, 65536 samples, 2^26 primitives) keep real inputs
+// these. The scene's own caps (image side 16384, 65536 samples, 2^27 primitives) keep real inputs
 // far from 2^64; these make overflow impossible by construction rather than by those caps alone.
 #pragma once
 
