@@ -192,6 +192,16 @@ TEST(CliTest, TileTimeoutExitsThreeAndWritesNothing) {
   EXPECT_FALSE(has_image_files(dir.path()));
 }
 
+TEST(CliTest, ImageTooLargeForTheDeviceExitsThreeNamingTheLimit) {
+  // 16384^2 pixels of 16 bytes are 2^32 bytes: past any device's maxStorageBufferRange (a uint32).
+  TempDir dir;
+  const Result run = vkray("render --validate --width 16384 --height 16384 -o out.png", dir.path());
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_NE(run.err.find("image too large"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("maxStorageBufferRange"), std::string::npos) << run.err;
+  EXPECT_FALSE(has_image_files(dir.path()));
+}
+
 TEST(CliTest, SigintDuringARenderExitsCleanlyAndWritesNothing) {
   TempDir dir;
   ChildProcess child({VKRAY_EXECUTABLE, "render", kScenes + "/teapot.json", "--width", "2048", "--height", "2048", "--spp",
