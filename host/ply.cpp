@@ -311,7 +311,8 @@ class BodyReader {
 struct Layout {
   const Element* vertex = nullptr;
   size_t position[3] = {};
-  std::optional<size_t> normal[3];
+  bool has_normals = false;  // nx, ny and nz are all scalar properties of the vertex
+  size_t normal[3] = {};
   const Element* face = nullptr;
   size_t indices = 0;
 };
@@ -330,10 +331,13 @@ Layout find_layout(const Header& header, const std::filesystem::path& file) {
     if (!p) fail(file.string(), std::string("the vertex element has no \"") + axes[k] + "\" property");
     if (layout.vertex->properties[*p].is_list) fail(file.string(), std::string("the vertex property \"") + axes[k] + "\" is a list");
     layout.position[k] = *p;
-    layout.normal[k] = layout.vertex->find(normal_axes[k]);
-    if (layout.normal[k] && layout.vertex->properties[*layout.normal[k]].is_list) layout.normal[k].reset();
   }
-  if (!(layout.normal[0] && layout.normal[1] && layout.normal[2])) layout.normal[0].reset();
+  layout.has_normals = true;
+  for (int k = 0; k < 3; ++k) {
+    const std::optional<size_t> p = layout.vertex->find(normal_axes[k]);
+    layout.has_normals = layout.has_normals && p && !layout.vertex->properties[*p].is_list;
+    if (p) layout.normal[k] = *p;
+  }
   if (!layout.face) fail(file.string(), "the PLY header declares no face element");
   std::optional<size_t> indices = layout.face->find("vertex_indices");
   if (!indices) indices = layout.face->find("vertex_index");
@@ -351,7 +355,7 @@ Mesh parse_ply(std::string_view bytes, const std::filesystem::path& file) {
   const Header header = read_header(bytes, file);
   const Layout layout = find_layout(header, file);
   const uint64_t vertex_count = layout.vertex->count;
-  const bool has_normals = layout.normal[0].has_value();
+  const bool has_normals = layout.has_normals;
 
   Mesh mesh;
   std::vector<glm::vec3> normals;
@@ -398,7 +402,7 @@ Mesh parse_ply(std::string_view bytes, const std::filesystem::path& file) {
         mesh.positions.emplace_back(coordinate(layout.position[0]), coordinate(layout.position[1]),
                                     coordinate(layout.position[2]));
         if (has_normals)
-          normals.emplace_back(coordinate(*layout.normal[0]), coordinate(*layout.normal[1]), coordinate(*layout.normal[2]));
+          normals.emplace_back(coordinate(layout.normal[0]), coordinate(layout.normal[1]), coordinate(layout.normal[2]));
       } else if (&element == layout.face) {
         mesh.polygons_split += polygon.size() > 3;
         // A fan from the first corner: exact for the convex polygons PLY files hold.
