@@ -1,6 +1,6 @@
 // A bounding volume hierarchy over the scene's primitives, built on the host with binned SAH and
-// laid out as the GPU reads it: binary nodes that hold both children's boxes, so one node fetch
-// tests two boxes. The GPU path and the CPU reference traverse it with their own code.
+// binary nodes that hold both children's boxes. The CPU reference traverses it as it is; the GPU
+// path reads a 4-wide, quantized copy of it (gpu/scene_packing.h).
 #pragma once
 
 #include <cstdint>
@@ -36,8 +36,9 @@ constexpr uint32_t kLeafBit = VKRAY_LEAF_BIT;
 constexpr uint32_t kLeafCountBits = VKRAY_LEAF_COUNT_BITS;
 constexpr uint32_t kMaxLeafSize = (1u << kLeafCountBits) - 1;
 constexpr uint32_t kMaxPrimitives = 1u << (31 - kLeafCountBits);
-// The traversal stacks hold this many entries; the builder keeps the depth below it.
-constexpr uint32_t kMaxDepth = VKRAY_TRAVERSAL_STACK;
+// The builder keeps the depth (levels of inner nodes) below this; the GPU's traversal stack is sized
+// for it (VKRAY_TRAVERSAL_STACK).
+constexpr uint32_t kMaxDepth = 64;
 
 inline bool is_leaf(uint32_t link) { return (link & kLeafBit) != 0; }
 inline uint32_t leaf_first(uint32_t link) { return (link & ~kLeafBit) >> kLeafCountBits; }

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 #include "checked.h"
 #include "errors.h"
@@ -26,32 +27,34 @@ constexpr double kTestsPerTile = double(1 << 26);
 
 constexpr vk::DescriptorType kTexel = vk::DescriptorType::eUniformTexelBuffer;
 
-// A texel buffer and its RGBA32F view; never empty (Vulkan has no zero-sized buffers), the shader
-// is told the real count.
+// A texel buffer and its view (RGBA32F for vec4 texels, RGBA32UI for uvec4); never empty (Vulkan
+// has no zero-sized buffers), the shader is told the real count.
 struct TexelBuffer {
   Buffer buffer;
   vk::raii::BufferView view{nullptr};
 };
 
-TexelBuffer make_texel_buffer(const Context& ctx, const std::vector<glm::vec4>& texels, const char* what) {
+template <typename Texel>
+TexelBuffer make_texel_buffer(const Context& ctx, const std::vector<Texel>& texels, const char* what) {
+  static_assert(sizeof(Texel) == 16);
+  constexpr vk::Format format = std::is_same_v<Texel, glm::uvec4> ? vk::Format::eR32G32B32A32Uint : vk::Format::eR32G32B32A32Sfloat;
   if (texels.size() > ctx.limits().maxTexelBufferElements)
     throw DeviceError(std::string("scene too large for ") + ctx.device_name() + ": " + std::to_string(texels.size()) +
                       " " + what + " texels, maxTexelBufferElements is " +
                       std::to_string(ctx.limits().maxTexelBufferElements));
-  static const glm::vec4 placeholder(0.0f);
-  const glm::vec4* data = texels.empty() ? &placeholder : texels.data();
+  static const Texel placeholder(0);
+  const Texel* data = texels.empty() ? &placeholder : texels.data();
   TexelBuffer t;
-  const vk::DeviceSize bytes = checked_mul(std::max<size_t>(texels.size(), 1), sizeof(glm::vec4), what);
+  const vk::DeviceSize bytes = checked_mul(std::max<size_t>(texels.size(), 1), sizeof(Texel), what);
   t.buffer = upload_buffer(ctx, data, bytes, vk::BufferUsageFlagBits::eUniformTexelBuffer);
-  t.view = vk::raii::BufferView(ctx.device(), vk::BufferViewCreateInfo({}, *t.buffer.buffer,
-                                                                       vk::Format::eR32G32B32A32Sfloat, 0, bytes));
+  t.view = vk::raii::BufferView(ctx.device(), vk::BufferViewCreateInfo({}, *t.buffer.buffer, format, 0, bytes));
   return t;
 }
 
 // Refuses, before allocating anything, a scene whose buffers cannot fit the device's memory.
 void check_memory(const Context& ctx, const PackedScene& packed) {
-  uint64_t texels = 0;
-  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.nodes, &packed.materials, &packed.lights})
+  uint64_t texels = packed.nodes.size();
+  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.materials, &packed.lights})
     texels = checked_add(texels, buffer->size(), "scene buffers");
   const uint64_t bytes = checked_mul(texels, sizeof(glm::vec4), "scene buffers");
   const auto memory = ctx.physical_device().getMemoryProperties();

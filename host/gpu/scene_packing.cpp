@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
+#include <stdexcept>
 
 #include "camera.h"
 
@@ -10,7 +12,114 @@ namespace {
 
 float bits(uint32_t v) { return std::bit_cast<float>(v); }
 
+// Corner q (0..255) of a quantized box along one axis, computed as the shader does. q * scale is
+// exact (8 bits times a power of two), so fused or not, the sum is rounded once.
+float dequantize(float origin, float scale, uint32_t q) { return origin + float(q) * scale; }
+
+// The smallest power of two `scale` with 254 * scale >= extent: a box side spans at most 254 steps,
+// leaving one step of room for rounding outward. Returned as a biased float exponent (1..254).
+uint32_t scale_exponent(double extent) {
+  int e = -126;
+  if (extent > 0) {
+    std::frexp(extent / 254.0, &e);  // extent / 254 = m * 2^e, m in [0.5, 1): 2^e >= extent / 254
+    e = std::clamp(e, -126, 127);
+  }
+  return uint32_t(e + 127);
+}
+
+class NodePacker {
+ public:
+  explicit NodePacker(const Bvh& bvh) : bvh_(bvh) {}
+
+  std::vector<glm::uvec4> pack() {
+    if (!bvh_.nodes.empty()) emit(0);
+    return std::move(texels_);
+  }
+
+ private:
+  struct Child {
+    uint32_t link;
+    Aabb box;
+  };
+
+  // Writes the wide node for binary node `index` (and, first, the wide nodes below it); returns its
+  // index. The root is 0, which is why 0 can mean "no child".
+  uint32_t emit(uint32_t index) {
+    const uint32_t wide = uint32_t(texels_.size() / VKRAY_TEXELS_PER_NODE);
+    texels_.resize(texels_.size() + VKRAY_TEXELS_PER_NODE);
+    Child children[VKRAY_NODE_WIDTH];
+    int count = 0;
+    const BvhNode& node = bvh_.nodes[index];
+    for (int c = 0; c < 2; ++c) {
+      const uint32_t link = node.link[c];
+      if (is_leaf(link)) {
+        if (leaf_count(link) > 0) children[count++] = {link, node.child[c]};  // count 0: the empty slot of a one-leaf root
+        continue;
+      }
+      const BvhNode& child = bvh_.nodes[link];
+      for (int g = 0; g < 2; ++g)
+        if (!is_leaf(child.link[g]) || leaf_count(child.link[g]) > 0) children[count++] = {child.link[g], child.child[g]};
+    }
+    for (int c = 0; c < count; ++c)
+      if (!is_leaf(children[c].link)) children[c].link = emit(children[c].link);
+    write(wide, children, count);
+    return wide;
+  }
+
+  void write(uint32_t wide, const Child* children, int count) {
+    Aabb all;
+    for (int c = 0; c < count; ++c) all.grow(children[c].box);
+    glm::uvec4* t = &texels_[size_t(wide) * VKRAY_TEXELS_PER_NODE];
+    uint32_t exponents = 0;
+    glm::vec3 scale;
+    for (int axis = 0; axis < 3; ++axis) {
+      const uint32_t e = scale_exponent(double(all.max[axis]) - double(all.min[axis]));
+      exponents |= e << (8 * axis);
+      scale[axis] = std::bit_cast<float>(e << 23);
+      t[0][axis] = std::bit_cast<uint32_t>(all.min[axis]);
+    }
+    t[0].w = exponents;
+    for (int c = 0; c < count; ++c) {
+      t[1][c] = children[c].link;
+      for (int axis = 0; axis < 3; ++axis) {
+        const float origin = all.min[axis], lo = children[c].box.min[axis], hi = children[c].box.max[axis];
+        // Round outward: the largest step at or below lo, the smallest at or above hi.
+        uint32_t q_lo = uint32_t(std::clamp(std::floor((double(lo) - origin) / scale[axis]), 0.0, 255.0));
+        while (q_lo > 0 && dequantize(origin, scale[axis], q_lo) > lo) --q_lo;
+        uint32_t q_hi = uint32_t(std::clamp(std::ceil((double(hi) - origin) / scale[axis]), 0.0, 255.0));
+        while (q_hi < 255 && dequantize(origin, scale[axis], q_hi) < hi) ++q_hi;
+        if (dequantize(origin, scale[axis], q_hi) < hi) throw std::logic_error("BVH node quantization lost a box side");
+        // Byte c of (lo.x, lo.y, lo.z, hi.x) in texel 2 and of (hi.y, hi.z) in texel 3.
+        set_byte(t[2][axis], c, q_lo);
+        if (axis == 0)
+          set_byte(t[2].w, c, q_hi);
+        else
+          set_byte(t[3][axis - 1], c, q_hi);
+      }
+    }
+  }
+
+  static void set_byte(uint32_t& word, int c, uint32_t value) { word |= value << (8 * c); }
+
+  const Bvh& bvh_;
+  std::vector<glm::uvec4> texels_;
+};
+
 }  // namespace
+
+std::vector<glm::uvec4> pack_nodes(const Bvh& bvh) { return NodePacker(bvh).pack(); }
+
+Aabb unpack_child_box(const glm::uvec4* node, int c) {
+  Aabb box;
+  const uint32_t hi_words[3] = {node[2].w, node[3].x, node[3].y};
+  for (int axis = 0; axis < 3; ++axis) {
+    const float origin = std::bit_cast<float>(node[0][axis]);
+    const float scale = std::bit_cast<float>(((node[0].w >> (8 * axis)) & 0xffu) << 23);
+    box.min[axis] = dequantize(origin, scale, (node[2][axis] >> (8 * c)) & 0xffu);
+    box.max[axis] = dequantize(origin, scale, (hi_words[axis] >> (8 * c)) & 0xffu);
+  }
+  return box;
+}
 
 FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const ImageSettings& image) {
   FrameUniforms f{};
@@ -58,13 +167,7 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
       packed.primitives.emplace_back(0.0f);
     }
   }
-  packed.nodes.reserve(bvh.nodes.size() * VKRAY_TEXELS_PER_NODE);
-  for (const BvhNode& n : bvh.nodes) {
-    packed.nodes.emplace_back(n.child[0].min, bits(n.link[0]));
-    packed.nodes.emplace_back(n.child[0].max, bits(n.link[1]));
-    packed.nodes.emplace_back(n.child[1].min, 0.0f);
-    packed.nodes.emplace_back(n.child[1].max, 0.0f);
-  }
+  packed.nodes = pack_nodes(bvh);
   for (const Material& m : scene.materials) packed.materials.emplace_back(m.albedo, 0.0f);
   for (const PointLight& l : scene.lights) {
     packed.lights.emplace_back(l.position, 0.0f);

@@ -28,12 +28,20 @@ static_assert(sizeof(TileConstants) == 16);
 struct PackedScene {
   std::vector<glm::vec4> primitives;  // VKRAY_TEXELS_PER_PRIMITIVE texels each, in BVH leaf order
   std::vector<glm::vec4> normals;     // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when nothing is smooth
-  std::vector<glm::vec4> nodes;       // VKRAY_TEXELS_PER_NODE texels each
+  std::vector<glm::uvec4> nodes;      // VKRAY_TEXELS_PER_NODE texels each (pack_nodes)
   std::vector<glm::vec4> materials;   // one texel each
   std::vector<glm::vec4> lights;      // VKRAY_TEXELS_PER_LIGHT texels each
 };
 
 PackedScene pack_scene(const Scene& scene, const Bvh& bvh);
+
+// The binary BVH as the shader reads it: 4-wide nodes, each a binary node with its children's
+// children, child boxes quantized to 8 bits per side (layout in shaders/shared/types.h). Empty when
+// the BVH is.
+std::vector<glm::uvec4> pack_nodes(const Bvh& bvh);
+
+// Child c's box as the shader decodes it from a packed node at `node` (texels node..node+3).
+Aabb unpack_child_box(const glm::uvec4* node, int c);
 
 // The per-frame uniforms (camera, image, counts). `image` is the resolution actually rendered (the
 // scene's, or the command line's).

@@ -19,7 +19,7 @@ using glm::vec4;
 #define VKRAY_BINDING_FRAME 0       // uniform buffer: FrameUniforms
 #define VKRAY_BINDING_PRIMITIVES 1  // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_PRIMITIVE each, in BVH order
 #define VKRAY_BINDING_NORMALS 2     // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_PRIMITIVE each (smooth triangles)
-#define VKRAY_BINDING_NODES 3       // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_NODE each
+#define VKRAY_BINDING_NODES 3       // uniform texel buffer, RGBA32UI, VKRAY_TEXELS_PER_NODE each
 #define VKRAY_BINDING_MATERIALS 4   // uniform texel buffer, RGBA32F, one texel (albedo) each
 #define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_LIGHT each
 #define VKRAY_BINDING_OUTPUT 6      // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
@@ -37,12 +37,21 @@ using glm::vec4;
 #define VKRAY_PRIM_SPHERE 0x80000000u
 #define VKRAY_PRIM_SMOOTH 0x40000000u  // a triangle with vertex normals in the normals buffer
 #define VKRAY_PRIM_MATERIAL_MASK 0x3fffffffu
-// BVH node: (left.min.xyz, left link), (left.max.xyz, right link), (right.min.xyz, 0), (right.max.xyz, 0).
+// BVH node, 4-wide (host/gpu/scene_packing.cpp collapses the binary BVH two levels at a time), in a
+// RGBA32UI texel buffer, VKRAY_TEXELS_PER_NODE texels each:
+//   0: (origin.xyz as float bits, e), e = ex | ey << 8 | ez << 16, biased float exponents
+//   1: the four child links; 0 = no child (no node links to the root)
+//   2: (lo.x, lo.y, lo.z, hi.x), 3: (hi.y, hi.z, 0, 0): byte c of each is child c's box corner in
+//      steps of 2^(e - 127) from the origin, rounded outward, so a child's box always contains its
+//      primitives: origin + q * 2^(e - 127) is exact up to the one rounding of the sum.
 // A link is an inner node's index, or VKRAY_LEAF_BIT | first << VKRAY_LEAF_COUNT_BITS | count.
 #define VKRAY_TEXELS_PER_NODE 4
+#define VKRAY_NODE_WIDTH 4
 #define VKRAY_LEAF_BIT 0x80000000u
 #define VKRAY_LEAF_COUNT_BITS 4u
-#define VKRAY_TRAVERSAL_STACK 64
+// A node pushes at most VKRAY_NODE_WIDTH - 1 children, and the binary BVH is at most 64 levels
+// deep (host/bvh.h), so at most 32 wide ones.
+#define VKRAY_TRAVERSAL_STACK 96
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
 // precision: a ray along the line where two walls meet, coplanar surfaces); the primitive that
 // comes first in the scene wins, so the result does not depend on traversal order.
