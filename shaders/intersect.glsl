@@ -91,17 +91,4 @@ vec3 safe_inverse(vec3 d) {
   return vec3(d.x < 0.0 ? -1.0 : 1.0, d.y < 0.0 ? -1.0 : 1.0, d.z < 0.0 ? -1.0 : 1.0) / magnitude;
 }
 
-// The slab test: (t_enter, t_exit) of the ray against the box, clipped to (t_min, t_max); it hits
-// when t_enter <= t_exit. t_exit is scaled by 1 + 2 gamma(3) (Ize, "Robust BVH Ray Traversal",
-// JCGT 2013) so float rounding can never reject a box the ray touches, flat boxes included (the
-// box of an axis-aligned wall has zero thickness).
-vec2 intersect_box(vec3 origin, vec3 inv_dir, vec3 box_min, vec3 box_max, float t_min, float t_max) {
-  vec3 t0 = (box_min - origin) * inv_dir;
-  vec3 t1 = (box_max - origin) * inv_dir;
-  vec3 near = min(t0, t1), far = max(t0, t1);
-  float enter = max(max(near.x, near.y), max(near.z, t_min));
-  float exit = min(min(far.x, far.y), min(far.z, t_max)) * 1.0000004;
-  return vec2(enter, exit);
-}
-
 #endif

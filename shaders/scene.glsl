@@ -108,7 +108,10 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
     vec4 hi_x = origin.x + vec4((uvec4(q0.w) >> byte_shift) & 0xffu) * scale.x;
     vec4 hi_y = origin.y + vec4((uvec4(q1.x) >> byte_shift) & 0xffu) * scale.y;
     vec4 hi_z = origin.z + vec4((uvec4(q1.y) >> byte_shift) & 0xffu) * scale.z;
-    // The slab test of intersect_box, for four boxes at once.
+    // The slab test for four boxes at once: (t_enter, t_exit) clipped to (t_min, t_limit), a hit when
+    // t_enter <= t_exit. t_exit is scaled by 1 + 2 gamma(3) (Ize, "Robust BVH Ray Traversal", JCGT
+    // 2013) so float rounding can never reject a box the ray touches, flat boxes included (the box of
+    // an axis-aligned wall has zero thickness).
     vec4 enter = max(max((( backward.x ? hi_x : lo_x) - ray.origin.x) * inv_dir.x,
                          (( backward.y ? hi_y : lo_y) - ray.origin.y) * inv_dir.y),
                      max((( backward.z ? hi_z : lo_z) - ray.origin.z) * inv_dir.z, vec4(t_min)));
