@@ -12,6 +12,13 @@ namespace {
 
 float bits(uint32_t v) { return std::bit_cast<float>(v); }
 
+// The word holding the children's high sides along `axis`: byte c of (lo.x, lo.y, lo.z, hi.x) in
+// texel 2 and of (hi.y, hi.z) in texel 3 (shaders/shared/types.h).
+template <typename Texel>
+auto* hi_word(Texel* node, int axis) {
+  return axis == 0 ? &node[2].w : &node[3][axis - 1];
+}
+
 // Corner q (0..255) of a quantized box along one axis, computed as the shader does. q * scale is
 // exact (8 bits times a power of two), so fused or not, the sum is rounded once.
 float dequantize(float origin, float scale, uint32_t q) { return origin + float(q) * scale; }
@@ -89,12 +96,8 @@ class NodePacker {
         uint32_t q_hi = uint32_t(std::clamp(std::ceil((double(hi) - origin) / scale[axis]), 0.0, 255.0));
         while (q_hi < 255 && dequantize(origin, scale[axis], q_hi) < hi) ++q_hi;
         if (dequantize(origin, scale[axis], q_hi) < hi) throw std::logic_error("BVH node quantization lost a box side");
-        // Byte c of (lo.x, lo.y, lo.z, hi.x) in texel 2 and of (hi.y, hi.z) in texel 3.
         set_byte(t[2][axis], c, q_lo);
-        if (axis == 0)
-          set_byte(t[2].w, c, q_hi);
-        else
-          set_byte(t[3][axis - 1], c, q_hi);
+        set_byte(*hi_word(t, axis), c, q_hi);
       }
     }
   }
@@ -111,12 +114,11 @@ std::vector<glm::uvec4> pack_nodes(const Bvh& bvh) { return NodePacker(bvh).pack
 
 Aabb unpack_child_box(const glm::uvec4* node, int c) {
   Aabb box;
-  const uint32_t hi_words[3] = {node[2].w, node[3].x, node[3].y};
   for (int axis = 0; axis < 3; ++axis) {
     const float origin = std::bit_cast<float>(node[0][axis]);
     const float scale = std::bit_cast<float>(((node[0].w >> (8 * axis)) & 0xffu) << 23);
     box.min[axis] = dequantize(origin, scale, (node[2][axis] >> (8 * c)) & 0xffu);
-    box.max[axis] = dequantize(origin, scale, (hi_words[axis] >> (8 * c)) & 0xffu);
+    box.max[axis] = dequantize(origin, scale, (*hi_word(node, axis) >> (8 * c)) & 0xffu);
   }
   return box;
 }
