@@ -66,6 +66,59 @@ void order_pair(inout float key_a, inout uint link_a, inout float key_b, inout u
   link_b = swap ? link : link_b;
 }
 
+// The children of an inner node that the ray enters within (t_min, t_limit), nearest first: keys are
+// the entry distances, NO_CHILD for a child not entered (those come last).
+struct Children {
+  vec4 key;
+  uvec4 link;
+};
+
+const float NO_CHILD = 3.4e38;  // beyond any t (FAR)
+
+// min and max as a compare and a select. The built-ins also define the result for a NaN operand,
+// which costs llvmpipe a third instruction each; no slab-test value can be NaN (safe_inverse keeps
+// 1 / d finite, and boxes and ray origins are finite).
+vec4 min_no_nan(vec4 a, vec4 b) { return mix(a, b, lessThan(b, a)); }
+vec4 max_no_nan(vec4 a, vec4 b) { return mix(a, b, greaterThan(b, a)); }
+
+Children enter_node(Ray ray, vec3 inv_dir, bvec3 backward, uint node, float t_min, float t_limit) {
+  const uvec4 byte_shift = uvec4(0u, 8u, 16u, 24u);
+  int base = int(node) * VKRAY_TEXELS_PER_NODE;
+  uvec4 header = texelFetch(nodes, base), links = texelFetch(nodes, base + 1), q0 = texelFetch(nodes, base + 2),
+        q1 = texelFetch(nodes, base + 3);
+  // The four child boxes, one child per vector component (exact products: q < 256, scale = 2^k).
+  vec3 origin = uintBitsToFloat(header.xyz);
+  vec3 scale = uintBitsToFloat(((uvec3(header.w) >> uvec3(0u, 8u, 16u)) & 0xffu) << 23u);
+  vec4 lo_x = origin.x + vec4((uvec4(q0.x) >> byte_shift) & 0xffu) * scale.x;
+  vec4 lo_y = origin.y + vec4((uvec4(q0.y) >> byte_shift) & 0xffu) * scale.y;
+  vec4 lo_z = origin.z + vec4((uvec4(q0.z) >> byte_shift) & 0xffu) * scale.z;
+  vec4 hi_x = origin.x + vec4((uvec4(q0.w) >> byte_shift) & 0xffu) * scale.x;
+  vec4 hi_y = origin.y + vec4((uvec4(q1.x) >> byte_shift) & 0xffu) * scale.y;
+  vec4 hi_z = origin.z + vec4((uvec4(q1.y) >> byte_shift) & 0xffu) * scale.z;
+  // The slab test for four boxes at once: (t_enter, t_exit) clipped to (t_min, t_limit), a hit when
+  // t_enter <= t_exit. t_exit is scaled by 1 + 2 gamma(3) (Ize, "Robust BVH Ray Traversal", JCGT
+  // 2013) so float rounding can never reject a box the ray touches, flat boxes included (the box of
+  // an axis-aligned wall has zero thickness).
+  vec4 enter = max_no_nan(max_no_nan(((backward.x ? hi_x : lo_x) - ray.origin.x) * inv_dir.x,
+                                     ((backward.y ? hi_y : lo_y) - ray.origin.y) * inv_dir.y),
+                          max_no_nan(((backward.z ? hi_z : lo_z) - ray.origin.z) * inv_dir.z, vec4(t_min)));
+  vec4 exit = min_no_nan(min_no_nan(((backward.x ? lo_x : hi_x) - ray.origin.x) * inv_dir.x,
+                                    ((backward.y ? lo_y : hi_y) - ray.origin.y) * inv_dir.y),
+                         min_no_nan(((backward.z ? lo_z : hi_z) - ray.origin.z) * inv_dir.z, vec4(t_limit))) *
+              1.0000004;
+  bvec4 entered = bvec4(uvec4(lessThanEqual(enter, exit)) & uvec4(notEqual(links, uvec4(0u))));
+  vec4 key = mix(vec4(NO_CHILD), enter, entered);
+  // Nearest first: a sorting network on four.
+  float k0 = key.x, k1 = key.y, k2 = key.z, k3 = key.w;
+  uint l0 = links.x, l1 = links.y, l2 = links.z, l3 = links.w;
+  order_pair(k0, l0, k1, l1);
+  order_pair(k2, l2, k3, l3);
+  order_pair(k0, l0, k2, l2);
+  order_pair(k1, l1, k3, l3);
+  order_pair(k1, l1, k2, l2);
+  return Children(vec4(k0, k1, k2, k3), uvec4(l0, l1, l2, l3));
+}
+
 // Closest hit in (t_min, t_max); with any_hit, the first hit found (for shadow rays).
 Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   Hit hit = Hit(t_max, NO_HIT);
@@ -75,9 +128,6 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   vec3 inv_dir = safe_inverse(ray.dir);
   // The slab test's near plane on each axis is the box's low side when the ray goes up that axis.
   bvec3 backward = lessThan(inv_dir, vec3(0.0));
-  const uvec4 byte_shift = uvec4(0u, 8u, 16u, 24u);
-  const float NONE = 3.4e38;  // the key of a child not hit: beyond any t (FAR)
-
   // At most VKRAY_TRAVERSAL_STACK entries are in use; the spare ones keep a write at the top (one
   // past the last entry, by a lane whose result is masked off) inside the array.
   uint stack[VKRAY_TRAVERSAL_STACK + VKRAY_NODE_WIDTH];
@@ -86,57 +136,29 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   // One loop step handles one node or one leaf: leaves are entered like nodes (nearest child next,
   // the others on the stack), so the leaf code exists once. On llvmpipe an `if` is not a branch
   // (both sides run, masked), so every step costs the leaf code plus the node code; 4-wide nodes
-  // take 40% fewer steps than binary ones (README, "Benchmark"). A leaf popped after a closer hit was found
-  // is still tested; the limit in intersect_leaf keeps the result exact.
+  // take 40% fewer steps than binary ones (README, "Benchmark"). For the same reason there is one pop
+  // site for leaves and nodes alike: each site would cost every step a per-lane gather. A leaf popped
+  // after a closer hit was found is still tested; the limit in intersect_leaf keeps the result exact.
   for (;;) {
+    bool pop = true;
     if ((node & VKRAY_LEAF_BIT) != 0u) {
       if (intersect_leaf(ray, shear, node, t_min, t_max, any_hit, hit, hit_index)) return hit;
-      if (depth == 0) break;
-      node = stack[--depth];
-      continue;
-    }
-    int base = int(node) * VKRAY_TEXELS_PER_NODE;
-    uvec4 header = texelFetch(nodes, base), links = texelFetch(nodes, base + 1), q0 = texelFetch(nodes, base + 2),
-          q1 = texelFetch(nodes, base + 3);
-    float t_limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
-    // The four child boxes, one child per vector component (exact products: q < 256, scale = 2^k).
-    vec3 origin = uintBitsToFloat(header.xyz);
-    vec3 scale = uintBitsToFloat(((uvec3(header.w) >> uvec3(0u, 8u, 16u)) & 0xffu) << 23u);
-    vec4 lo_x = origin.x + vec4((uvec4(q0.x) >> byte_shift) & 0xffu) * scale.x;
-    vec4 lo_y = origin.y + vec4((uvec4(q0.y) >> byte_shift) & 0xffu) * scale.y;
-    vec4 lo_z = origin.z + vec4((uvec4(q0.z) >> byte_shift) & 0xffu) * scale.z;
-    vec4 hi_x = origin.x + vec4((uvec4(q0.w) >> byte_shift) & 0xffu) * scale.x;
-    vec4 hi_y = origin.y + vec4((uvec4(q1.x) >> byte_shift) & 0xffu) * scale.y;
-    vec4 hi_z = origin.z + vec4((uvec4(q1.y) >> byte_shift) & 0xffu) * scale.z;
-    // The slab test for four boxes at once: (t_enter, t_exit) clipped to (t_min, t_limit), a hit when
-    // t_enter <= t_exit. t_exit is scaled by 1 + 2 gamma(3) (Ize, "Robust BVH Ray Traversal", JCGT
-    // 2013) so float rounding can never reject a box the ray touches, flat boxes included (the box of
-    // an axis-aligned wall has zero thickness).
-    vec4 enter = max(max((( backward.x ? hi_x : lo_x) - ray.origin.x) * inv_dir.x,
-                         (( backward.y ? hi_y : lo_y) - ray.origin.y) * inv_dir.y),
-                     max((( backward.z ? hi_z : lo_z) - ray.origin.z) * inv_dir.z, vec4(t_min)));
-    vec4 exit = min(min(((backward.x ? lo_x : hi_x) - ray.origin.x) * inv_dir.x,
-                        ((backward.y ? lo_y : hi_y) - ray.origin.y) * inv_dir.y),
-                    min(((backward.z ? lo_z : hi_z) - ray.origin.z) * inv_dir.z, vec4(t_limit))) * 1.0000004;
-    bvec4 entered = bvec4(uvec4(lessThanEqual(enter, exit)) & uvec4(notEqual(links, uvec4(0u))));
-    vec4 key = mix(vec4(NONE), enter, entered);
-    // Nearest child first (a sorting network on four), then the others onto the stack, farthest first.
-    float k0 = key.x, k1 = key.y, k2 = key.z, k3 = key.w;
-    uint l0 = links.x, l1 = links.y, l2 = links.z, l3 = links.w;
-    order_pair(k0, l0, k1, l1);
-    order_pair(k2, l2, k3, l3);
-    order_pair(k0, l0, k2, l2);
-    order_pair(k1, l1, k3, l3);
-    order_pair(k1, l1, k2, l2);
-    if (k0 < NONE) {
-      stack[depth] = l3;
-      depth += int(k3 < NONE);
-      stack[depth] = l2;
-      depth += int(k2 < NONE);
-      stack[depth] = l1;
-      depth += int(k1 < NONE);
-      node = l0;
     } else {
+      float t_limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
+      Children c = enter_node(ray, inv_dir, backward, node, t_min, t_limit);
+      // The nearest child next, the others onto the stack, farthest first.
+      if (c.key.x < NO_CHILD) {
+        stack[depth] = c.link.w;
+        depth += int(c.key.w < NO_CHILD);
+        stack[depth] = c.link.z;
+        depth += int(c.key.z < NO_CHILD);
+        stack[depth] = c.link.y;
+        depth += int(c.key.y < NO_CHILD);
+        node = c.link.x;
+        pop = false;
+      }
+    }
+    if (pop) {
       if (depth == 0) break;
       node = stack[--depth];
     }
