@@ -115,6 +115,7 @@ GpuRun render_gpu(const LoadedScene& loaded, const RenderFlags& flags, const std
     const std::filesystem::path shader_dir = flags.shader_dir.empty() ? default_shader_dir() : flags.shader_dir;
     const gpu::CompiledShader shader = gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir});
     const gpu::TracePipeline pipeline(ctx, shader.spirv);
+    pipeline.pipeline(loaded.scene);  // compiled now, so that compile_ms counts it
     ctx.check_validation("pipeline creation");
     run.compile_ms = ms_since(start);
 

@@ -90,6 +90,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
       // that stays true if rendering ever overlaps with reloading.
       ctx.queue().waitIdle();
       pipeline = std::make_unique<gpu::TracePipeline>(ctx, compiled.spirv, &pipeline_cache);
+      if (scene) pipeline->pipeline(*scene);  // compiled now, so that the time reported counts it
       spirv = std::move(compiled.spirv);
       ctx.check_validation("pipeline creation");
       return "compile " + format_ms(ms_since(start));

@@ -99,13 +99,17 @@ TEST_P(CornellTest, FloorInTheOpenIsLit) {
 }
 
 // ---- A sphere, built in the test -------------------------------------------------------------------
-TEST_F(RenderTest, SphereShadingAndBackground) {
-  const Scene scene = parse_scene(R"({
+Scene one_sphere_scene() {
+  return parse_scene(R"({
     "camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "up": [0, 1, 0], "focal_length": 2},
     "background": [0.2, 0.3, 0.4], "ambient": [0.05, 0.05, 0.05],
     "materials": {"m": {"albedo": [0.8, 0.5, 0.2]}},
     "lights": [{"type": "point", "position": [0, 3, 0], "intensity": [20, 20, 20]}],
     "objects": [{"type": "sphere", "center": [0, 0, 4], "radius": 1, "material": "m"}]})", "sphere.json");
+}
+
+TEST_F(RenderTest, SphereShadingAndBackground) {
+  const Scene scene = one_sphere_scene();
   for (const bool cpu : {false, true}) {
     SCOPED_TRACE(cpu ? "CPU reference" : "GPU");
     const Image image = render(scene, {64, 64, 1}, {}, cpu);
@@ -123,6 +127,20 @@ TEST_F(RenderTest, SphereShadingAndBackground) {
     ASSERT_GT(cos_theta, 0.1);
     expect_radiance(image.at(31, 20), glm::dvec3(0.8, 0.5, 0.2) * (0.05 + 20 * cos_theta / (kPi * r2)), "sphere top");
   }
+}
+
+TEST_F(RenderTest, OnePipelineServesScenesWithAndWithoutSpheres) {
+  // A scene without spheres gets a pipeline variant without the sphere test (gpu::ShaderVariant);
+  // compiled first, it must not serve the sphere scene after it.
+  const Scene no_spheres = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
+  const Scene spheres = one_sphere_scene();
+  const Image before = render(no_spheres, {32, 32, 1});
+  const Image sphere = render(spheres, {32, 32, 1});
+  const Image sphere_reference = render(spheres, {32, 32, 1}, {}, /*cpu=*/true);
+  expect_radiance(sphere.at(16, 16), glm::dvec3(sphere_reference.at(16, 16)), "sphere center");
+  EXPECT_NE(sphere.at(16, 16), glm::vec3(0.2f, 0.3f, 0.4f)) << "the sphere is missing";
+  const Image after = render(no_spheres, {32, 32, 1});
+  EXPECT_EQ(before.pixels, after.pixels);
 }
 
 TEST_F(RenderTest, TilesCoverTheImageExactly) {

@@ -69,7 +69,8 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
 
 }  // namespace
 
-TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv, const vk::raii::PipelineCache* cache) {
+TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv, const vk::raii::PipelineCache* cache)
+    : device_(&ctx.device()), cache_(cache) {
   using S = vk::ShaderStageFlagBits;
   const vk::DescriptorSetLayoutBinding bindings[] = {
       {VKRAY_BINDING_FRAME, vk::DescriptorType::eUniformBuffer, 1, S::eCompute},
@@ -84,10 +85,24 @@ TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& sp
   const vk::PushConstantRange push(S::eCompute, 0, sizeof(TileConstants));
   const vk::DescriptorSetLayout set_layout = *set_layout_;
   layout_ = vk::raii::PipelineLayout(ctx.device(), vk::PipelineLayoutCreateInfo({}, set_layout, push));
-  const vk::raii::ShaderModule module(ctx.device(), vk::ShaderModuleCreateInfo({}, spirv));
-  const vk::PipelineShaderStageCreateInfo stage({}, S::eCompute, *module, "main");
-  pipeline_ = vk::raii::Pipeline(ctx.device(), cache ? vk::Optional<const vk::raii::PipelineCache>(*cache) : nullptr,
-                                 vk::ComputePipelineCreateInfo({}, stage, *layout_));
+  module_ = vk::raii::ShaderModule(ctx.device(), vk::ShaderModuleCreateInfo({}, spirv));
+}
+
+TracePipeline::~TracePipeline() = default;
+
+ShaderVariant shader_variant(const Scene& scene) { return ShaderVariant{.spheres = !scene.spheres.empty()}; }
+
+const vk::raii::Pipeline& TracePipeline::pipeline(const Scene& scene) const {
+  const ShaderVariant variant = shader_variant(scene);
+  const std::lock_guard lock(mutex_);
+  if (const auto found = pipelines_.find(variant); found != pipelines_.end()) return found->second;
+  const VkBool32 spheres = variant.spheres;
+  const vk::SpecializationMapEntry entry(VKRAY_SPEC_SPHERES, 0, sizeof(spheres));
+  const vk::SpecializationInfo specialization(entry, vk::ArrayProxyNoTemporaries<const VkBool32>(spheres));
+  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *module_, "main", &specialization);
+  vk::raii::Pipeline created(*device_, cache_ ? vk::Optional<const vk::raii::PipelineCache>(*cache_) : nullptr,
+                             vk::ComputePipelineCreateInfo({}, stage, *layout_));
+  return pipelines_.emplace(variant, std::move(created)).first->second;
 }
 
 uint32_t tile_side(const Scene& scene, const ImageSettings& image) {
@@ -180,6 +195,7 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
   stats.upload_seconds = seconds_since(start);
 
   // ---- trace, one submission per tile ----
+  const vk::raii::Pipeline& compute_pipeline = pipeline.pipeline(scene);  // compiled here unless asked for before
   start = Clock::now();
   const vk::raii::CommandPool command_pool(device, {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, ctx.queue_family()});
   vk::raii::CommandBuffers cbs(device, {*command_pool, vk::CommandBufferLevel::ePrimary, 1});
@@ -197,7 +213,7 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
 
     cb.reset();
     cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
-    cb.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline.pipeline());
+    cb.bindPipeline(vk::PipelineBindPoint::eCompute, *compute_pipeline);
     cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline.layout(), 0, set, {});
     cb.pushConstants<TileConstants>(*pipeline.layout(), vk::ShaderStageFlagBits::eCompute, 0, tile);
     cb.dispatch((tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X,

@@ -4,8 +4,11 @@
 
 #include <chrono>
 #include <cstdint>
+#include <compare>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include <vulkan/vulkan_raii.hpp>
@@ -21,20 +24,40 @@ struct Bvh;
 
 namespace vkray::gpu {
 
-// Descriptor set layout, pipeline layout and pipeline for shaders/trace.comp's interface.
+// What a scene needs of the shader, given to it as specialization constants (shared/types.h), so
+// that the pipeline for a scene has no code for what the scene lacks: on llvmpipe code behind an if
+// costs every lane even when no lane takes it.
+struct ShaderVariant {
+  bool spheres = true;  // VKRAY_SPEC_SPHERES
+
+  auto operator<=>(const ShaderVariant&) const = default;
+};
+
+ShaderVariant shader_variant(const Scene& scene);
+
+// Descriptor set layout, pipeline layout and the pipelines for shaders/trace.comp's interface, one
+// per ShaderVariant, each compiled the first time a scene needs it.
 class TracePipeline {
  public:
-  // `cache` (optional) makes re-creating a pipeline from SPIR-V seen before in this process cheap.
+  // `cache` (optional; it must outlive this) makes re-creating a pipeline from SPIR-V seen before in
+  // this process cheap.
   TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv, const vk::raii::PipelineCache* cache = nullptr);
+  ~TracePipeline();
 
   const vk::raii::DescriptorSetLayout& set_layout() const { return set_layout_; }
   const vk::raii::PipelineLayout& layout() const { return layout_; }
-  const vk::raii::Pipeline& pipeline() const { return pipeline_; }
+  // The pipeline for `scene`, compiled now if no scene before needed the same variant. Callers that
+  // time compilation apart from tracing call this before rendering.
+  const vk::raii::Pipeline& pipeline(const Scene& scene) const;
 
  private:
+  const vk::raii::Device* device_;
+  const vk::raii::PipelineCache* cache_;
   vk::raii::DescriptorSetLayout set_layout_{nullptr};
   vk::raii::PipelineLayout layout_{nullptr};
-  vk::raii::Pipeline pipeline_{nullptr};
+  vk::raii::ShaderModule module_{nullptr};
+  mutable std::mutex mutex_;
+  mutable std::map<ShaderVariant, vk::raii::Pipeline> pipelines_;
 };
 
 // A scene on the device: its BVH built and its buffers uploaded, ready for any number of renders.

@@ -24,6 +24,10 @@ using glm::vec4;
 #define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_LIGHT each
 #define VKRAY_BINDING_OUTPUT 6      // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
 
+// ---- Specialization constants ------------------------------------------------------------------
+// false when the scene has no spheres: the pipeline for it has no sphere test (gpu::ShaderVariant).
+#define VKRAY_SPEC_SPHERES 0
+
 // Texel buffers rather than storage buffers: with the triangles in a storage buffer instead, a
 // 1024x1024 render on Mesa 22.3.6 lavapipe (2 cores) took 1.8-2.3x as long (README, "How the GPU
 // path works").
