@@ -14,6 +14,7 @@ layout(push_constant) uniform Tile { TileConstants tile; };
 layout(std430, set = 0, binding = VKRAY_BINDING_OUTPUT) writeonly buffer Output { vec4 radiance[]; };
 
 void main() {
+  frame = frame_block;
   uvec2 local = gl_GlobalInvocationID.xy;
   if (local.x >= tile.width || local.y >= tile.height) return;
   uvec2 pixel = uvec2(tile.x0, tile.y0) + local;
