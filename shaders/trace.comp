@@ -15,7 +15,9 @@ layout(std430, set = 0, binding = VKRAY_BINDING_OUTPUT) writeonly buffer Output 
 
 void main() {
   frame = frame_block;
-  uvec2 local = gl_GlobalInvocationID.xy;
+  // The workgroup's place in the tile: its row permuted (TileConstants::row_stride).
+  uvec2 group = uvec2(gl_WorkGroupID.x, (gl_WorkGroupID.y * tile.row_stride) % gl_NumWorkGroups.y);
+  uvec2 local = group * uvec2(VKRAY_WORKGROUP_X, VKRAY_WORKGROUP_Y) + gl_LocalInvocationID.xy;
   if (local.x >= tile.width || local.y >= tile.height) return;
   uvec2 pixel = uvec2(tile.x0, tile.y0) + local;
   uint index = pixel.y * frame.width + pixel.x;

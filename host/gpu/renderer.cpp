@@ -210,14 +210,16 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
     tile.y0 = (tile_index / tiles_x) * side;
     tile.width = std::min(side, image.width - tile.x0);
     tile.height = std::min(side, image.height - tile.y0);
+    const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
+    const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
+    tile.row_stride = row_stride(groups_y);
 
     cb.reset();
     cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
     cb.bindPipeline(vk::PipelineBindPoint::eCompute, *compute_pipeline);
     cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline.layout(), 0, set, {});
     cb.pushConstants<TileConstants>(*pipeline.layout(), vk::ShaderStageFlagBits::eCompute, 0, tile);
-    cb.dispatch((tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X,
-                (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y, 1);
+    cb.dispatch(groups_x, groups_y, 1);
     // The shader's writes are read by the host after the fence.
     const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
     cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 
 #include "camera.h"
@@ -121,6 +122,13 @@ Aabb unpack_child_box(const glm::uvec4* node, int c) {
     box.max[axis] = dequantize(origin, scale, (*hi_word(node, axis) >> (8 * c)) & 0xffu);
   }
   return box;
+}
+
+uint32_t row_stride(uint32_t rows) {
+  if (rows <= 2) return 1;
+  uint32_t stride = static_cast<uint32_t>(std::lround(double(rows) * 0.6180339887498949));
+  while (std::gcd(stride, rows) != 1) ++stride;  // ends by rows - 1 at the latest
+  return stride;
 }
 
 FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const ImageSettings& image) {

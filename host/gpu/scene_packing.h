@@ -22,7 +22,7 @@ static_assert(offsetof(FrameUniforms, primitive_count) == 108);
 static_assert(offsetof(FrameUniforms, strata_y) == 124);
 static_assert(offsetof(FrameUniforms, epsilon) == 140);
 static_assert(sizeof(FrameUniforms) == 144);
-static_assert(sizeof(TileConstants) == 16);
+static_assert(sizeof(TileConstants) == 20);
 
 // The scene's buffers; the per-frame uniforms come from pack_frame().
 struct PackedScene {
@@ -46,5 +46,10 @@ Aabb unpack_child_box(const glm::uvec4* node, int c);
 // The per-frame uniforms (camera, image, counts). `image` is the resolution actually rendered (the
 // scene's, or the command line's).
 FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const ImageSettings& image);
+
+// TileConstants::row_stride for a dispatch of `rows` workgroup rows: the integer nearest
+// rows / golden ratio that is coprime with rows (so r -> r * stride mod rows is a permutation, and
+// consecutive rows land far apart). 1 for rows <= 2.
+uint32_t row_stride(uint32_t rows);
 
 }  // namespace vkray::gpu

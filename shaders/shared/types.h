@@ -99,6 +99,11 @@ struct TileConstants {
   uint y0;
   uint width;
   uint height;
+  // Workgroup row r of the dispatch renders row (r * row_stride) mod rows of the tile, a
+  // permutation (row_stride is coprime with rows). llvmpipe hands each of its threads one
+  // contiguous share of a dispatch's workgroups; scattered rows give every share a like mix of
+  // cheap and costly pixels, so no thread finishes long before the others (gpu::row_stride).
+  uint row_stride;
 };
 
 #ifdef __cplusplus
