@@ -1,5 +1,5 @@
-// The scene in the layout the shader reads (shaders/shared/types.h): texel arrays and frame
-// uniforms. No Vulkan here, so it is testable without a device.
+// The scene in the layout the shader reads (shaders/shared/types.h): texel arrays, frame uniforms
+// and the tile constants' row order. No Vulkan here, so it is testable without a device.
 #pragma once
 
 #include <cstddef>
