@@ -35,8 +35,9 @@ bool read_file(const std::filesystem::path& file, std::string& text) {
 
 class Includer : public glslang::TShader::Includer {
  public:
-  Includer(std::vector<std::filesystem::path> dirs, std::vector<std::filesystem::path>& sources)
-      : dirs_(std::move(dirs)), sources_(sources) {}
+  Includer(std::vector<std::filesystem::path> dirs, const std::vector<GeneratedInclude>& generated,
+           std::vector<std::filesystem::path>& sources)
+      : dirs_(std::move(dirs)), generated_(generated), sources_(sources) {}
 
   IncludeResult* includeLocal(const char* header, const char* includer, size_t) override {
     return find(header, std::filesystem::path(includer).parent_path());
@@ -51,6 +52,13 @@ class Includer : public glslang::TShader::Includer {
 
  private:
   IncludeResult* find(const char* header, const std::filesystem::path& local_dir) {
+    for (const auto& g : generated_)
+      if (g.name == header) {
+        auto text = std::make_unique<std::string>(g.text);
+        auto* result = new IncludeResult(g.name + " (generated)", text->data(), text->size(), text.get());
+        text.release();
+        return result;
+      }
     std::vector<std::filesystem::path> candidates;
     if (!local_dir.empty()) candidates.push_back(local_dir / header);
     for (const auto& dir : dirs_) candidates.push_back(dir / header);
@@ -68,6 +76,7 @@ class Includer : public glslang::TShader::Includer {
   }
 
   std::vector<std::filesystem::path> dirs_;
+  const std::vector<GeneratedInclude>& generated_;
   std::vector<std::filesystem::path>& sources_;
 };
 
@@ -96,7 +105,8 @@ std::string format_log(const std::string& log) {
 }  // namespace
 
 CompiledShader compile_compute_shader(const std::filesystem::path& entry,
-                                      const std::vector<std::filesystem::path>& include_dirs) {
+                                      const std::vector<std::filesystem::path>& include_dirs,
+                                      const std::vector<GeneratedInclude>& generated) {
   static GlslangProcess process;
 
   const std::filesystem::path entry_path = entry.lexically_normal();
@@ -116,7 +126,7 @@ CompiledShader compile_compute_shader(const std::filesystem::path& entry,
   shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
   shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
 
-  Includer includer(include_dirs, result.sources);
+  Includer includer(include_dirs, generated, result.sources);
   const auto messages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
   if (!shader.parse(GetDefaultResources(), 460, false, messages, includer))
     throw ShaderError(format_log(shader.getInfoLog()));

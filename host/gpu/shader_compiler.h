@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace vkray::gpu {
@@ -13,11 +14,18 @@ struct CompiledShader {
   std::vector<std::filesystem::path> sources;
 };
 
-// Compiles `entry` for Vulkan 1.2. `#include "x"` is looked up next to the including file, then in
-// `include_dirs` in order; `#include <x>` only in `include_dirs`. Throws ShaderError whose message
-// has one line per problem, "file:line: error: message", where file is the file that has the error
-// (an included file too).
+// Text served for an #include of `name` in place of any file of that name (code the host generates).
+struct GeneratedInclude {
+  std::string name;  // as written in the #include
+  std::string text;
+};
+
+// Compiles `entry` for Vulkan 1.2. `#include "x"` is looked up in `generated`, then next to the
+// including file, then in `include_dirs` in order; `#include <x>` skips the including file's folder.
+// Throws ShaderError whose message has one line per problem, "file:line: error: message", where
+// file is the file that has the error (an included file too; "x (generated)" for generated code).
 CompiledShader compile_compute_shader(const std::filesystem::path& entry,
-                                      const std::vector<std::filesystem::path>& include_dirs = {});
+                                      const std::vector<std::filesystem::path>& include_dirs = {},
+                                      const std::vector<GeneratedInclude>& generated = {});
 
 }  // namespace vkray::gpu
