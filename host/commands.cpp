@@ -114,18 +114,23 @@ GpuRun render_gpu(const LoadedScene& loaded, const RenderFlags& flags, const std
     const auto start = Clock::now();
     const std::filesystem::path shader_dir = flags.shader_dir.empty() ? default_shader_dir() : flags.shader_dir;
     const gpu::CompiledShader shader = gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir});
-    const gpu::TracePipeline pipeline(ctx, shader.spirv);
-    pipeline.pipeline(loaded.scene);  // compiled now, so that compile_ms counts it
-    ctx.check_validation("pipeline creation");
+    const gpu::TracePipeline pipeline(ctx, shader_dir, shader.spirv);
     run.compile_ms = ms_since(start);
+    const gpu::GpuScene gpu_scene(ctx, loaded.scene, bvh);
+    // The scene's pipeline variant compiled now, so that compile_ms counts it (a small scene's own
+    // code is compiled only now that the scene is packed).
+    const auto variant_start = Clock::now();
+    pipeline.pipeline(gpu::shader_variant(gpu_scene, loaded.image, flags.inline_scene));
+    ctx.check_validation("pipeline creation");
+    run.compile_ms += ms_since(variant_start);
 
     Progress progress(show_progress, "tracing");
     gpu::RenderOptions render_options;
     render_options.progress = [&](uint32_t done, uint32_t total) { progress.update(done, total, "tiles"); };
     render_options.tile_timeout = std::chrono::milliseconds(flags.tile_timeout_ms);
+    render_options.inline_scene = flags.inline_scene;
     if (stop) render_options.cancel = [stop] { return stop->pending(); };
     try {
-      const gpu::GpuScene gpu_scene(ctx, loaded.scene, bvh);
       run.image = gpu::render(ctx, pipeline, gpu_scene, loaded.image, render_options, &run.stats);
       run.stats.bvh_seconds = gpu_scene.bvh_seconds();
       run.stats.upload_seconds += gpu_scene.upload_seconds();
@@ -212,7 +217,8 @@ int run_render(const RenderCommand& cmd) {
     trace_seconds = run.stats.trace_seconds;
     phases = "load " + format_ms(loaded.load_ms) + " | compile " + format_ms(run.compile_ms) + " | upload " +
              format_ms(run.stats.upload_seconds * 1e3) + " | trace " + format_ms(run.stats.trace_seconds * 1e3) + " (" +
-             std::to_string(run.stats.tiles) + (run.stats.tiles == 1 ? " tile" : " tiles") + ") | read back " +
+             std::to_string(run.stats.tiles) + (run.stats.tiles == 1 ? " tile" : " tiles") +
+             (run.stats.inline_scene ? ", scene compiled into the shader" : "") + ") | read back " +
              format_ms(run.stats.readback_seconds * 1e3);
   }
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "gpu/inline_scene.h"
 #include "scene.h"
 
 namespace vkray {
@@ -21,6 +22,7 @@ struct RenderFlags {
   bool validate = false;
   unsigned threads = 0;  // CPU reference threads; 0: one per hardware thread
   uint32_t tile_timeout_ms = 60000;  // longest one GPU submission may take
+  gpu::InlineScene inline_scene = gpu::InlineScene::automatic;
 };
 
 struct RenderCommand {
@@ -56,6 +58,7 @@ struct BenchCommand {
   unsigned threads = 0;  // CPU reference and Embree threads; 0: one per hardware thread
   std::string device;
   std::filesystem::path shader_dir;  // empty: the installed (or source-tree) shaders
+  gpu::InlineScene inline_scene = gpu::InlineScene::automatic;
   bool cpu_reference = true;
   bool embree = true;
   bool json = false;

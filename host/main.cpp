@@ -1,6 +1,8 @@
 // vkray's command line: parses arguments, runs a subcommand, and turns errors into a message on
 // stderr and the documented exit code. Nothing below main() ever lets an exception escape.
 #include <iostream>
+#include <map>
+#include <string>
 
 #include <CLI/CLI.hpp>
 #include <vulkan/vulkan_raii.hpp>
@@ -19,6 +21,21 @@ constexpr const char* kExitCodes =
     "  4  parity: the GPU and CPU images differ beyond the documented tolerance\n"
     "  130  interrupted by SIGINT (Ctrl-C) or SIGTERM; nothing was written\n";
 
+// --inline-scene: how a scene is traced (host/gpu/inline_scene.h).
+CLI::Option* add_inline_scene_option(CLI::App* cmd, vkray::gpu::InlineScene& value) {
+  using vkray::gpu::InlineScene;
+  static const std::map<std::string, InlineScene> names{
+      {"auto", InlineScene::automatic}, {"always", InlineScene::always}, {"never", InlineScene::never}};
+  return cmd
+      ->add_option_function<std::string>(
+          "--inline-scene", [&value](const std::string& name) { value = names.at(name); },
+          "GPU path for scenes of at most 32 primitives: compile the scene into the shader (every primitive "
+          "tested, no BVH) 'always', 'never', or 'auto' (default: when the render has at least 2^20 camera "
+          "rays, so that the longer compile pays off)")
+      ->option_text("auto|always|never")
+      ->check(CLI::IsMember({"auto", "always", "never"}));
+}
+
 // Flags every rendering command takes.
 void add_render_flags(CLI::App* cmd, vkray::RenderFlags& flags) {
   cmd->add_option("scene", flags.scene, "Scene file (default: the Cornell box, scenes/cornell.json)");
@@ -34,6 +51,7 @@ void add_render_flags(CLI::App* cmd, vkray::RenderFlags& flags) {
                   "Longest one GPU submission (a tile) may run, in milliseconds, before the render fails with exit 3 "
                   "(default 60000)")
       ->check(CLI::Range(1, 3600000));
+  add_inline_scene_option(cmd, flags.inline_scene);
   cmd->footer(kExitCodes);
 }
 
@@ -85,6 +103,7 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--threads", bench.threads, "Threads for the CPU reference and Embree")->check(CLI::Range(1, 256));
   bench_cmd->add_option("--device", bench.device, "Vulkan device: index or part of its name");
   bench_cmd->add_option("--shader-dir", bench.shader_dir, "Folder with trace.comp and its includes (to measure a variant)");
+  add_inline_scene_option(bench_cmd, bench.inline_scene);
   bench_cmd->add_flag("!--no-cpu-reference", bench.cpu_reference, "Leave the CPU reference out");
   bench_cmd->add_flag("!--no-embree", bench.embree, "Leave Embree out");
   bench_cmd->add_flag("--json", bench.json, "Print the results as JSON");

@@ -61,6 +61,13 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
   std::vector<uint32_t> spirv;
   std::vector<std::filesystem::path> shader_sources{shader_dir / "trace.comp"};
   bool scene_broken = false, shader_broken = false;
+  // Compiles the pipeline the current scene needs (a small scene's own code, say), so that the time
+  // reported for a reload counts it. A ShaderError here is the shaders' (the generated code follows
+  // the contract in inline_scene.glsl).
+  auto prepare_pipeline = [&] {
+    if (pipeline && gpu_scene)
+      pipeline->pipeline(gpu::shader_variant(*gpu_scene, image_settings(*scene, cmd.flags), cmd.flags.inline_scene));
+  };
 
   auto reload_scene = [&]() -> std::string {
     const auto start = Clock::now();
@@ -72,12 +79,19 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
       gpu_scene = std::move(uploaded);  // the old GpuScene goes first, while its scene still exists
       scene = std::move(loaded);
       scene_broken = false;
-      return "scene " + format_ms(ms_since(start));
     } catch (const SceneError& e) {
       std::cerr << "vkray: error: " << e.what() << "\n";
       scene_broken = true;
       return "scene has errors";
     }
+    try {
+      prepare_pipeline();
+    } catch (const ShaderError& e) {
+      std::cerr << e.what() << "\n";
+      shader_broken = true;
+      return "scene " + format_ms(ms_since(start)) + ", shader has errors";
+    }
+    return "scene " + format_ms(ms_since(start));
   };
   auto recompile = [&]() -> std::string {
     const auto start = Clock::now();
@@ -85,12 +99,17 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
       gpu::CompiledShader compiled = gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir});
       shader_sources = compiled.sources;
       shader_broken = false;
-      if (pipeline && compiled.spirv == spirv) return "compile " + format_ms(ms_since(start)) + " (SPIR-V unchanged)";
+      // The SPIR-V without a scene compiled in says nothing about the one with it (its functions are
+      // not in the other), so a scene that is compiled in is always recompiled.
+      const bool compiled_in = gpu_scene && gpu::use_inline_scene(*gpu_scene, image_settings(*scene, cmd.flags),
+                                                                  cmd.flags.inline_scene);
+      if (pipeline && compiled.spirv == spirv && !compiled_in)
+        return "compile " + format_ms(ms_since(start)) + " (SPIR-V unchanged)";
       // Renders wait for their last tile, so no work uses the old pipeline now; wait anyway, so
       // that stays true if rendering ever overlaps with reloading.
       ctx.queue().waitIdle();
-      pipeline = std::make_unique<gpu::TracePipeline>(ctx, compiled.spirv, &pipeline_cache);
-      if (scene) pipeline->pipeline(*scene);  // compiled now, so that the time reported counts it
+      pipeline = std::make_unique<gpu::TracePipeline>(ctx, shader_dir, compiled.spirv, &pipeline_cache);
+      prepare_pipeline();
       spirv = std::move(compiled.spirv);
       ctx.check_validation("pipeline creation");
       return "compile " + format_ms(ms_since(start));
@@ -112,6 +131,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
     const ImageSettings image = image_settings(*scene, cmd.flags);
     gpu::RenderOptions render_options;
     render_options.cancel = [&] { return stop.pending(); };
+    render_options.inline_scene = cmd.flags.inline_scene;
     const auto start = Clock::now();
     const Image result = gpu::render(ctx, *pipeline, *gpu_scene, image, render_options);
     const double render_ms = ms_since(start);

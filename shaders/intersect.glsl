@@ -32,23 +32,30 @@ RayShear ray_shear(vec3 d) {
   return RayShear(ivec3(kx, ky, kz), vec3(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]));
 }
 
-float intersect_triangle(Ray ray, RayShear sh, vec3 v0, vec3 v1, vec3 v2, float t_min, float t_max) {
-  // Vertices relative to the origin, permuted and sheared into the ray's frame.
-  vec3 a = v0 - ray.origin, b = v1 - ray.origin, c = v2 - ray.origin;
-  float ax = a[sh.k.x] - sh.s.x * a[sh.k.z], ay = a[sh.k.y] - sh.s.y * a[sh.k.z];
-  float bx = b[sh.k.x] - sh.s.x * b[sh.k.z], by = b[sh.k.y] - sh.s.y * b[sh.k.z];
-  float cx = c[sh.k.x] - sh.s.x * c[sh.k.z], cy = c[sh.k.y] - sh.s.y * c[sh.k.z];
-  // Edge functions. `precise`: a fused multiply-add would break the exact antisymmetry that makes
-  // the test watertight.
-  precise float u = cx * by - cy * bx;
-  precise float v = ax * cy - ay * cx;
-  precise float w = bx * ay - by * ax;
-  if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return -1.0;
+// A point in the ray's frame: x, y its place in the plane across the ray (where the edge functions
+// below are computed), z its depth, scaled so that the point at distance t along the ray has z = t.
+// shear_point takes the point relative to the origin, and the shear as plain vectors.
+vec3 shear_point(vec3 a, ivec3 k, vec3 s) { return vec3(a[k.x] - s.x * a[k.z], a[k.y] - s.y * a[k.z], s.z * a[k.z]); }
+
+vec3 shear_vertex(Ray ray, RayShear sh, vec3 v) { return shear_point(v - ray.origin, sh.k, sh.s); }
+
+// The test for a triangle whose vertices are already in the ray's frame (shear_vertex), without
+// branches: on llvmpipe both sides of an if run anyway. Edge functions are `precise`: a fused
+// multiply-add would break the exact antisymmetry that makes the test watertight. Outside: the
+// edge functions differ in sign. det = 0: the ray lies in the triangle's plane, or the triangle is
+// degenerate (its division by 0 is discarded with it).
+float sheared_triangle(vec3 a, vec3 b, vec3 c, float t_min, float t_max) {
+  precise float u = c.x * b.y - c.y * b.x;
+  precise float v = a.x * c.y - a.y * c.x;
+  precise float w = b.x * a.y - b.y * a.x;
+  bool outside = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
   float det = u + v + w;
-  // det = 0: the ray lies in the triangle's plane, or the triangle is degenerate.
-  if (det == 0.0) return -1.0;
-  float t = (u * (sh.s.z * a[sh.k.z]) + v * (sh.s.z * b[sh.k.z]) + w * (sh.s.z * c[sh.k.z])) / det;
-  return (t > t_min && t < t_max) ? t : -1.0;
+  float t = (u * a.z + v * b.z + w * c.z) / det;
+  return (!outside && det != 0.0 && t > t_min && t < t_max) ? t : -1.0;
+}
+
+float intersect_triangle(Ray ray, RayShear sh, vec3 v0, vec3 v1, vec3 v2, float t_min, float t_max) {
+  return sheared_triangle(shear_vertex(ray, sh, v0), shear_vertex(ray, sh, v1), shear_vertex(ray, sh, v2), t_min, t_max);
 }
 
 // Ray-sphere: the quadratic |o + t d - c|^2 = r^2 with |d| = 1, i.e. t^2 - 2 b t + c = 0 with

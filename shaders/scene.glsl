@@ -65,6 +65,13 @@ bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max
   return false;
 }
 
+// ---- Small scenes, compiled into the shader (host/gpu/inline_scene.h) ----------------------------------
+// The generated test_inline_primitives() (contract in inline_scene.glsl) shears each distinct
+// vertex once (shear_point) and tests each triangle with sheared_triangle (intersect.glsl), in the
+// scene's order.
+
+#include "inline_scene.glsl"
+
 // Puts the pair with the smaller key first.
 void order_pair(inout float key_a, inout uint link_a, inout float key_b, inout uint link_b) {
   bool swap = key_b < key_a;
@@ -135,6 +142,11 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   uint hit_index = 0u;
   if (frame.primitive_count == 0u) return hit;
   RayShear shear = ray_shear(ray.dir);
+#ifdef VKRAY_INLINE_SCENE
+  float limit = t_max;
+  test_inline_primitives(ray, shear, t_min, any_hit, hit, limit);
+  return hit;
+#endif
   vec3 inv_dir = safe_inverse(ray.dir);
   // The slab test's near plane on each axis is the box's low side when the ray goes up that axis.
   bvec3 backward = lessThan(inv_dir, vec3(0.0));

@@ -86,7 +86,24 @@ TEST(CliTest, UsageErrorsExitTwo) {
   EXPECT_EQ(vkray("render --spp 0", dir.path()).exit_code, 2);
   EXPECT_EQ(vkray("render --width -3", dir.path()).exit_code, 2);
   EXPECT_EQ(vkray("render --no-such-flag", dir.path()).exit_code, 2);
+  const Result bad_path = vkray("render --inline-scene sometimes", dir.path());
+  EXPECT_EQ(bad_path.exit_code, 2);
+  EXPECT_NE(bad_path.err.find("sometimes not in {auto,always,never}"), std::string::npos) << bad_path.err;
   EXPECT_FALSE(has_image_files(dir.path()));
+}
+
+TEST(CliTest, InlineSceneChoosesTheGpuPathAndSaysWhichItTook) {
+  TempDir dir;
+  const Result compiled_in = vkray("render --inline-scene always --width 40 --height 30 -o a.png", dir.path());
+  ASSERT_EQ(compiled_in.exit_code, 0) << compiled_in.err;
+  EXPECT_NE(compiled_in.err.find("scene compiled into the shader"), std::string::npos) << compiled_in.err;
+  const Result bvh = vkray("render --inline-scene never --width 40 --height 30 -o b.png", dir.path());
+  ASSERT_EQ(bvh.exit_code, 0) << bvh.err;
+  EXPECT_EQ(bvh.err.find("compiled into"), std::string::npos) << bvh.err;
+  // auto: too few camera rays at 40 x 30 to repay the compile.
+  const Result automatic = vkray("render --width 40 --height 30 -o c.png", dir.path());
+  ASSERT_EQ(automatic.exit_code, 0) << automatic.err;
+  EXPECT_EQ(automatic.err.find("compiled into"), std::string::npos) << automatic.err;
 }
 
 TEST(CliTest, UnknownOutputTypeExitsOneBeforeRendering) {
@@ -178,6 +195,8 @@ TEST(CliTest, BenchPrintsJsonForEachScene) {
   ASSERT_EQ(j.size(), 2u);
   EXPECT_EQ(j[1].at("scene"), "teapot");
   EXPECT_EQ(j[1].at("triangles"), 6322);
+  EXPECT_EQ(j[0].at("gpu_path"), "bvh");  // 32 x 32: too few camera rays to compile the Cornell box in
+  EXPECT_EQ(j[1].at("gpu_path"), "bvh");
   for (const char* mode : {"primary", "primary_shadow"}) {
     EXPECT_GT(j[0].at(mode).at("gpu_mrays").get<double>(), 0.0);
     EXPECT_GT(j[0].at(mode).at("cpu_reference_mrays").get<double>(), 0.0);

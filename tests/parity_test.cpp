@@ -35,15 +35,21 @@ Scene scaled(Scene s, float k) {
 struct SceneCase {
   std::string file;
   uint32_t spp;
+  bool compiled_in = false;  // gpu::InlineScene::always (the scene small enough), else the BVH
 };
-void PrintTo(const SceneCase& c, std::ostream* os) { *os << c.file << " at " << c.spp << " spp"; }
+void PrintTo(const SceneCase& c, std::ostream* os) {
+  *os << c.file << " at " << c.spp << " spp" << (c.compiled_in ? ", compiled into the shader" : "");
+}
 
 class SceneParityTest : public ParityTest, public ::testing::WithParamInterface<SceneCase> {};
 
 TEST_P(SceneParityTest, WithinTolerance) {
   const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / GetParam().file);
-  const ParityRun r = run(scene, {256, 256, GetParam().spp});
-  expect_parity(r, scene.name + "-" + std::to_string(GetParam().spp) + "spp");
+  const bool compiled_in = GetParam().compiled_in;
+  const ParityRun r =
+      run(scene, {256, 256, GetParam().spp}, compiled_in ? gpu::InlineScene::always : gpu::InlineScene::never);
+  EXPECT_EQ(r.inline_scene, compiled_in);
+  expect_parity(r, scene.name + "-" + std::to_string(GetParam().spp) + "spp" + (compiled_in ? "-inline" : ""));
   EXPECT_EQ(r.metrics.interior_over_2, 0u);
 }
 
@@ -55,6 +61,9 @@ std::vector<SceneCase> scene_cases() {
   std::sort(files.begin(), files.end());
   for (const auto& f : files)
     for (uint32_t spp : {1u, 16u}) cases.push_back({f, spp});
+  // The shipped scenes small enough to be compiled into the shader (gpu::kMaxInlinePrimitives).
+  for (const char* f : {"cornell.json", "cornell-spheres.json"})
+    for (uint32_t spp : {1u, 16u}) cases.push_back({f, spp, true});
   return cases;
 }
 
@@ -62,33 +71,43 @@ INSTANTIATE_TEST_SUITE_P(Scenes, SceneParityTest, ::testing::ValuesIn(scene_case
                          [](const ::testing::TestParamInfo<SceneCase>& param) {
                            std::string name = param.param.file.substr(0, param.param.file.size() - 5);
                            std::replace(name.begin(), name.end(), '-', '_');
-                           return name + "_" + std::to_string(param.param.spp) + "spp";
+                           return name + "_" + std::to_string(param.param.spp) + "spp" +
+                                  (param.param.compiled_in ? "_inline" : "");
                          });
 
-// ---- Adversarial cases -------------------------------------------------------------------------------
-class AdversarialParityTest : public ParityTest {
+// ---- Adversarial cases, on both GPU paths ------------------------------------------------------------
+// Each case runs with the BVH and with the scene compiled into the shader (gpu::InlineScene), the
+// second skipped where the scene is too large to compile in.
+class AdversarialParityTest : public ParityTest, public ::testing::WithParamInterface<gpu::InlineScene> {
  protected:
   ParityRun check(const Scene& scene, const std::string& name, ImageSettings image = {128, 128, 1}) {
-    ParityRun r = run(scene, image);
-    expect_parity(r, name);
+    const bool compiled_in = GetParam() == gpu::InlineScene::always;
+    if (compiled_in && scene.triangles.size() + scene.spheres.size() > gpu::kMaxInlinePrimitives) {
+      ADD_FAILURE() << name << ": more than " << gpu::kMaxInlinePrimitives << " primitives, too large to compile in";
+      return {};
+    }
+    ParityRun r = run(scene, image, GetParam());
+    EXPECT_EQ(r.inline_scene, compiled_in);
+    expect_parity(r, name + (compiled_in ? "-inline" : ""));
     return r;
   }
 };
 
-TEST_F(AdversarialParityTest, GrazingRaysAlongAWall) {
+TEST_P(AdversarialParityTest, GrazingRaysAlongAWall) {
   Scene s = cornell();
   s.camera.position = {-0.995f, 0.0f, -0.99f};  // 5 thousandths from the left wall, looking along it
   s.camera.focal_length = 0.6f;
   check(s, "grazing-along-wall");
 }
 
-TEST_F(AdversarialParityTest, SharedEdgesHaveNoCracks) {
+TEST_P(AdversarialParityTest, SharedEdgesHaveNoCracks) {
   // A 40 x 40 grid of quads (3200 triangles sharing edges) filling the view; background magenta.
+  // With the scene compiled in: a 4 x 4 grid (32 triangles) instead.
   Scene s = cornell();
   s.triangles.clear();
   s.background = {1, 0, 1};
-  const int n = 40;
-  auto p = [&](int i, int j) { return glm::vec3(-3.0f + 6.0f * float(i) / n, -3.0f + 6.0f * float(j) / n, 0.3f * std::sin(float(i + j))); };
+  const int n = GetParam() == gpu::InlineScene::always ? 4 : 40;
+  auto p = [&](int i, int j) { return glm::vec3(-3.0f + 6.0f * float(i) / float(n), -3.0f + 6.0f * float(j) / float(n), 0.3f * std::sin(float(i + j))); };
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
       s.triangles.push_back({{p(i, j), p(i + 1, j), p(i + 1, j + 1)}, 6});
@@ -103,26 +122,26 @@ TEST_F(AdversarialParityTest, SharedEdgesHaveNoCracks) {
   }
 }
 
-TEST_F(AdversarialParityTest, LightExactlyOnASurface) {
+TEST_P(AdversarialParityTest, LightExactlyOnASurface) {
   Scene s = cornell();
   s.lights[0].position = {0.0f, -1.0f, -0.3f};  // on the ceiling plane
   check(s, "light-on-surface");
 }
 
-TEST_F(AdversarialParityTest, LightInThePlaneOfATriangle) {
+TEST_P(AdversarialParityTest, LightInThePlaneOfATriangle) {
   Scene s = cornell();
   // Level with the short block's top face (triangle 18), beside the block: shadow rays graze the face.
   s.lights[0].position = {0.9f, s.triangles[18].v[0].y, -0.5f};
   check(s, "light-in-triangle-plane");
 }
 
-TEST_F(AdversarialParityTest, CameraInThePlaneOfTheFloor) {
+TEST_P(AdversarialParityTest, CameraInThePlaneOfTheFloor) {
   Scene s = cornell();
   s.camera.position = {0.0f, s.triangles[0].v[0].y, -0.9f};
   check(s, "camera-in-floor-plane");
 }
 
-TEST_F(AdversarialParityTest, CameraInsideASphere) {
+TEST_P(AdversarialParityTest, CameraInsideASphere) {
   Scene s = cornell();
   s.triangles.clear();
   s.spheres = {{{0, 0, 0}, 3.0f, 6}, {{0.3f, 0.2f, 1.2f}, 0.5f, 0}};
@@ -131,11 +150,11 @@ TEST_F(AdversarialParityTest, CameraInsideASphere) {
   check(s, "camera-inside-sphere");
 }
 
-TEST_F(AdversarialParityTest, SmallSceneScale) { check(scaled(cornell(), 1e-3f), "scale-1e-3"); }
+TEST_P(AdversarialParityTest, SmallSceneScale) { check(scaled(cornell(), 1e-3f), "scale-1e-3"); }
 
-TEST_F(AdversarialParityTest, LargeSceneScale) { check(scaled(cornell(), 1e4f), "scale-1e4"); }
+TEST_P(AdversarialParityTest, LargeSceneScale) { check(scaled(cornell(), 1e4f), "scale-1e4"); }
 
-TEST_F(AdversarialParityTest, LightBehindASurface) {
+TEST_P(AdversarialParityTest, LightBehindASurface) {
   Scene s = cornell();
   s.lights[0].position = {0.0f, -0.5f, 1.5f};  // behind the back wall: only ambient reaches the room
   const ParityRun r = check(s, "light-behind-surface");
@@ -143,7 +162,7 @@ TEST_F(AdversarialParityTest, LightBehindASurface) {
   EXPECT_NEAR(r.gpu.at(64, 40).r, 0.75f * 0.1f, 1e-6f);
 }
 
-TEST_F(AdversarialParityTest, SixteenLights) {
+TEST_P(AdversarialParityTest, SixteenLights) {
   Scene s = cornell();
   const PointLight base = s.lights[0];
   s.lights.clear();
@@ -152,6 +171,11 @@ TEST_F(AdversarialParityTest, SixteenLights) {
       s.lights.push_back({{-0.75f + 0.5f * float(i), -0.9f, -0.75f + 0.5f * float(j)}, base.intensity / 16.0f});
   check(s, "sixteen-lights");
 }
+
+INSTANTIATE_TEST_SUITE_P(Paths, AdversarialParityTest, ::testing::Values(gpu::InlineScene::never, gpu::InlineScene::always),
+                         [](const ::testing::TestParamInfo<gpu::InlineScene>& param) {
+                           return param.param == gpu::InlineScene::always ? "inline" : "bvh";
+                         });
 
 // ---- The comparison itself can fail -------------------------------------------------------------------
 class ComparisonTest : public ParityTest {

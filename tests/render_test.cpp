@@ -2,14 +2,19 @@
 // the GPU path and the CPU reference must each get them right on their own.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <numbers>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
 #include "gpu/renderer.h"
 #include "gpu/shader_compiler.h"
+#include "errors.h"
 #include "support/gpu_fixture.h"
+#include "support/temp_dir.h"
 #include "cpu/reference.h"
 
 namespace vkray::test {
@@ -21,11 +26,14 @@ class RenderTest : public GpuTest {
  protected:
   Image render(const Scene& scene, ImageSettings image, gpu::RenderOptions options = {}, bool cpu = false) {
     if (cpu) return cpu::render_reference(scene, image).image;
+    return gpu::render(ctx(), *pipeline(), scene, image, options);
+  }
+  const gpu::TracePipeline* pipeline() {
     if (!pipeline_) {
       const auto shader = gpu::compile_compute_shader(std::filesystem::path(VKRAY_SHADER_DIR) / "trace.comp", {VKRAY_SHADER_DIR});
-      pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), shader.spirv);
+      pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), VKRAY_SHADER_DIR, shader.spirv);
     }
-    return gpu::render(ctx(), *pipeline_, scene, image, options);
+    return pipeline_.get();
   }
   void TearDown() override {
     pipeline_.reset();
@@ -42,12 +50,18 @@ void expect_radiance(glm::vec3 actual, glm::dvec3 expected, const char* what) {
 // ---- The Cornell box at 256x256: camera (0,0,-3) looking along +z, up (0,-1,0), F = 256 px, so pixel
 // (i, j) looks along (x, -y, 256) with x = i + 0.5 - 128, y = 128 - (j + 0.5). One light of power
 // 14 (I = 14/4pi) at (0,-0.5,-0.7), ambient 0.1. ----------------------------------------------------
-class CornellTest : public RenderTest, public ::testing::WithParamInterface<bool> {
+enum class Renderer { gpu_bvh, gpu_inline, cpu };
+const char* name(Renderer r) { return r == Renderer::cpu ? "cpu" : r == Renderer::gpu_inline ? "gpu_inline" : "gpu"; }
+void PrintTo(Renderer r, std::ostream* os) { *os << name(r); }
+
+class CornellTest : public RenderTest, public ::testing::WithParamInterface<Renderer> {
  protected:
   void SetUp() override {
     RenderTest::SetUp();
     scene_ = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
-    image_ = render(scene_, {256, 256, 1}, {}, /*cpu=*/GetParam());
+    gpu::RenderOptions options;
+    options.inline_scene = GetParam() == Renderer::gpu_inline ? gpu::InlineScene::always : gpu::InlineScene::never;
+    image_ = render(scene_, {256, 256, 1}, options, /*cpu=*/GetParam() == Renderer::cpu);
   }
   void TearDown() override { RenderTest::TearDown(); }
   Scene scene_;
@@ -153,8 +167,80 @@ TEST_F(RenderTest, TilesCoverTheImageExactly) {
   for (size_t i = 0; i < whole.pixels.size(); ++i) ASSERT_EQ(whole.pixels[i], tiled.pixels[i]) << "pixel " << i;
 }
 
-INSTANTIATE_TEST_SUITE_P(Renderers, CornellTest, ::testing::Values(false, true),
-                         [](const ::testing::TestParamInfo<bool>& param) { return param.param ? "cpu" : "gpu"; });
+// ---- A small scene compiled into the shader (gpu::InlineScene) ----------------------------------------
+gpu::RenderOptions path(gpu::InlineScene inline_scene) {
+  gpu::RenderOptions options;
+  options.inline_scene = inline_scene;
+  return options;
+}
+
+TEST_F(RenderTest, SceneCompiledInMatchesTheBvhPixelForPixel) {
+  // The same triangle and sphere tests, and the same tie rule, so the same image; a difference means
+  // the generated code lost or misplaced a primitive.
+  for (const char* file : {"cornell.json", "cornell-spheres.json"}) {
+    const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / file);
+    const Image bvh = render(scene, {96, 64, 2}, path(gpu::InlineScene::never));
+    const Image compiled_in = render(scene, {96, 64, 2}, path(gpu::InlineScene::always));
+    ASSERT_EQ(bvh.pixels.size(), compiled_in.pixels.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < bvh.pixels.size(); ++i) differ += bvh.pixels[i] != compiled_in.pixels[i];
+    EXPECT_EQ(differ, 0u) << file;
+  }
+}
+
+TEST_F(RenderTest, PolicyChoosesThePath) {
+  const Scene cornell = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
+  const gpu::GpuScene small(ctx(), cornell);
+  EXPECT_FALSE(gpu::use_inline_scene(small, {512, 512, 1}, gpu::InlineScene::automatic));  // 2^18 camera rays
+  EXPECT_TRUE(gpu::use_inline_scene(small, {1024, 1024, 1}, gpu::InlineScene::automatic));
+  EXPECT_TRUE(gpu::use_inline_scene(small, {512, 512, 4}, gpu::InlineScene::automatic));
+  EXPECT_TRUE(gpu::use_inline_scene(small, {8, 8, 1}, gpu::InlineScene::always));
+  EXPECT_FALSE(gpu::use_inline_scene(small, {4096, 4096, 1}, gpu::InlineScene::never));
+
+  Scene larger = cornell;  // one triangle over the limit
+  while (larger.triangles.size() <= gpu::kMaxInlinePrimitives) larger.triangles.push_back(larger.triangles.back());
+  const gpu::GpuScene large(ctx(), larger);
+  EXPECT_TRUE(large.inline_scene().empty());
+  EXPECT_FALSE(gpu::use_inline_scene(large, {4096, 4096, 1}, gpu::InlineScene::always));
+  gpu::RenderStats stats;
+  gpu::render(ctx(), *pipeline(), large, {16, 16, 1}, path(gpu::InlineScene::always), &stats);
+  EXPECT_FALSE(stats.inline_scene);
+  gpu::render(ctx(), *pipeline(), small, {16, 16, 1}, path(gpu::InlineScene::always), &stats);
+  EXPECT_TRUE(stats.inline_scene);
+}
+
+TEST_F(RenderTest, GeneratedCodeThatDoesNotCompileIsAShaderError) {
+  // A shader folder whose scene.glsl no longer gives the generated code what it calls: its own
+  // SPIR-V compiles (nothing after the include calls shear_point), the scene's does not, and the
+  // message says where.
+  TempDir dir;
+  std::filesystem::copy(VKRAY_SHADER_DIR, dir.path(), std::filesystem::copy_options::recursive);
+  std::string text;
+  {
+    std::ifstream in(dir / "scene.glsl");
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::string include = "#include \"inline_scene.glsl\"";
+  ASSERT_NE(text.find(include), std::string::npos);
+  text.replace(text.find(include), 0, "#define shear_point(a, k, s) missing_function(a)\n");
+  std::ofstream(dir / "scene.glsl") << text;
+
+  const auto shader = gpu::compile_compute_shader(dir / "trace.comp", {dir.path()});
+  const gpu::TracePipeline pipeline(ctx(), dir.path(), shader.spirv);
+  const Scene cornell = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
+  const gpu::GpuScene scene(ctx(), cornell);
+  EXPECT_NO_THROW(pipeline.pipeline(gpu::shader_variant(scene, {64, 64, 1}, gpu::InlineScene::never)));
+  try {
+    pipeline.pipeline(gpu::shader_variant(scene, {64, 64, 1}, gpu::InlineScene::always));
+    ADD_FAILURE() << "no ShaderError";
+  } catch (const ShaderError& e) {
+    EXPECT_NE(std::string(e.what()).find("inline_scene.glsl (generated):"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("missing_function"), std::string::npos) << e.what();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Renderers, CornellTest, ::testing::Values(Renderer::gpu_bvh, Renderer::gpu_inline, Renderer::cpu),
+                         [](const ::testing::TestParamInfo<Renderer>& param) { return name(param.param); });
 
 }  // namespace
 }  // namespace vkray::test

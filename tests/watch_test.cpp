@@ -10,6 +10,7 @@
 
 #include "image.h"
 #include "support/child_process.h"
+#include "support/run_vkray.h"
 #include "support/temp_dir.h"
 
 namespace vkray::test {
@@ -137,6 +138,33 @@ TEST_F(WatchTest, SceneEditsRerenderAndABrokenSceneIsSurvived) {
   const auto fixed = expect_line("reload 3");
   ASSERT_TRUE(fixed);
   EXPECT_NE(fixed->find("render"), std::string::npos) << *fixed;
+}
+
+TEST_F(WatchTest, ASceneCompiledIntoTheShaderFollowsGeometryEditsAndShaderEdits) {
+  // Geometry is constants in the shader there (gpu::InlineScene): a scene edit must recompile it.
+  // Each image must be what a one-shot render through the BVH gives for the same files.
+  start({"--inline-scene", "always"});
+  const auto reference = [&](const std::string& name) {
+    const auto run = run_vkray("render cornell.json --shader-dir shaders --inline-scene never --width 64 --height 64 -o " +
+                                   name, dir_.path());
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return read_pfm(dir_ / name);
+  };
+  // (EXPECT_TRUE, not EXPECT_EQ: gtest would print all 4096 pixels of a mismatch.)
+  const Image before = reference("before.pfm");
+  EXPECT_TRUE(image().pixels == before.pixels);
+
+  save_by_rename("cornell.json", replaced("cornell.json", "[555, 0, 0]", "[555, 150, 0]"));  // tilt the floor
+  const auto line = expect_line("reload 1");
+  ASSERT_TRUE(line);
+  EXPECT_NE(line->find("render"), std::string::npos) << *line;
+  const Image tilted = image();
+  EXPECT_FALSE(tilted.pixels == before.pixels) << "the edit changed nothing";
+  EXPECT_TRUE(tilted.pixels == reference("tilted.pfm").pixels);
+
+  save_by_rename("shaders/trace.comp", replaced("shaders/trace.comp", kScale, kScale + " * 0.5"));
+  ASSERT_TRUE(expect_line("reload 2"));
+  EXPECT_TRUE(image().pixels == reference("half.pfm").pixels);
 }
 
 std::pair<long, long> WatchTest::twenty_reloads() {

@@ -42,6 +42,7 @@ struct SceneResult {
   size_t triangles = 0;
   double load_ms = 0, bvh_ms = 0, embree_build_ms = 0;
   double gpu_frame_ms[2] = {0, 0};  // median trace time, primary / with shadows
+  bool inline_scene = false;        // the GPU path ran the scene compiled into the shader, not the BVH
   Rates rates[2];                   // [0] camera rays only, [1] with shadow rays
 };
 
@@ -74,7 +75,7 @@ int run_bench(const BenchCommand& cmd) {
   options.device = cmd.device;
   gpu::Context ctx(options);
   const std::filesystem::path shader_dir = cmd.shader_dir.empty() ? default_shader_dir() : cmd.shader_dir;
-  const gpu::TracePipeline pipeline(ctx, gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir}).spirv);
+  const gpu::TracePipeline pipeline(ctx, shader_dir, gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir}).spirv);
   std::cerr << "vkray bench: device " << ctx.device_name() << " (" << ctx.driver_name() << "); CPU reference and "
             << (with_embree ? embree_name() : std::string("no Embree"))
             << " on " << threads << " threads; " << cmd.width << "x" << cmd.height << ", 1 sample per pixel, "
@@ -99,12 +100,17 @@ int run_bench(const BenchCommand& cmd) {
     }
 #endif
     const ImageSettings image{cmd.width, cmd.height, 1};
-    gpu::render(ctx, pipeline, gpu_scene, {64, 64, 1});  // warm-up: lavapipe compiles on first dispatch
+    // The path the measured renders take, decided once, so that the warm-up render (lavapipe compiles
+    // on the first dispatch) uses the same pipeline.
+    gpu::RenderOptions warm_up;
+    r.inline_scene = gpu::use_inline_scene(gpu_scene, image, cmd.inline_scene);
+    warm_up.inline_scene = r.inline_scene ? gpu::InlineScene::always : gpu::InlineScene::never;
+    gpu::render(ctx, pipeline, gpu_scene, {64, 64, 1}, warm_up);
     std::vector<double> frame_ms[2];
     for (unsigned round = 0; round < cmd.repeat; ++round) {
       for (int mode = 0; mode < 2; ++mode) {
         const bool shadows = mode == 1;
-        gpu::RenderOptions render_options;
+        gpu::RenderOptions render_options = warm_up;
         render_options.shadows = shadows;
         gpu::RenderStats stats;
         gpu::render(ctx, pipeline, gpu_scene, image, render_options, &stats);
@@ -135,7 +141,8 @@ int run_bench(const BenchCommand& cmd) {
     nlohmann::json out = nlohmann::json::array();
     for (const auto& r : results) {
       nlohmann::json j = {{"scene", r.name}, {"triangles", r.triangles}, {"width", cmd.width}, {"height", cmd.height},
-                          {"bvh_build_ms", r.bvh_ms}, {"device", ctx.device_name()}, {"threads", threads}};
+                          {"bvh_build_ms", r.bvh_ms}, {"device", ctx.device_name()}, {"threads", threads},
+                          {"gpu_path", r.inline_scene ? "inline" : "bvh"}};
       for (int mode = 0; mode < 2; ++mode) {
         const std::string key = mode == 0 ? "primary" : "primary_shadow";
         nlohmann::json m = {{"gpu_mrays", median(r.rates[mode].gpu)}, {"gpu_trace_ms", r.gpu_frame_ms[mode]}};
@@ -157,7 +164,7 @@ int run_bench(const BenchCommand& cmd) {
   std::printf("%-13s %9s %9s %9s | %8s %8s %8s %8s %8s | %8s %8s %8s %8s %8s\n", "scene", "triangles", "vkray ms", "Embree ms", "GPU",
               "GPU ms", "CPU ref", "Embree", "GPU/Emb", "GPU", "GPU ms", "CPU ref", "Embree", "GPU/Emb");
   for (const auto& r : results) {
-    std::printf("%-13s %9zu %9s %9s", r.name.c_str(), r.triangles, fixed(r.bvh_ms, 1).c_str(),
+    std::printf("%-13s %9zu %9s %9s", (r.name + (r.inline_scene ? " *" : "")).c_str(), r.triangles, fixed(r.bvh_ms, 1).c_str(),
                 with_embree ? fixed(r.embree_build_ms, 1).c_str() : "-");
     for (int mode = 0; mode < 2; ++mode) {
       const double gpu = median(r.rates[mode].gpu), embree = median(r.rates[mode].embree);
@@ -167,6 +174,8 @@ int run_bench(const BenchCommand& cmd) {
     }
     std::printf("\n");
   }
+  if (std::any_of(results.begin(), results.end(), [](const SceneResult& r) { return r.inline_scene; }))
+    std::printf("* GPU path: the scene compiled into the shader, no BVH (--inline-scene never to measure the BVH)\n");
   return kExitOk;
 }
 

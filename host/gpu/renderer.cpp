@@ -10,7 +10,9 @@
 #include "errors.h"
 #include "gpu/buffer.h"
 #include "bvh.h"
+#include "gpu/inline_scene.h"
 #include "gpu/scene_packing.h"
+#include "gpu/shader_compiler.h"
 
 namespace vkray::gpu {
 namespace {
@@ -24,6 +26,14 @@ double seconds_since(Clock::time_point start) {
 // One submission aims at about this many ray-primitive tests: a fraction of a second on lavapipe
 // with 2 cores, so no single submission runs long (lavapipe has no GPU watchdog to stop one).
 constexpr double kTestsPerTile = double(1 << 26);
+
+// Compiling a scene into the shader makes pipeline creation slower (lavapipe, the Cornell box's 30
+// triangles: about XXX ms more) and each camera ray with its shadow rays cheaper (XXX); below
+// this many camera rays the BVH is quicker overall. Measured: README, "Benchmark".
+constexpr uint64_t kInlineMinCameraRays = uint64_t(1) << 20;
+
+// Pipelines kept for scenes compiled in (`vkray watch` makes one for every edit of a small scene).
+constexpr size_t kKeptInlinePipelines = 4;
 
 constexpr vk::DescriptorType kTexel = vk::DescriptorType::eUniformTexelBuffer;
 
@@ -69,8 +79,9 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
 
 }  // namespace
 
-TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv, const vk::raii::PipelineCache* cache)
-    : device_(&ctx.device()), cache_(cache) {
+TracePipeline::TracePipeline(const Context& ctx, std::filesystem::path shader_dir, const std::vector<uint32_t>& spirv,
+                             const vk::raii::PipelineCache* cache)
+    : device_(&ctx.device()), cache_(cache), shader_dir_(std::move(shader_dir)) {
   using S = vk::ShaderStageFlagBits;
   const vk::DescriptorSetLayoutBinding bindings[] = {
       {VKRAY_BINDING_FRAME, vk::DescriptorType::eUniformBuffer, 1, S::eCompute},
@@ -90,19 +101,50 @@ TracePipeline::TracePipeline(const Context& ctx, const std::vector<uint32_t>& sp
 
 TracePipeline::~TracePipeline() = default;
 
-ShaderVariant shader_variant(const Scene& scene) { return ShaderVariant{.spheres = !scene.spheres.empty()}; }
+bool use_inline_scene(const GpuScene& scene, const ImageSettings& image, InlineScene policy) {
+  if (policy == InlineScene::never || scene.inline_scene().empty()) return false;
+  if (policy == InlineScene::always) return true;
+  const uint64_t camera_rays = uint64_t(image.width) * image.height * image.samples_per_pixel;
+  return camera_rays >= kInlineMinCameraRays;
+}
 
-const vk::raii::Pipeline& TracePipeline::pipeline(const Scene& scene) const {
-  const ShaderVariant variant = shader_variant(scene);
+ShaderVariant shader_variant(const GpuScene& scene, const ImageSettings& image, InlineScene policy) {
+  ShaderVariant variant;
+  variant.spheres = !scene.scene().spheres.empty();
+  if (use_inline_scene(scene, image, policy)) variant.inline_scene = scene.inline_scene();
+  return variant;
+}
+
+std::shared_ptr<const vk::raii::Pipeline> TracePipeline::pipeline(const ShaderVariant& variant) const {
   const std::lock_guard lock(mutex_);
   if (const auto found = pipelines_.find(variant); found != pipelines_.end()) return found->second;
+  auto created = create(variant);
+  if (!variant.inline_scene.empty()) {
+    inline_order_.push_back(variant);
+    if (inline_order_.size() > kKeptInlinePipelines) {  // a render still using it holds its own reference
+      pipelines_.erase(inline_order_.front());
+      inline_order_.pop_front();
+    }
+  }
+  return pipelines_.emplace(variant, std::move(created)).first->second;
+}
+
+std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVariant& variant) const {
+  // A scene compiled in is a module of its own; the module may go once the pipeline exists.
+  vk::raii::ShaderModule inline_module{nullptr};
+  if (!variant.inline_scene.empty()) {
+    const auto spirv =
+        compile_compute_shader(shader_dir_ / "trace.comp", {shader_dir_}, {{"inline_scene.glsl", variant.inline_scene}}).spirv;
+    inline_module = vk::raii::ShaderModule(*device_, vk::ShaderModuleCreateInfo({}, spirv));
+  }
+  const vk::ShaderModule module = variant.inline_scene.empty() ? *module_ : *inline_module;
   const VkBool32 spheres = variant.spheres;
   const vk::SpecializationMapEntry entry(VKRAY_SPEC_SPHERES, 0, sizeof(spheres));
   const vk::SpecializationInfo specialization(entry, vk::ArrayProxyNoTemporaries<const VkBool32>(spheres));
-  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *module_, "main", &specialization);
-  vk::raii::Pipeline created(*device_, cache_ ? vk::Optional<const vk::raii::PipelineCache>(*cache_) : nullptr,
-                             vk::ComputePipelineCreateInfo({}, stage, *layout_));
-  return pipelines_.emplace(variant, std::move(created)).first->second;
+  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, module, "main", &specialization);
+  return std::make_shared<const vk::raii::Pipeline>(
+      *device_, cache_ ? vk::Optional<const vk::raii::PipelineCache>(*cache_) : nullptr,
+      vk::ComputePipelineCreateInfo({}, stage, *layout_));
 }
 
 uint32_t tile_side(const Scene& scene, const ImageSettings& image) {
@@ -127,6 +169,7 @@ GpuScene::GpuScene(const Context& ctx, const Scene& scene, const Bvh* prebuilt) 
   bvh_seconds_ = bvh.build_seconds;
   primitive_count_ = uint32_t(bvh.order.size());
   const PackedScene packed = pack_scene(scene, bvh);
+  if (primitive_count_ <= kMaxInlinePrimitives) inline_scene_ = inline_scene_glsl(packed);
   check_memory(ctx, packed);
   buffers_ = std::make_unique<Buffers>(Buffers{make_texel_buffer(ctx, packed.primitives, "primitive"),
                                                make_texel_buffer(ctx, packed.normals, "normal"),
@@ -195,7 +238,9 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
   stats.upload_seconds = seconds_since(start);
 
   // ---- trace, one submission per tile ----
-  const vk::raii::Pipeline& compute_pipeline = pipeline.pipeline(scene);  // compiled here unless asked for before
+  const ShaderVariant variant = shader_variant(gpu_scene, image, options.inline_scene);
+  stats.inline_scene = !variant.inline_scene.empty();
+  const auto compute_pipeline = pipeline.pipeline(variant);  // compiled here unless asked for before
   start = Clock::now();
   const vk::raii::CommandPool command_pool(device, {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, ctx.queue_family()});
   vk::raii::CommandBuffers cbs(device, {*command_pool, vk::CommandBufferLevel::ePrimary, 1});
@@ -216,7 +261,7 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
 
     cb.reset();
     cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
-    cb.bindPipeline(vk::PipelineBindPoint::eCompute, *compute_pipeline);
+    cb.bindPipeline(vk::PipelineBindPoint::eCompute, **compute_pipeline);
     cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline.layout(), 0, set, {});
     cb.pushConstants<TileConstants>(*pipeline.layout(), vk::ShaderStageFlagBits::eCompute, 0, tile);
     cb.dispatch(groups_x, groups_y, 1);

@@ -5,16 +5,20 @@
 #include <chrono>
 #include <compare>
 #include <cstdint>
+#include <deque>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include <vulkan/vulkan_raii.hpp>
 
 #include "errors.h"
 #include "gpu/context.h"
+#include "gpu/inline_scene.h"
 #include "image.h"
 #include "scene.h"
 
@@ -24,40 +28,54 @@ struct Bvh;
 
 namespace vkray::gpu {
 
-// What a scene needs of the shader, given to it as specialization constants (shared/types.h), so
-// that the pipeline for a scene has no code for what the scene lacks: on llvmpipe code behind an if
-// costs every lane even when no lane takes it.
+// What a scene needs of the shader: specialization constants (shared/types.h), so that the
+// pipeline for a scene has no code for what the scene lacks (on llvmpipe code behind an if costs
+// every lane even when no lane takes it), and the scene's own code when it is compiled in.
 struct ShaderVariant {
-  bool spheres = true;  // VKRAY_SPEC_SPHERES
+  bool spheres = true;       // VKRAY_SPEC_SPHERES
+  std::string inline_scene;  // served as shaders/inline_scene.glsl; empty: that file, and the BVH is walked
 
   auto operator<=>(const ShaderVariant&) const = default;
 };
 
-ShaderVariant shader_variant(const Scene& scene);
+class GpuScene;
+
+// Whether a render of `scene` at `image` uses the code compiled from it, under `policy`.
+bool use_inline_scene(const GpuScene& scene, const ImageSettings& image, InlineScene policy);
+
+ShaderVariant shader_variant(const GpuScene& scene, const ImageSettings& image, InlineScene policy);
 
 // Descriptor set layout, pipeline layout and the pipelines for shaders/trace.comp's interface, one
-// per ShaderVariant, each compiled the first time a scene needs it.
+// per ShaderVariant, each compiled the first time a render needs it.
 class TracePipeline {
  public:
-  // `cache` (optional; it must outlive this) makes re-creating a pipeline from SPIR-V seen before in
-  // this process cheap.
-  TracePipeline(const Context& ctx, const std::vector<uint32_t>& spirv, const vk::raii::PipelineCache* cache = nullptr);
+  // `spirv`: shader_dir/trace.comp compiled as it is (compile_compute_shader); variants with a
+  // scene compiled in are compiled from shader_dir when first needed. `cache` (optional; it must
+  // outlive this) makes re-creating a pipeline from SPIR-V seen before in this process cheap.
+  TracePipeline(const Context& ctx, std::filesystem::path shader_dir, const std::vector<uint32_t>& spirv,
+                const vk::raii::PipelineCache* cache = nullptr);
   ~TracePipeline();
 
   const vk::raii::DescriptorSetLayout& set_layout() const { return set_layout_; }
   const vk::raii::PipelineLayout& layout() const { return layout_; }
-  // The pipeline for `scene`, compiled now if no scene before needed the same variant. Callers that
-  // time compilation apart from tracing call this before rendering.
-  const vk::raii::Pipeline& pipeline(const Scene& scene) const;
+  // The pipeline for `variant`, compiled now if not kept from before. Callers that time compilation
+  // apart from tracing call this before rendering. Throws ShaderError when the shaders do not compile
+  // with a scene's generated code (a shader folder whose scene.glsl no longer fits the contract in
+  // inline_scene.glsl). The few most recent variants with a scene compiled in are kept.
+  std::shared_ptr<const vk::raii::Pipeline> pipeline(const ShaderVariant& variant) const;
 
  private:
+  std::shared_ptr<const vk::raii::Pipeline> create(const ShaderVariant& variant) const;
+
   const vk::raii::Device* device_;
   const vk::raii::PipelineCache* cache_;
+  std::filesystem::path shader_dir_;
   vk::raii::DescriptorSetLayout set_layout_{nullptr};
   vk::raii::PipelineLayout layout_{nullptr};
   vk::raii::ShaderModule module_{nullptr};
   mutable std::mutex mutex_;
-  mutable std::map<ShaderVariant, vk::raii::Pipeline> pipelines_;
+  mutable std::map<ShaderVariant, std::shared_ptr<const vk::raii::Pipeline>> pipelines_;
+  mutable std::deque<ShaderVariant> inline_order_;  // variants with a scene compiled in, oldest first
 };
 
 // A scene on the device: its BVH built and its buffers uploaded, ready for any number of renders.
@@ -69,6 +87,9 @@ class GpuScene {
   GpuScene(GpuScene&&) noexcept;
 
   const Scene& scene() const { return *scene_; }
+  // The code that compiles this scene into the shader (inline_scene_glsl); empty for a scene with
+  // more than kMaxInlinePrimitives primitives, or none.
+  const std::string& inline_scene() const { return inline_scene_; }
   double bvh_seconds() const { return bvh_seconds_; }
   double upload_seconds() const { return upload_seconds_; }  // BVH build included
   uint32_t primitive_count() const { return primitive_count_; }
@@ -80,6 +101,7 @@ class GpuScene {
   const Scene* scene_;
   std::unique_ptr<Buffers> buffers_;
   uint32_t primitive_count_ = 0;
+  std::string inline_scene_;
   double bvh_seconds_ = 0, upload_seconds_ = 0;
 };
 
@@ -90,6 +112,7 @@ struct RenderStats {
   double readback_seconds = 0;
   uint64_t rays = 0;  // camera rays + shadow rays
   uint32_t tiles = 0;
+  bool inline_scene = false;  // traced by code compiled from the scene, not by walking the BVH
 };
 
 struct RenderOptions {
@@ -103,6 +126,7 @@ struct RenderOptions {
   std::function<bool()> cancel;
   // false: no shadow rays, every light counts as visible (benchmarks of camera rays alone).
   bool shadows = true;
+  InlineScene inline_scene = InlineScene::automatic;
 };
 
 // A render stopped by RenderOptions::cancel; no work is left in flight.

@@ -10,17 +10,21 @@ void ParityTest::TearDown() {
   GpuTest::TearDown();
 }
 
-ParityRun ParityTest::run(const Scene& scene, const ImageSettings& image) {
+ParityRun ParityTest::run(const Scene& scene, const ImageSettings& image, gpu::InlineScene inline_scene) {
   if (!pipeline_) {
     const std::filesystem::path dir = VKRAY_SHADER_DIR;
-    pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), gpu::compile_compute_shader(dir / "trace.comp", {dir}).spirv);
+    pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), dir, gpu::compile_compute_shader(dir / "trace.comp", {dir}).spirv);
   }
   ParityRun result;
   const Bvh bvh = build_bvh(primitive_boxes(scene));  // one hierarchy, traversed by both renderers
-  result.gpu = gpu::render(ctx(), *pipeline_, gpu::GpuScene(ctx(), scene, &bvh), image);
-  cpu::ReferenceOptions options;
-  options.bvh = &bvh;
-  result.cpu = cpu::render_reference(scene, image, options);
+  gpu::RenderOptions options;
+  options.inline_scene = inline_scene;
+  gpu::RenderStats stats;
+  result.gpu = gpu::render(ctx(), *pipeline_, gpu::GpuScene(ctx(), scene, &bvh), image, options, &stats);
+  result.inline_scene = stats.inline_scene;
+  cpu::ReferenceOptions reference_options;
+  reference_options.bvh = &bvh;
+  result.cpu = cpu::render_reference(scene, image, reference_options);
   result.metrics = compare_images(result.gpu, result.cpu.image, result.cpu.signatures);
   return result;
 }
