@@ -21,6 +21,7 @@ layout(set = 0, binding = VKRAY_BINDING_LIGHTS) uniform samplerBuffer lights;
 // sphere test. On llvmpipe code behind an if runs for every lane (masked), so a test no primitive
 // needs still costs every leaf step (bunny, 256^2: 7% of the shader's instructions).
 layout(constant_id = VKRAY_SPEC_SPHERES) const bool SCENE_HAS_SPHERES = true;
+layout(constant_id = VKRAY_SPEC_SHADOWS) const bool SHADOW_RAYS = true;
 
 // ---- Primitives ---------------------------------------------------------------------------------------
 // A primitive is VKRAY_TEXELS_PER_PRIMITIVE texels (host/gpu/scene_packing.cpp): a triangle's three

@@ -34,7 +34,7 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
     // Written as !(> 0) so a light exactly at x (0/0 = NaN) contributes nothing.
     if (!(cos_theta > 0.0)) continue;
 
-    if ((frame.options & VKRAY_OPTION_NO_SHADOWS) == 0u) {
+    if (SHADOW_RAYS) {
       vec3 shadow_dir = light_pos - shadow_origin;
       float shadow_dist = length(shadow_dir);
       rays += 1u;

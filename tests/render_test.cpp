@@ -209,6 +209,30 @@ TEST_F(RenderTest, PolicyChoosesThePath) {
   EXPECT_TRUE(stats.inline_scene);
 }
 
+TEST_F(RenderTest, WithoutShadowRaysEveryLightIsVisible) {
+  // RenderOptions::shadows = false (vkray bench's camera rays alone) is a pipeline without the
+  // shadow-ray code (VKRAY_SPEC_SHADOWS): the floor in the tall block's shadow (pixel (60, 200) at
+  // 256^2, CornellTest) is lit as the CPU reference without shadow rays has it, and only camera
+  // rays are counted; with shadows again, the same pipeline object serves the shadowed image.
+  const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
+  cpu::ReferenceOptions reference_options;
+  reference_options.shadows = false;
+  const Image reference = cpu::render_reference(scene, {256, 256, 1}, reference_options).image;
+  for (const auto inline_scene : {gpu::InlineScene::never, gpu::InlineScene::always}) {
+    gpu::RenderOptions options = path(inline_scene);
+    options.shadows = false;
+    gpu::RenderStats stats;
+    const Image unshadowed = gpu::render(ctx(), *pipeline(), scene, {256, 256, 1}, options, &stats);
+    EXPECT_EQ(stats.rays, 256u * 256u);
+    expect_radiance(unshadowed.at(60, 200), glm::dvec3(reference.at(60, 200)), "floor behind the tall block, lit");
+    EXPECT_GT(unshadowed.at(60, 200).g, 1.2f * 0.75f * 0.1f) << "still in shadow (ambient only)";
+    options.shadows = true;
+    const Image shadowed = gpu::render(ctx(), *pipeline(), scene, {256, 256, 1}, options, &stats);
+    EXPECT_GT(stats.rays, 256u * 256u);
+    expect_radiance(shadowed.at(60, 200), glm::dvec3(0.15, 0.75, 0.15) * 0.1, "floor in shadow");
+  }
+}
+
 TEST_F(RenderTest, GeneratedCodeThatDoesNotCompileIsAShaderError) {
   // A shader folder whose scene.glsl no longer gives the generated code what it calls: its own
   // SPIR-V compiles (nothing after the include calls shear_point), the scene's does not, and the

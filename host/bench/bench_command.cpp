@@ -100,12 +100,15 @@ int run_bench(const BenchCommand& cmd) {
     }
 #endif
     const ImageSettings image{cmd.width, cmd.height, 1};
-    // The path the measured renders take, decided once, so that the warm-up render (lavapipe compiles
-    // on the first dispatch) uses the same pipeline.
+    // The path the measured renders take, decided once, so that the warm-up renders (lavapipe
+    // compiles on the first dispatch) use the same two pipelines, with and without shadow rays.
     gpu::RenderOptions warm_up;
     r.inline_scene = gpu::use_inline_scene(gpu_scene, image, cmd.inline_scene);
     warm_up.inline_scene = r.inline_scene ? gpu::InlineScene::always : gpu::InlineScene::never;
-    gpu::render(ctx, pipeline, gpu_scene, {64, 64, 1}, warm_up);
+    for (const bool shadows : {false, true}) {
+      warm_up.shadows = shadows;
+      gpu::render(ctx, pipeline, gpu_scene, {64, 64, 1}, warm_up);
+    }
     std::vector<double> frame_ms[2];
     for (unsigned round = 0; round < cmd.repeat; ++round) {
       for (int mode = 0; mode < 2; ++mode) {

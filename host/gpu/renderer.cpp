@@ -108,9 +108,10 @@ bool use_inline_scene(const GpuScene& scene, const ImageSettings& image, InlineS
   return camera_rays >= kInlineMinCameraRays;
 }
 
-ShaderVariant shader_variant(const GpuScene& scene, const ImageSettings& image, InlineScene policy) {
+ShaderVariant shader_variant(const GpuScene& scene, const ImageSettings& image, InlineScene policy, bool shadows) {
   ShaderVariant variant;
   variant.spheres = !scene.scene().spheres.empty();
+  variant.shadows = shadows;
   if (use_inline_scene(scene, image, policy)) variant.inline_scene = scene.inline_scene();
   return variant;
 }
@@ -138,9 +139,10 @@ std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVari
     inline_module = vk::raii::ShaderModule(*device_, vk::ShaderModuleCreateInfo({}, spirv));
   }
   const vk::ShaderModule module = variant.inline_scene.empty() ? *module_ : *inline_module;
-  const VkBool32 spheres = variant.spheres;
-  const vk::SpecializationMapEntry entry(VKRAY_SPEC_SPHERES, 0, sizeof(spheres));
-  const vk::SpecializationInfo specialization(entry, vk::ArrayProxyNoTemporaries<const VkBool32>(spheres));
+  const VkBool32 constants[] = {variant.spheres, variant.shadows};
+  const vk::SpecializationMapEntry entries[] = {{VKRAY_SPEC_SPHERES, 0, sizeof(VkBool32)},
+                                                {VKRAY_SPEC_SHADOWS, sizeof(VkBool32), sizeof(VkBool32)}};
+  const vk::SpecializationInfo specialization(entries, vk::ArrayProxyNoTemporaries<const VkBool32>(constants));
   const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, module, "main", &specialization);
   return std::make_shared<const vk::raii::Pipeline>(
       *device_, cache_ ? vk::Optional<const vk::raii::PipelineCache>(*cache_) : nullptr,
@@ -202,7 +204,6 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
   // ---- per-frame data: uniforms, output ----
   auto start = Clock::now();
   FrameUniforms frame = pack_frame(scene, gpu_scene.primitive_count(), image);
-  if (!options.shadows) frame.options |= VKRAY_OPTION_NO_SHADOWS;
   const vk::DeviceSize pixel_bytes =
       checked_mul(checked_mul(image.width, image.height, "output image"), sizeof(glm::vec4), "output image");
   if (pixel_bytes > ctx.limits().maxStorageBufferRange)
@@ -238,7 +239,7 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
   stats.upload_seconds = seconds_since(start);
 
   // ---- trace, one submission per tile ----
-  const ShaderVariant variant = shader_variant(gpu_scene, image, options.inline_scene);
+  const ShaderVariant variant = shader_variant(gpu_scene, image, options.inline_scene, options.shadows);
   stats.inline_scene = !variant.inline_scene.empty();
   const auto compute_pipeline = pipeline.pipeline(variant);  // compiled here unless asked for before
   start = Clock::now();

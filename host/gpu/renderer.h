@@ -33,6 +33,7 @@ namespace vkray::gpu {
 // every lane even when no lane takes it), and the scene's own code when it is compiled in.
 struct ShaderVariant {
   bool spheres = true;       // VKRAY_SPEC_SPHERES
+  bool shadows = true;       // VKRAY_SPEC_SHADOWS (RenderOptions::shadows)
   std::string inline_scene;  // served as shaders/inline_scene.glsl; empty: that file, and the BVH is walked
 
   auto operator<=>(const ShaderVariant&) const = default;
@@ -43,7 +44,8 @@ class GpuScene;
 // Whether a render of `scene` at `image` uses the code compiled from it, under `policy`.
 bool use_inline_scene(const GpuScene& scene, const ImageSettings& image, InlineScene policy);
 
-ShaderVariant shader_variant(const GpuScene& scene, const ImageSettings& image, InlineScene policy);
+ShaderVariant shader_variant(const GpuScene& scene, const ImageSettings& image, InlineScene policy,
+                             bool shadows = true);
 
 // Descriptor set layout, pipeline layout and the pipelines for shaders/trace.comp's interface, one
 // per ShaderVariant, each compiled the first time a render needs it.

@@ -19,9 +19,9 @@ static_assert(offsetof(FrameUniforms, forward) == 48);
 static_assert(offsetof(FrameUniforms, ambient) == 80);
 static_assert(offsetof(FrameUniforms, width) == 96);
 static_assert(offsetof(FrameUniforms, primitive_count) == 108);
-static_assert(offsetof(FrameUniforms, strata_y) == 124);
-static_assert(offsetof(FrameUniforms, epsilon) == 140);
-static_assert(sizeof(FrameUniforms) == 144);
+static_assert(offsetof(FrameUniforms, strata_y) == 120);
+static_assert(offsetof(FrameUniforms, epsilon) == 136);
+static_assert(sizeof(FrameUniforms) == 140);
 static_assert(sizeof(TileConstants) == 20);
 
 // The scene's buffers; the per-frame uniforms come from pack_frame().

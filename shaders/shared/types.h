@@ -27,6 +27,9 @@ using glm::vec4;
 // ---- Specialization constants ------------------------------------------------------------------
 // false when the scene has no spheres: the pipeline for it has no sphere test (gpu::ShaderVariant).
 #define VKRAY_SPEC_SPHERES 0
+// false for a render without shadow rays (every light counts as visible: camera rays alone, for
+// `vkray bench`): the pipeline has no shadow-ray code, which would cost every lane, masked.
+#define VKRAY_SPEC_SHADOWS 1
 
 // Texel buffers rather than storage buffers: with the triangles in a storage buffer instead, a
 // 1024x1024 render on Mesa 22.3.6 lavapipe (2 cores) took 1.8-2.3x as long (README, "How the GPU
@@ -80,7 +83,6 @@ struct FrameUniforms {
   uint height;
   uint samples_per_pixel;
   uint primitive_count;  // 0: the scene has no geometry (no BVH to traverse)
-  uint options;          // VKRAY_OPTION_* bits
   uint light_count;
   uint strata_x;    // sample pattern: strata_x * strata_y >= samples_per_pixel
   uint strata_y;
@@ -89,9 +91,6 @@ struct FrameUniforms {
   float inv_samples_per_pixel;
   float epsilon;    // self-intersection offset, scaled to the scene's extent
 };
-
-// FrameUniforms::options
-#define VKRAY_OPTION_NO_SHADOWS 1u  // every light counts as visible: camera rays only (vkray bench)
 
 // ---- Push constants: the tile this dispatch covers ---------------------------------------------
 struct TileConstants {
