@@ -23,7 +23,9 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
   // Shadow rays start a little off the surface, on the side the ray came from.
   vec3 shadow_origin = x + frame.epsilon * n_geometric;
   vec3 irradiance = frame.ambient.rgb;
-  // do-while, as the sample loop in trace.comp: a loop that tests first costs a masked pass more.
+  // A do-while without `continue`, as the sample loop in trace.comp: a loop that tests first costs
+  // a masked pass more, and so does one with a `continue` (the compiler moves the test to the top
+  // of the next pass, for every lane).
   uint i = 0u;
   if (frame.light_count > 0u) do {
     int base = int(i) * VKRAY_TEXELS_PER_LIGHT;
@@ -31,18 +33,16 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
     vec3 to_light = light_pos - x;
     float r2 = dot(to_light, to_light);
     float cos_theta = dot(n, to_light * inversesqrt(r2));
-    // Written as !(> 0) so a light exactly at x (0/0 = NaN) contributes nothing.
-    if (!(cos_theta > 0.0)) continue;
-
-    if (SHADOW_RAYS) {
+    // Written as > 0 so a light exactly at x (0/0 = NaN) contributes nothing.
+    bool lit = cos_theta > 0.0;
+    if (SHADOW_RAYS && lit) {
       vec3 shadow_dir = light_pos - shadow_origin;
       float shadow_dist = length(shadow_dir);
       rays += 1u;
       // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
-      if (trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon))
-        continue;
+      lit = !trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon);
     }
-    irradiance += texelFetch(lights, base + 1).rgb * (cos_theta / (PI * r2));
+    if (lit) irradiance += texelFetch(lights, base + 1).rgb * (cos_theta / (PI * r2));
   } while (++i < frame.light_count);
   return surface.albedo * irradiance;
 }
