@@ -46,23 +46,26 @@ bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max
                     inout uint hit_index) {
   uint first = (link & ~VKRAY_LEAF_BIT) >> VKRAY_LEAF_COUNT_BITS;
   uint end = first + (link & ((1u << VKRAY_LEAF_COUNT_BITS) - 1u));
-  for (uint prim = first; prim < end; ++prim) {
+  // A do-while without `continue` (a leaf is never empty): see the light loop in shade.glsl.
+  uint prim = first;
+  do {
     int base = int(prim) * VKRAY_TEXELS_PER_PRIMITIVE;
     vec4 a = texelFetch(primitives, base), b = texelFetch(primitives, base + 1), c = texelFetch(primitives, base + 2);
     // Anything up to a tie with the best hit so far is still a candidate.
     float limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
     float t = intersect_primitive(ray, shear, a, b, c, t_min, limit);
-    if (t <= 0.0) continue;
-    uint index = floatBitsToUint(b.w);
-    if (any_hit) {
-      hit = Hit(t, prim);
-      return true;
+    if (t > 0.0) {
+      uint index = floatBitsToUint(b.w);
+      if (any_hit) {
+        hit = Hit(t, prim);
+        return true;
+      }
+      if (hit.prim == NO_HIT || t < hit.t * (1.0 - VKRAY_TIE) || index < hit_index) {
+        hit = Hit(t, prim);
+        hit_index = index;
+      }
     }
-    if (hit.prim == NO_HIT || t < hit.t * (1.0 - VKRAY_TIE) || index < hit_index) {
-      hit = Hit(t, prim);
-      hit_index = index;
-    }
-  }
+  } while (++prim < end);
   return false;
 }
 
