@@ -1,9 +1,9 @@
 // A small scene compiled into the shader. What the tracer includes here when it walks the BVH is
 // this file, which declares nothing. For a scene of a few dozen primitives the host serves code it
 // generates under this name instead (host/gpu/inline_scene.cpp): it defines VKRAY_INLINE_SCENE and
-//   void test_inline_primitives(Ray ray, RayShear shear, float t_min, bool any_hit, inout Hit hit,
-//                               inout float limit)
+//   void test_inline_primitives(Ray ray, RayShear shear, float t_min, float t_max, bool any_hit,
+//                               inout Hit hit)
 // which tests every primitive of the scene in the scene's order, its coordinates written as
-// constants, with shear_point and sheared_triangle (intersect.glsl) or intersect_sphere, keeping
-// the closest hit closer than `limit` (or, with any_hit, any hit); traverse() (scene.glsl) then
-// calls it instead of walking the BVH.
+// constants, with shear_point and sheared_triangle (intersect.glsl) or intersect_sphere, and keeps
+// the closest hit in (t_min, t_max) (with any_hit: a hit); traverse() (scene.glsl) then calls it
+// instead of walking the BVH.

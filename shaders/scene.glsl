@@ -147,8 +147,7 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   if (frame.primitive_count == 0u) return hit;
   RayShear shear = ray_shear(ray.dir);
 #ifdef VKRAY_INLINE_SCENE
-  float limit = t_max;
-  test_inline_primitives(ray, shear, t_min, any_hit, hit, limit);
+  test_inline_primitives(ray, shear, t_min, t_max, any_hit, hit);
   return hit;
 #endif
   vec3 inv_dir = safe_inverse(ray.dir);

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
 #include <bit>
 #include <cstdio>
+#include <map>
 #include <numeric>
 #include <vector>
 
@@ -44,9 +44,9 @@ std::string inline_scene_glsl(const PackedScene& packed) {
   // Calls with only `in` parameters of plain types, and the best hit in locals: glslang copies
   // every struct and `inout` argument through temporaries, which both it and the driver's compiler
   // then spend time on (for the Cornell box's 30 triangles 0.1 s more than this).
-  out += "void test_inline_primitives(Ray ray, RayShear shear, float t_min, bool any_hit, inout Hit hit, inout float limit) {\n";
+  out += "void test_inline_primitives(Ray ray, RayShear shear, float t_min, float t_max, bool any_hit, inout Hit hit) {\n";
   out += "  vec3 o = ray.origin, s = shear.s;\n  ivec3 k = shear.k;\n";
-  out += "  float best_t = hit.t, bound = limit, t;\n  uint best = hit.prim;\n";
+  out += "  float best_t = hit.t, bound = t_max, t;\n  uint best = hit.prim;\n";
   // Each distinct vertex is sheared once (triangles of a mesh or a box share them), the triangles
   // then refer to it by name.
   std::map<std::array<uint32_t, 3>, std::string> vertices;
@@ -70,7 +70,7 @@ std::string inline_scene_glsl(const PackedScene& packed) {
     out += "  if (t > 0.0) { best_t = t; best = " + std::to_string(p) +
            "u; bound = any_hit ? bound : t * (1.0 - VKRAY_TIE); }\n";
   }
-  out += "  hit = Hit(best_t, best);\n  limit = bound;\n}\n";
+  out += "  hit = Hit(best_t, best);\n}\n";
   return out;
 }
 

@@ -1,7 +1,7 @@
 // Small scenes compiled into the shader: GLSL that tests every primitive of a packed scene, with
 // the primitives' coordinates written as constants. On llvmpipe each BVH step of a small scene
-// costs as much as testing dozens of triangles with constants (README, "Benchmark"), so below a
-// size the tracer tests them all instead of walking the hierarchy.
+// costs as much as testing about a dozen triangles with constants (README, "Benchmark"), so below
+// a size the tracer can test them all instead of walking the hierarchy.
 #pragma once
 
 #include <cstdint>
@@ -22,11 +22,11 @@ enum class InlineScene {
 // Scenes of at most this many primitives can be compiled into the shader.
 constexpr uint32_t kMaxInlinePrimitives = 32;
 
-// The body of shaders/inline_scene.glsl's contract for `packed`: a function
-//   void test_inline_primitives(Ray ray, RayShear shear, float t_min, inout Hit hit, inout uint hit_index)
-// that calls test_inline_triangle / test_inline_sphere (shaders/scene.glsl) once per primitive, in
-// the scene's order, each with its coordinates as literals (exact: 17 significant digits) and its
-// place in the primitive buffer. Empty when the scene has no primitives.
+// The text served as shaders/inline_scene.glsl for `packed` (the contract is in that file): it
+// defines VKRAY_INLINE_SCENE and test_inline_primitives(), which shears each distinct vertex once
+// (shear_point) and tests every primitive once, in the scene's order, with sheared_triangle or
+// intersect_sphere, coordinates as literals (exact: 17 significant digits), keeping the hit's place
+// in the primitive buffer. Empty when the scene has no primitives.
 std::string inline_scene_glsl(const PackedScene& packed);
 
 }  // namespace vkray::gpu
