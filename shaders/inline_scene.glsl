@@ -1,6 +1,6 @@
 // A small scene compiled into the shader. What the tracer includes here when it walks the BVH is
 // this file, which declares nothing. For a scene of a few dozen primitives the host serves code it
-// generates under this name instead (host/gpu/inline_scene.cpp): it defines VKRAY_INLINE_SCENE and
+// generates under this name instead (host/packing/inline_scene.cpp): it defines VKRAY_INLINE_SCENE and
 //   void test_inline_primitives(Ray ray, RayShear shear, float t_min, float t_max, bool any_hit,
 //                               inout Hit hit)
 // which tests every primitive of the scene in the scene's order, its coordinates written as

@@ -1,4 +1,4 @@
-// Scene access and the traversal every ray needs: the BVH (host/bvh.h) walked front to back for
+// Scene access and the traversal every ray needs: the BVH (host/bvh/bvh.h) walked front to back for
 // the closest hit (camera rays), or until any hit (shadow rays).
 #ifndef VKRAY_SCENE_GLSL
 #define VKRAY_SCENE_GLSL
@@ -24,7 +24,7 @@ layout(constant_id = VKRAY_SPEC_SPHERES) const bool SCENE_HAS_SPHERES = true;
 layout(constant_id = VKRAY_SPEC_SHADOWS) const bool SHADOW_RAYS = true;
 
 // ---- Primitives ---------------------------------------------------------------------------------------
-// A primitive is VKRAY_TEXELS_PER_PRIMITIVE texels (host/gpu/scene_packing.cpp): a triangle's three
+// A primitive is VKRAY_TEXELS_PER_PRIMITIVE texels (host/packing/scene_packing.cpp): a triangle's three
 // vertices, or a sphere's center and radius; a.w holds its flags, b.w its index in the scene.
 
 // t of the nearest intersection with the primitive in (t_min, t_max), or -1.
@@ -69,7 +69,7 @@ bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max
   return false;
 }
 
-// ---- Small scenes, compiled into the shader (host/gpu/inline_scene.h) ----------------------------------
+// ---- Small scenes, compiled into the shader (host/packing/inline_scene.h) ----------------------------------
 // The generated test_inline_primitives() (contract in inline_scene.glsl) shears each distinct
 // vertex once (shear_point) and tests each triangle with sheared_triangle (intersect.glsl), in the
 // scene's order.

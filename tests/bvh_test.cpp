@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bvh.h"
+#include "bvh/bvh.h"
 
 namespace vkray {
 namespace {

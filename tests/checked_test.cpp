@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "checked.h"
+#include "base/checked.h"
 
 namespace vkray {
 namespace {

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "errors.h"
-#include "image.h"
+#include "base/errors.h"
+#include "image/image.h"
 
 namespace vkray {
 namespace {

@@ -12,9 +12,9 @@
 
 #include <gtest/gtest.h>
 
-#include "bvh.h"
-#include "gpu/inline_scene.h"
-#include "gpu/scene_packing.h"
+#include "bvh/bvh.h"
+#include "packing/inline_scene.h"
+#include "packing/scene_packing.h"
 
 namespace vkray::gpu {
 namespace {

@@ -6,9 +6,9 @@
 
 #include <gtest/gtest.h>
 
-#include "errors.h"
-#include "mesh.h"
-#include "scene.h"
+#include "base/errors.h"
+#include "mesh/mesh.h"
+#include "scene/scene.h"
 #include "support/temp_dir.h"
 
 namespace vkray {

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "bvh.h"
-#include "gpu/scene_packing.h"
+#include "bvh/bvh.h"
+#include "packing/scene_packing.h"
 
 namespace vkray::gpu {
 namespace {

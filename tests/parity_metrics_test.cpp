@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "parity.h"
+#include "image/parity_metrics.h"
 
 namespace vkray {
 namespace {

@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
-#include "errors.h"
-#include "ply.h"
+#include "base/errors.h"
+#include "mesh/ply.h"
 
 namespace vkray {
 namespace {

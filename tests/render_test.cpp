@@ -12,7 +12,7 @@
 
 #include "gpu/renderer.h"
 #include "gpu/shader_compiler.h"
-#include "errors.h"
+#include "base/errors.h"
 #include "support/gpu_fixture.h"
 #include "support/temp_dir.h"
 #include "cpu/reference.h"

@@ -3,8 +3,8 @@
 
 #include <gtest/gtest.h>
 
-#include "camera.h"
-#include "../shaders/shared/sampling.h"
+#include "scene/camera.h"
+#include "shared/sampling.h"
 
 namespace vkray {
 namespace {

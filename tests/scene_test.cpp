@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/constants.hpp>
 
-#include "errors.h"
-#include "scene.h"
+#include "base/errors.h"
+#include "scene/scene.h"
 
 namespace vkray {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "errors.h"
+#include "base/errors.h"
 #include "gpu/shader_compiler.h"
 #include "support/temp_dir.h"
 

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "gpu/scene_packing.h"
+#include "packing/scene_packing.h"
 
 namespace vkray::gpu {
 namespace {

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "transform.h"
+#include "scene/transform.h"
 
 namespace vkray {
 namespace {

@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "image.h"
+#include "image/image.h"
 #include "support/child_process.h"
 #include "support/run_vkray.h"
 #include "support/temp_dir.h"

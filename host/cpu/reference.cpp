@@ -9,10 +9,10 @@
 #include <numbers>
 #include <thread>
 
-#include "bvh.h"
-#include "camera.h"
-#include "../shaders/shared/types.h"
-#include "../shaders/shared/sampling.h"
+#include "bvh/bvh.h"
+#include "scene/camera.h"
+#include "shared/types.h"
+#include "shared/sampling.h"
 
 namespace vkray::cpu {
 namespace {

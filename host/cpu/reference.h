@@ -8,8 +8,8 @@
 #include <functional>
 #include <vector>
 
-#include "image.h"
-#include "scene.h"
+#include "image/image.h"
+#include "scene/scene.h"
 
 namespace vkray {
 struct Bvh;

@@ -5,7 +5,7 @@
 #include <iostream>
 #include <optional>
 
-#include "errors.h"
+#include "base/errors.h"
 
 namespace vkray::gpu {
 namespace {

@@ -6,12 +6,12 @@
 #include <cstring>
 #include <type_traits>
 
-#include "checked.h"
-#include "errors.h"
+#include "base/checked.h"
+#include "base/errors.h"
 #include "gpu/buffer.h"
-#include "bvh.h"
-#include "gpu/inline_scene.h"
-#include "gpu/scene_packing.h"
+#include "bvh/bvh.h"
+#include "packing/inline_scene.h"
+#include "packing/scene_packing.h"
 #include "gpu/shader_compiler.h"
 
 namespace vkray::gpu {

@@ -16,11 +16,11 @@
 
 #include <vulkan/vulkan_raii.hpp>
 
-#include "errors.h"
+#include "base/errors.h"
 #include "gpu/context.h"
-#include "gpu/inline_scene.h"
-#include "image.h"
-#include "scene.h"
+#include "packing/inline_scene.h"
+#include "image/image.h"
+#include "scene/scene.h"
 
 namespace vkray {
 struct Bvh;

@@ -11,7 +11,7 @@
 #include <glslang/Public/ShaderLang.h>
 #include <glslang/SPIRV/GlslangToSpv.h>
 
-#include "errors.h"
+#include "base/errors.h"
 
 namespace vkray::gpu {
 namespace {

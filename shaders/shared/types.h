@@ -1,7 +1,7 @@
 // Everything that crosses between the C++ host and the GLSL shaders: binding numbers, workgroup size,
 // the uniform and push-constant structs, and the texel layout of the scene buffers. Both languages
 // include this file, so a binding number or a struct member is written exactly once. The C++ side
-// static_asserts the std140 layout in host/gpu/scene_packing.h.
+// static_asserts the std140 layout in host/packing/scene_packing.h.
 #ifndef VKRAY_SHARED_TYPES_H
 #define VKRAY_SHARED_TYPES_H
 
@@ -44,7 +44,7 @@ using glm::vec4;
 #define VKRAY_PRIM_SPHERE 0x80000000u
 #define VKRAY_PRIM_SMOOTH 0x40000000u  // a triangle with vertex normals in the normals buffer
 #define VKRAY_PRIM_MATERIAL_MASK 0x3fffffffu
-// BVH node, 4-wide (host/gpu/scene_packing.cpp collapses the binary BVH two levels at a time), in a
+// BVH node, 4-wide (host/packing/scene_packing.cpp collapses the binary BVH two levels at a time), in a
 // RGBA32UI texel buffer, VKRAY_TEXELS_PER_NODE texels each:
 //   0: (origin.xyz as float bits, e), e = ex | ey << 8 | ez << 16, biased float exponents
 //   1: the four child links; 0 = no child (no node links to the root)
@@ -57,7 +57,7 @@ using glm::vec4;
 #define VKRAY_LEAF_BIT 0x80000000u
 #define VKRAY_LEAF_COUNT_BITS 4u
 // A node pushes at most VKRAY_NODE_WIDTH - 1 children, and the binary BVH is at most 64 levels
-// deep (host/bvh.h), so at most 32 wide ones.
+// deep (host/bvh/bvh.h), so at most 32 wide ones.
 #define VKRAY_TRAVERSAL_STACK 96
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
 // precision: a ray along the line where two walls meet, coplanar surfaces); the primitive that

@@ -3,8 +3,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "errors.h"
-#include "mesh.h"
+#include "base/errors.h"
+#include "mesh/mesh.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {

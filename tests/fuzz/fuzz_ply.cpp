@@ -1,10 +1,10 @@
-// libFuzzer target: PLY meshes, ASCII and binary (host/ply.cpp).
+// libFuzzer target: PLY meshes, ASCII and binary (host/mesh/ply.cpp).
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
 
-#include "errors.h"
-#include "mesh.h"
+#include "base/errors.h"
+#include "mesh/mesh.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {

@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "errors.h"
-#include "scene.h"
+#include "base/errors.h"
+#include "scene/scene.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {

@@ -1,6 +1,6 @@
 #include "support/parity_run.h"
 
-#include "bvh.h"
+#include "bvh/bvh.h"
 #include "gpu/shader_compiler.h"
 
 namespace vkray::test {

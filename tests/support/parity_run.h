@@ -9,7 +9,7 @@
 
 #include "cpu/reference.h"
 #include "gpu/renderer.h"
-#include "parity.h"
+#include "image/parity_metrics.h"
 #include "support/gpu_fixture.h"
 
 namespace vkray::gpu {

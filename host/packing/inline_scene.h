@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string>
 
-#include "gpu/scene_packing.h"
+#include "packing/scene_packing.h"
 
 namespace vkray::gpu {
 

@@ -1,4 +1,4 @@
-#include "transform.h"
+#include "scene/transform.h"
 
 #include <algorithm>
 #include <cmath>

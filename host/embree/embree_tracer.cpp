@@ -1,4 +1,4 @@
-#include "bench/embree_tracer.h"
+#include "embree/embree_tracer.h"
 
 #include <algorithm>
 #include <atomic>
@@ -11,7 +11,7 @@
 
 #include <embree3/rtcore.h>
 
-#include "camera.h"
+#include "scene/camera.h"
 
 namespace vkray::bench {
 

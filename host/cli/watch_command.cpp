@@ -11,17 +11,17 @@
 #include <iostream>
 #include <memory>
 
-#include "commands.h"
-#include "errors.h"
-#include "file_watcher.h"
+#include "cli/commands.h"
+#include "base/errors.h"
+#include "cli/file_watcher.h"
 #include "gpu/context.h"
 #include "gpu/renderer.h"
 #include "gpu/shader_compiler.h"
-#include "image.h"
-#include "paths.h"
-#include "scene.h"
-#include "stop_signals.h"
-#include "timing.h"
+#include "image/image.h"
+#include "session/paths.h"
+#include "scene/scene.h"
+#include "cli/stop_signals.h"
+#include "base/timing.h"
 
 namespace vkray {
 namespace {

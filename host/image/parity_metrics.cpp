@@ -1,4 +1,4 @@
-#include "parity.h"
+#include "image/parity_metrics.h"
 
 #include <algorithm>
 #include <cmath>

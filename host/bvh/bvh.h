@@ -8,8 +8,8 @@
 
 #include <glm/glm.hpp>
 
-#include "scene.h"
-#include "../shaders/shared/types.h"
+#include "scene/scene.h"
+#include "shared/types.h"
 
 namespace vkray {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace vkray::bench {
 

@@ -1,4 +1,4 @@
-#include "file_watcher.h"
+#include "cli/file_watcher.h"
 
 #include <poll.h>
 #include <sys/inotify.h>

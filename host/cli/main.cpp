@@ -7,8 +7,8 @@
 #include <CLI/CLI.hpp>
 #include <vulkan/vulkan_raii.hpp>
 
-#include "commands.h"
-#include "errors.h"
+#include "cli/commands.h"
+#include "base/errors.h"
 
 namespace {
 
@@ -21,7 +21,7 @@ constexpr const char* kExitCodes =
     "  4  parity: the GPU and CPU images differ beyond the documented tolerance\n"
     "  130  interrupted by SIGINT (Ctrl-C) or SIGTERM; nothing was written\n";
 
-// --inline-scene: how a scene is traced (host/gpu/inline_scene.h).
+// --inline-scene: how a scene is traced (host/packing/inline_scene.h).
 CLI::Option* add_inline_scene_option(CLI::App* cmd, vkray::gpu::InlineScene& value) {
   using vkray::gpu::InlineScene;
   static const std::map<std::string, InlineScene> names{

@@ -1,4 +1,4 @@
-#include "bvh.h"
+#include "bvh/bvh.h"
 
 #include <algorithm>
 #include <array>

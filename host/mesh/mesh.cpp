@@ -1,4 +1,4 @@
-#include "mesh.h"
+#include "mesh/mesh.h"
 
 #include <algorithm>
 #include <cfloat>
@@ -13,8 +13,8 @@
 
 #include <tiny_obj_loader.h>
 
-#include "errors.h"
-#include "ply.h"
+#include "base/errors.h"
+#include "mesh/ply.h"
 
 namespace vkray {
 namespace {

@@ -10,18 +10,18 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bvh.h"
-#include "commands.h"
+#include "bvh/bvh.h"
+#include "cli/commands.h"
 #include "cpu/reference.h"
-#include "errors.h"
+#include "base/errors.h"
 #include "gpu/context.h"
 #include "gpu/renderer.h"
 #include "gpu/shader_compiler.h"
-#include "paths.h"
-#include "scene.h"
-#include "timing.h"
+#include "session/paths.h"
+#include "scene/scene.h"
+#include "base/timing.h"
 #ifdef VKRAY_HAVE_EMBREE
-#include "bench/embree_tracer.h"
+#include "embree/embree_tracer.h"
 #endif
 
 namespace vkray {

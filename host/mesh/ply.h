@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <string_view>
 
-#include "mesh.h"
+#include "mesh/mesh.h"
 
 namespace vkray {
 

@@ -1,4 +1,4 @@
-#include "image.h"
+#include "image/image.h"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -15,7 +15,7 @@
 
 #include <png.h>
 
-#include "errors.h"
+#include "base/errors.h"
 
 namespace vkray {
 namespace {

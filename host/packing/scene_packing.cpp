@@ -1,4 +1,4 @@
-#include "gpu/scene_packing.h"
+#include "packing/scene_packing.h"
 
 #include <algorithm>
 #include <bit>
@@ -6,7 +6,7 @@
 #include <numeric>
 #include <stdexcept>
 
-#include "camera.h"
+#include "scene/camera.h"
 
 namespace vkray::gpu {
 namespace {

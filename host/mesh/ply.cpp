@@ -1,4 +1,4 @@
-#include "ply.h"
+#include "mesh/ply.h"
 
 #include <algorithm>
 #include <bit>
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "errors.h"
+#include "base/errors.h"
 
 namespace vkray {
 namespace {

@@ -7,9 +7,9 @@
 
 #include <glm/glm.hpp>
 
-#include "bvh.h"
-#include "scene.h"
-#include "../shaders/shared/types.h"
+#include "bvh/bvh.h"
+#include "scene/scene.h"
+#include "shared/types.h"
 
 namespace vkray::gpu {
 

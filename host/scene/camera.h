@@ -6,7 +6,7 @@
 
 #include <glm/glm.hpp>
 
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace vkray {
 

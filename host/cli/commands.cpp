@@ -1,4 +1,4 @@
-#include "commands.h"
+#include "cli/commands.h"
 
 #include <unistd.h>
 
@@ -12,18 +12,18 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bvh.h"
+#include "bvh/bvh.h"
 #include "cpu/reference.h"
-#include "errors.h"
+#include "base/errors.h"
 #include "gpu/context.h"
 #include "gpu/renderer.h"
 #include "gpu/shader_compiler.h"
-#include "image.h"
-#include "parity.h"
-#include "paths.h"
-#include "scene.h"
-#include "stop_signals.h"
-#include "timing.h"
+#include "image/image.h"
+#include "image/parity_metrics.h"
+#include "session/paths.h"
+#include "scene/scene.h"
+#include "cli/stop_signals.h"
+#include "base/timing.h"
 
 namespace vkray {
 namespace {

@@ -1,4 +1,4 @@
-#include "scene.h"
+#include "scene/scene.h"
 
 #include <algorithm>
 #include <cfloat>
@@ -12,9 +12,9 @@
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
-#include "errors.h"
-#include "mesh.h"
-#include "transform.h"
+#include "base/errors.h"
+#include "mesh/mesh.h"
+#include "scene/transform.h"
 
 namespace vkray {
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "gpu/inline_scene.h"
-#include "scene.h"
+#include "packing/inline_scene.h"
+#include "scene/scene.h"
 
 namespace vkray {
 
