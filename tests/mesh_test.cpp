@@ -7,7 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "base/errors.h"
-#include "mesh/mesh.h"
+#include "mesh/load.h"
+#include "mesh/normals.h"
 #include "scene/scene.h"
 #include "support/temp_dir.h"
 

@@ -13,7 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "base/errors.h"
-#include "mesh/mesh.h"
+#include "mesh/load.h"
+#include "mesh/normals.h"
 #include "scene/transform.h"
 
 namespace vkray {

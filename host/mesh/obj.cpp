@@ -1,20 +1,15 @@
-#include "mesh/mesh.h"
+#include "mesh/obj.h"
 
 #include <algorithm>
 #include <cfloat>
 #include <charconv>
-#include <fstream>
-#include <sstream>
 #include <cctype>
 #include <cmath>
-#include <cstring>
 #include <string>
-#include <unordered_map>
 
 #include <tiny_obj_loader.h>
 
 #include "base/errors.h"
-#include "mesh/ply.h"
 
 namespace vkray {
 namespace {
@@ -62,6 +57,8 @@ void check_obj_vertices(const std::filesystem::path& file, std::string_view text
     }
   }
 }
+
+}  // namespace
 
 Mesh parse_obj(const std::string& text, const std::filesystem::path& file) {
   check_obj_vertices(file, text);
@@ -113,63 +110,6 @@ Mesh parse_obj(const std::string& text, const std::filesystem::path& file) {
   }
   if (all_normals && normals.size() == mesh.triangles.size()) mesh.corner_normals = std::move(normals);
   return mesh;
-}
-
-}  // namespace
-
-std::vector<std::array<glm::vec3, 3>> area_weighted_normals(const std::vector<std::array<glm::vec3, 3>>& triangles) {
-  struct Key {
-    uint32_t x, y, z;
-    bool operator==(const Key&) const = default;
-  };
-  struct Hash {
-    size_t operator()(const Key& k) const { return (size_t(k.x) * 73856093u) ^ (size_t(k.y) * 19349663u) ^ (size_t(k.z) * 83492791u); }
-  };
-  auto key = [](const glm::vec3& p) {
-    Key k;
-    std::memcpy(&k, &p, sizeof k);
-    return k;
-  };
-  std::unordered_map<Key, glm::vec3, Hash> sum;
-  sum.reserve(triangles.size());
-  for (const auto& t : triangles) {
-    const glm::vec3 n = glm::cross(t[1] - t[0], t[2] - t[0]);  // length = 2 * area: area-weighted
-    for (const auto& p : t) sum[key(p)] += n;
-  }
-  std::vector<std::array<glm::vec3, 3>> normals(triangles.size());
-  for (size_t i = 0; i < triangles.size(); ++i)
-    for (size_t k = 0; k < 3; ++k) {
-      const glm::vec3 n = sum[key(triangles[i][k])];
-      const float length = glm::length(n);
-      normals[i][k] = length > 0 ? n / length : glm::vec3(0.0f);
-    }
-  return normals;
-}
-
-Mesh parse_mesh(std::string_view bytes, const std::filesystem::path& name) {
-  std::string ext = name.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  Mesh mesh;
-  if (ext == ".obj") {
-    mesh = parse_obj(std::string(bytes), name);
-  } else if (ext == ".ply") {
-    mesh = parse_ply(bytes, name);
-  } else {
-    fail(name, "unknown mesh format \"" + ext + "\" (expected .obj or .ply)");
-  }
-  if (mesh.triangles.empty()) fail(name, "the mesh has no faces");
-  return mesh;
-}
-
-Mesh load_mesh(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec)) fail(file, "is a directory, not a mesh file");
-  if (!std::filesystem::is_regular_file(file, ec)) fail(file, "mesh file not found");
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (!in) fail(file, "cannot read mesh file");
-  return parse_mesh(bytes.str(), file);
 }
 
 }  // namespace vkray

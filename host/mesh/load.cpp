@@ -1,0 +1,48 @@
+#include "mesh/load.h"
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "base/errors.h"
+#include "mesh/obj.h"
+#include "mesh/ply.h"
+
+namespace vkray {
+namespace {
+
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
+  throw MeshError(file.string() + ": " + what);
+}
+
+}  // namespace
+
+Mesh parse_mesh(std::string_view bytes, const std::filesystem::path& name) {
+  std::string ext = name.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  Mesh mesh;
+  if (ext == ".obj") {
+    mesh = parse_obj(std::string(bytes), name);
+  } else if (ext == ".ply") {
+    mesh = parse_ply(bytes, name);
+  } else {
+    fail(name, "unknown mesh format \"" + ext + "\" (expected .obj or .ply)");
+  }
+  if (mesh.triangles.empty()) fail(name, "the mesh has no faces");
+  return mesh;
+}
+
+Mesh load_mesh(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) fail(file, "is a directory, not a mesh file");
+  if (!std::filesystem::is_regular_file(file, ec)) fail(file, "mesh file not found");
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (!in) fail(file, "cannot read mesh file");
+  return parse_mesh(bytes.str(), file);
+}
+
+}  // namespace vkray
