@@ -4,22 +4,23 @@
 #pragma once
 
 #include <cstdint>
-#include <stdexcept>
 #include <string>
+
+#include "base/errors.h"
 
 namespace vkray {
 
-// a * b, or std::length_error naming `what` when the product does not fit in 64 bits.
+// a * b, or LimitError (exit 1) naming `what` when the product does not fit in 64 bits.
 inline uint64_t checked_mul(uint64_t a, uint64_t b, const char* what) {
   uint64_t product = 0;
-  if (__builtin_mul_overflow(a, b, &product)) throw std::length_error(std::string(what) + ": size overflows 64 bits");
+  if (__builtin_mul_overflow(a, b, &product)) throw LimitError(std::string(what) + ": size overflows 64 bits");
   return product;
 }
 
 // a + b, likewise.
 inline uint64_t checked_add(uint64_t a, uint64_t b, const char* what) {
   uint64_t sum = 0;
-  if (__builtin_add_overflow(a, b, &sum)) throw std::length_error(std::string(what) + ": size overflows 64 bits");
+  if (__builtin_add_overflow(a, b, &sum)) throw LimitError(std::string(what) + ": size overflows 64 bits");
   return sum;
 }
 

@@ -1,4 +1,7 @@
-// The error types vkray raises, one per kind of failure, and the exit code each maps to.
+// Every error vkray raises, one type per kind of failure, and the process exit code of each kind.
+// The library throws only these (session/failure.h turns what a dependency throws into one of
+// them); each face maps them once: the command line to a message and exit_code(), the Python
+// module to its exception classes.
 #pragma once
 
 #include <stdexcept>
@@ -10,31 +13,79 @@ namespace vkray {
 // Process exit codes; documented in `vkray --help` and the README.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitBadInput = 1,  // scene, mesh, shader or output file
-  kExitUsage = 2,     // command line
-  kExitDevice = 3,    // Vulkan or device failure
+  kExitBadInput = 1,       // a scene, mesh, shader or output file; an input past a limit
+  kExitUsage = 2,          // the command line
+  kExitDevice = 3,         // Vulkan or the device
+  kExitParityFailed = 4,   // `vkray parity`: the images differ beyond the tolerance (a result, not an error)
+  kExitInternal = 70,      // a bug in vkray: an invariant that does not hold (sysexits' EX_SOFTWARE)
+  kExitInterrupted = 130,  // SIGINT or SIGTERM, the shell's convention for Ctrl-C
 };
 
-// A mistake in something the user gave us. The message names the file and the key or line.
-struct InputError : std::runtime_error {
+// The base of every error vkray raises. The message is complete: it names the file and the key or
+// line, or the Vulkan call and its result.
+class Error : public std::runtime_error {
+ public:
   using std::runtime_error::runtime_error;
+  virtual ExitCode exit_code() const = 0;
 };
+
+// ---- Input: something the user gave cannot be used (exit 1) -------------------------------------
+struct InputError : Error {
+  using Error::Error;
+  ExitCode exit_code() const override { return kExitBadInput; }
+};
+// A scene file, or a file it references: the message names the scene file and the key.
 struct SceneError : InputError {
   using InputError::InputError;
 };
-struct MeshError : InputError {
-  using InputError::InputError;
+// A mesh file; when read for a scene, the message names the scene's key too.
+struct MeshError : SceneError {
+  using SceneError::SceneError;
 };
+// A shader file: one "file:line: error: message" line per problem, for the file that has it.
 struct ShaderError : InputError {
   using InputError::InputError;
 };
+// An output file that cannot be written (its folder, its type, the disk).
 struct OutputError : InputError {
   using InputError::InputError;
 };
+// An input past a limit of vkray's (the BVH's primitive count) or of this machine's (sizes past 64
+// bits, host memory, inotify watches); the message names the limit.
+struct LimitError : InputError {
+  using InputError::InputError;
+};
 
-// Vulkan or the device failed: no device, an API call failed, a fence timed out, a validation message.
-struct DeviceError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+// ---- Usage: an option value the command line or a caller gave is out of range (exit 2) ----------
+struct UsageError : Error {
+  using Error::Error;
+  ExitCode exit_code() const override { return kExitUsage; }
+};
+
+// ---- Device: Vulkan or the device failed (exit 3) -------------------------------------------------
+// No device, a failed call (named with its VkResult), a validation message, a scene or image past a
+// device limit.
+struct DeviceError : Error {
+  using Error::Error;
+  ExitCode exit_code() const override { return kExitDevice; }
+};
+// A submission did not finish within its timeout. Its work may still be running on the device, so
+// what it uses stays alive (the session keeps it until the device is done with it).
+struct TimeoutError : DeviceError {
+  using DeviceError::DeviceError;
+};
+
+// ---- Interrupted: a caller's cancel callback asked to stop (exit 130) ----------------------------
+// Raised between units of work (tiles, rows): nothing is left running, nothing was written.
+struct Cancelled : Error {
+  Cancelled() : Error("interrupted") {}
+  ExitCode exit_code() const override { return kExitInterrupted; }
+};
+
+// ---- Internal: an invariant of vkray's own does not hold, a bug (exit 70) -----------------------
+struct InternalError : Error {
+  using Error::Error;
+  ExitCode exit_code() const override { return kExitInternal; }
 };
 
 // Text from a user's file, fit to quote in a one-line message: control and non-ASCII bytes become

@@ -4,7 +4,9 @@
 #include <array>
 #include <chrono>
 #include <numeric>
-#include <stdexcept>
+#include <string>
+
+#include "base/errors.h"
 
 namespace vkray {
 namespace {
@@ -147,9 +149,9 @@ class Builder {
 }  // namespace
 
 Bvh build_bvh(const std::vector<Aabb>& boxes) {
-  if (boxes.size() >= kMaxPrimitives)
-    throw std::length_error("too many primitives for the BVH: " + std::to_string(boxes.size()) + " (at most " +
-                            std::to_string(kMaxPrimitives - 1) + ")");
+  if (boxes.size() > kMaxScenePrimitives)
+    throw LimitError("too many primitives for the BVH: " + std::to_string(boxes.size()) + " (at most " +
+                     std::to_string(kMaxScenePrimitives) + ")");
   const auto start = std::chrono::steady_clock::now();
   Bvh bvh = Builder(boxes).build();
   bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -36,6 +36,7 @@ constexpr uint32_t kLeafBit = VKRAY_LEAF_BIT;
 constexpr uint32_t kLeafCountBits = VKRAY_LEAF_COUNT_BITS;
 constexpr uint32_t kMaxLeafSize = (1u << kLeafCountBits) - 1;
 constexpr uint32_t kMaxPrimitives = 1u << (31 - kLeafCountBits);
+static_assert(kMaxScenePrimitives == kMaxPrimitives - 1, "the scene's limit is the leaf encoding's");
 // The builder keeps the depth (levels of inner nodes) below this; the GPU's traversal stack is sized
 // for it (VKRAY_TRAVERSAL_STACK).
 constexpr uint32_t kMaxDepth = 64;
@@ -56,7 +57,7 @@ struct Bvh {
   double build_seconds = 0;
 };
 
-// Builds over primitives given by their bounding boxes. Throws std::length_error beyond kMaxPrimitives.
+// Builds over primitives given by their bounding boxes. Throws LimitError beyond kMaxScenePrimitives.
 Bvh build_bvh(const std::vector<Aabb>& boxes);
 
 // A scene's primitives are numbered triangles first, then spheres: primitive i < triangles.size()

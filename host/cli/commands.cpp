@@ -134,7 +134,7 @@ GpuRun render_gpu(const LoadedScene& loaded, const RenderFlags& flags, const std
       run.image = gpu::render(ctx, pipeline, gpu_scene, loaded.image, render_options, &run.stats);
       run.stats.bvh_seconds = gpu_scene.bvh_seconds();
       run.stats.upload_seconds += gpu_scene.upload_seconds();
-    } catch (const gpu::TimeoutError& e) {
+    } catch (const TimeoutError& e) {
       // Work may still be running on the device: destroying what it uses could hang or worse, so
       // report and leave at once. Nothing has been written.
       std::cerr << "vkray: device error: " << e.what() << "\n";
@@ -208,7 +208,7 @@ int run_render(const RenderCommand& cmd) {
     GpuRun run;
     try {
       run = render_gpu(loaded, cmd.flags, log, !cmd.quiet, &stop);
-    } catch (const gpu::Cancelled&) {
+    } catch (const Cancelled&) {
       std::cerr << "vkray: interrupted; no image written\n";
       return kExitInterrupted;
     }

@@ -70,9 +70,4 @@ int run_watch(const WatchCommand& command);
 int run_parity(const ParityCommand& command);
 int run_devices();
 
-// `vkray parity` exits with this when the images differ beyond the tolerance.
-constexpr int kExitParityFailed = 4;
-// A render stopped by SIGINT or SIGTERM (the shell's convention for Ctrl-C); nothing was written.
-constexpr int kExitInterrupted = 130;
-
 }  // namespace vkray

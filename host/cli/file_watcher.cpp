@@ -6,7 +6,9 @@
 
 #include <cerrno>
 #include <cstring>
-#include <system_error>
+#include <string>
+
+#include "base/errors.h"
 
 namespace vkray {
 namespace {
@@ -21,7 +23,11 @@ constexpr uint32_t kEvents = IN_MODIFY | IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREAT
 }  // namespace
 
 FileWatcher::FileWatcher() : fd_(inotify_init1(IN_NONBLOCK | IN_CLOEXEC)) {
-  if (fd_ < 0) throw std::system_error(errno, std::generic_category(), "inotify_init1");
+  if (fd_ < 0) {
+    const int error = errno;
+    throw LimitError(std::string("cannot watch files: inotify_init1: ") + std::strerror(error) +
+                     (error == EMFILE ? " (the limit is fs.inotify.max_user_instances)" : ""));
+  }
 }
 
 FileWatcher::~FileWatcher() { ::close(fd_); }
@@ -53,7 +59,12 @@ void FileWatcher::rewatch() {
   }
   for (const auto& folder : folders) {
     const int wd = inotify_add_watch(fd_, folder.c_str(), kEvents);
-    if (wd >= 0) watches_[wd] = folder;  // a folder that does not exist cannot change; skip it
+    if (wd >= 0) {
+      watches_[wd] = folder;
+    } else if (const int error = errno; error != ENOENT && error != ENOTDIR) {  // a missing folder cannot change
+      throw LimitError("cannot watch " + folder.string() + ": inotify_add_watch: " + std::strerror(error) +
+                       (error == ENOSPC ? " (the limit is fs.inotify.max_user_watches)" : ""));
+    }
   }
 }
 
@@ -71,7 +82,7 @@ std::vector<std::filesystem::path> FileWatcher::wait(std::chrono::milliseconds s
     const int timeout = changed.empty() ? -1 : static_cast<int>(settle.count());
     const int ready = ::poll(fds, 2, timeout);
     if (ready < 0 && errno == EINTR) continue;
-    if (ready < 0) throw std::system_error(errno, std::generic_category(), "poll");
+    if (ready < 0) throw LimitError(std::string("cannot wait for file changes: poll: ") + std::strerror(errno));
     if (fds[1].revents & POLLIN) return {};
     if (ready == 0) return {changed.begin(), changed.end()};  // settled
     for (;;) {

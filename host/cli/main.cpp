@@ -1,24 +1,25 @@
-// vkray's command line: parses arguments, runs a subcommand, and turns errors into a message on
-// stderr and the documented exit code. Nothing below main() ever lets an exception escape.
+// vkray's command line: parses arguments, runs a subcommand, and turns any error into one message on
+// stderr and the documented exit code (session/failure.h).
 #include <iostream>
 #include <map>
 #include <string>
 
 #include <CLI/CLI.hpp>
-#include <vulkan/vulkan_raii.hpp>
-
 #include "cli/commands.h"
 #include "base/errors.h"
+#include "session/failure.h"
 
 namespace {
 
 constexpr const char* kExitCodes =
     "Exit codes:\n"
     "  0  success\n"
-    "  1  bad input: scene, mesh or shader file, or an output file that cannot be written\n"
+    "  1  bad input: scene, mesh or shader file, an output file that cannot be written, or an input past a\n"
+    "     limit (primitives, sizes, host memory, inotify watches)\n"
     "  2  usage: unknown command or option, bad option value\n"
     "  3  Vulkan or device failure (no device, failed call, timeout, validation message)\n"
     "  4  parity: the GPU and CPU images differ beyond the documented tolerance\n"
+    "  70  internal error: a bug in vkray (please report it)\n"
     "  130  interrupted by SIGINT (Ctrl-C) or SIGTERM; nothing was written\n";
 
 // --inline-scene: how a scene is traced (host/packing/inline_scene.h).
@@ -125,22 +126,10 @@ int main(int argc, char** argv) {
     if (*watch_cmd) return run_watch(watch);
     if (*bench_cmd) return run_bench(bench);
     if (*devices_cmd) return run_devices();
-  } catch (const ShaderError& e) {
-    std::cerr << "vkray: shader compilation failed:\n" << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const InputError& e) {
-    std::cerr << "vkray: error: " << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const DeviceError& e) {
-    std::cerr << "vkray: device error: " << e.what() << "\n";
-    return kExitDevice;
-  } catch (const vk::SystemError& e) {
-    // Vulkan-Hpp's message names the call, e.g. "vk::raii::Device::createBuffer: ErrorOutOfDeviceMemory".
-    std::cerr << "vkray: Vulkan error: " << e.what() << "\n";
-    return kExitDevice;
-  } catch (const std::exception& e) {
-    std::cerr << "vkray: error: " << e.what() << "\n";
-    return kExitDevice;
+  } catch (...) {
+    const Failure failure = describe_failure(std::current_exception());
+    std::cerr << "vkray: " << failure.headline << (failure.multiline ? ":\n" : ": ") << failure.message << "\n";
+    return failure.exit_code;
   }
   return kExitUsage;
 }

@@ -177,7 +177,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
                 << render(errors_reported) << "\n";
       watch_current_files();
     }
-  } catch (const gpu::Cancelled&) {
+  } catch (const Cancelled&) {
     // Stopped mid-render: the image on disk is the last complete one.
   }
   ctx.queue().waitIdle();

@@ -5,12 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <thread>
 #include <vector>
 
 #include <embree3/rtcore.h>
 
+#include "base/errors.h"
 #include "scene/camera.h"
 
 namespace vkray::bench {
@@ -26,7 +26,7 @@ struct EmbreeTracer::State {
 
 EmbreeTracer::EmbreeTracer(const Scene& scene) : state_(std::make_unique<State>()), scene_(scene) {
   state_->device = rtcNewDevice(nullptr);
-  if (!state_->device) throw std::runtime_error("Embree: rtcNewDevice failed");
+  if (!state_->device) throw DeviceError("Embree: rtcNewDevice failed");
   const auto start = std::chrono::steady_clock::now();
   state_->scene = rtcNewScene(state_->device);
   if (!scene.triangles.empty()) {
@@ -58,7 +58,7 @@ EmbreeTracer::EmbreeTracer(const Scene& scene) : state_(std::make_unique<State>(
   }
   rtcCommitScene(state_->scene);
   build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (rtcGetDeviceError(state_->device) != RTC_ERROR_NONE) throw std::runtime_error("Embree: scene build failed");
+  if (rtcGetDeviceError(state_->device) != RTC_ERROR_NONE) throw DeviceError("Embree: scene build failed");
 }
 
 EmbreeTracer::~EmbreeTracer() = default;

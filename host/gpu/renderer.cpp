@@ -281,7 +281,7 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
     }
     device.resetFences(*fence);
     if (options.progress) options.progress(tile_index + 1, tile_count);
-    if (options.cancel && tile_index + 1 < tile_count && options.cancel()) throw Cancelled{};
+    if (options.cancel && tile_index + 1 < tile_count && options.cancel()) throw Cancelled();
   }
   stats.trace_seconds = seconds_since(start);
   stats.tiles = tile_count;

@@ -131,14 +131,6 @@ struct RenderOptions {
   InlineScene inline_scene = InlineScene::automatic;
 };
 
-// A render stopped by RenderOptions::cancel; no work is left in flight.
-struct Cancelled {};
-
-// A tile did not finish within RenderOptions::tile_timeout; work may still be in flight.
-struct TimeoutError : DeviceError {
-  using DeviceError::DeviceError;
-};
-
 // Renders a scene already on the device at `image` resolution and sample count. Throws
 // DeviceError (and vk::SystemError from failing Vulkan calls).
 Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& scene, const ImageSettings& image,

@@ -4,8 +4,8 @@
 #include <bit>
 #include <cmath>
 #include <numeric>
-#include <stdexcept>
 
+#include "base/check.h"
 #include "scene/camera.h"
 
 namespace vkray::gpu {
@@ -96,7 +96,7 @@ class NodePacker {
         while (q_lo > 0 && dequantize(origin, scale[axis], q_lo) > lo) --q_lo;
         uint32_t q_hi = uint32_t(std::clamp(std::ceil((double(hi) - origin) / scale[axis]), 0.0, 255.0));
         while (q_hi < 255 && dequantize(origin, scale[axis], q_hi) < hi) ++q_hi;
-        if (dequantize(origin, scale[axis], q_hi) < hi) throw std::logic_error("BVH node quantization lost a box side");
+        VKRAY_CHECK(dequantize(origin, scale[axis], q_hi) >= hi, "BVH node quantization lost a box side");
         set_byte(t[2][axis], c, q_lo);
         set_byte(*hi_word(t, axis), c, q_hi);
       }

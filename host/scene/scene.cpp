@@ -119,6 +119,8 @@ class SceneParser {
   void parse_mesh(const Value& v, const glm::mat4& transform);
   // Appends triangles, leaving out zero-area ones (they have no normal and are never hit).
   void add_triangles(const Value& where, std::vector<Triangle>& triangles);
+  // Fails at `where` when `adding` more primitives would pass kMaxScenePrimitives.
+  void check_primitive_count(const Value& where, size_t adding) const;
 
   const std::filesystem::path& file_;
   Scene& scene_;
@@ -274,6 +276,7 @@ void SceneParser::parse_object(const Value& v) {
       sphere.center = transform_point(transform, sphere.center);
       sphere.radius *= *s;
     }
+    check_primitive_count(v, 1);
     scene_.spheres.push_back(sphere);
   } else if (type == "triangles") {
     check_keys(v, {"type", "positions", "indices", "material", "transform"});
@@ -311,7 +314,15 @@ void SceneParser::parse_object(const Value& v) {
   }
 }
 
+void SceneParser::check_primitive_count(const Value& where, size_t adding) const {
+  const size_t count = scene_.triangles.size() + scene_.spheres.size();
+  if (adding > kMaxScenePrimitives - count)
+    throw LimitError(file_.string() + ": " + where.path + ": the scene would have " + std::to_string(count + adding) +
+                     " primitives; vkray renders at most " + std::to_string(kMaxScenePrimitives));
+}
+
 void SceneParser::add_triangles(const Value& where, std::vector<Triangle>& triangles) {
+  check_primitive_count(where, triangles.size());
   size_t degenerate = 0;
   for (const Triangle& t : triangles) {
     if (glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -13,6 +14,10 @@
 #include <glm/glm.hpp>
 
 namespace vkray {
+
+// A scene holds at most this many primitives (triangles and spheres together): a BVH leaf names its
+// first primitive in 27 bits (bvh/bvh.h checks that the two agree).
+constexpr size_t kMaxScenePrimitives = (size_t(1) << 27) - 1;
 
 struct ImageSettings {
   uint32_t width = 512;

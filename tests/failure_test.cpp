@@ -1,0 +1,63 @@
+// Every error reaches a face as one exit code and one message (base/errors.h, session/failure.h):
+// vkray's own by their kind, a dependency's classified once.
+#include <new>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+#include <vulkan/vulkan_raii.hpp>
+
+#include "base/checked.h"
+#include "base/errors.h"
+#include "session/failure.h"
+
+namespace vkray {
+namespace {
+
+template <typename E>
+Failure failure_of(const E& error) {
+  return describe_failure(std::make_exception_ptr(error));
+}
+
+TEST(FailureTest, EachKindHasItsExitCode) {
+  EXPECT_EQ(failure_of(SceneError("s.json: /camera: missing")).exit_code, kExitBadInput);
+  EXPECT_EQ(failure_of(MeshError("m.obj:3: bad")).exit_code, kExitBadInput);
+  EXPECT_EQ(failure_of(OutputError("x.jpg: unknown image type")).exit_code, kExitBadInput);
+  EXPECT_EQ(failure_of(LimitError("too many")).exit_code, kExitBadInput);
+  EXPECT_EQ(failure_of(UsageError("--width 0")).exit_code, kExitUsage);
+  EXPECT_EQ(failure_of(DeviceError("no device")).exit_code, kExitDevice);
+  EXPECT_EQ(failure_of(TimeoutError("tile")).exit_code, kExitDevice);
+  EXPECT_EQ(failure_of(Cancelled()).exit_code, kExitInterrupted);
+  EXPECT_EQ(failure_of(InternalError("x")).exit_code, kExitInternal);
+  const Failure shader = failure_of(ShaderError("a.glsl:3: error: x\nb.glsl:4: error: y"));
+  EXPECT_EQ(shader.exit_code, kExitBadInput);
+  EXPECT_TRUE(shader.multiline);
+}
+
+TEST(FailureTest, AMeshErrorIsASceneError) {
+  // What survives a broken scene (vkray watch, a Python caller) survives a broken mesh.
+  EXPECT_THROW(throw MeshError("m.obj"), SceneError);
+}
+
+TEST(FailureTest, WhatADependencyThrowsIsClassified) {
+  const Failure vulkan = failure_of(vk::OutOfDeviceMemoryError("vk::raii::Device::allocateMemory"));
+  EXPECT_EQ(vulkan.exit_code, kExitDevice);
+  EXPECT_NE(vulkan.message.find("allocateMemory"), std::string::npos) << vulkan.message;
+  EXPECT_EQ(failure_of(std::bad_alloc()).exit_code, kExitBadInput);
+  const Failure other = failure_of(std::logic_error("unexpected"));
+  EXPECT_EQ(other.exit_code, kExitInternal);
+  EXPECT_EQ(other.message, "unexpected");
+}
+
+TEST(FailureTest, OversizedArithmeticIsAnInputError) {
+  try {
+    checked_mul(uint64_t(1) << 40, uint64_t(1) << 40, "output image");
+    ADD_FAILURE() << "no error";
+  } catch (...) {
+    const Failure f = describe_failure(std::current_exception());
+    EXPECT_EQ(f.exit_code, kExitBadInput);
+    EXPECT_EQ(f.message, "output image: size overflows 64 bits");
+  }
+}
+
+}  // namespace
+}  // namespace vkray
