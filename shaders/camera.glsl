@@ -3,7 +3,8 @@
 #ifndef VKRAY_CAMERA_GLSL
 #define VKRAY_CAMERA_GLSL
 
-#include "scene.glsl"
+#include "ray.glsl"
+#include "resources.glsl"
 
 Ray camera_ray(uvec2 pixel, vec2 xi) {
   // `precise` forbids fusing these multiply-adds, so the ray matches the CPU's bit for bit on drivers

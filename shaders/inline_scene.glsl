@@ -5,5 +5,5 @@
 //                               inout Hit hit)
 // which tests every primitive of the scene in the scene's order, its coordinates written as
 // constants, with shear_point and sheared_triangle (intersect.glsl) or intersect_sphere, and keeps
-// the closest hit in (t_min, t_max) (with any_hit: a hit); traverse() (scene.glsl) then calls it
+// the closest hit in (t_min, t_max) (with any_hit: a hit); traverse() (traversal.glsl) then calls it
 // instead of walking the BVH.

@@ -12,7 +12,7 @@ const float FAR = 1e30;  // "no upper bound" for t; larger than any finite scene
 
 struct Hit {
   float t;
-  uint prim;  // triangle index, or triangle_count + sphere index; NO_HIT when nothing was hit
+  uint prim;  // the primitive's slot in the primitive buffer (BVH leaf order); NO_HIT when nothing was hit
 };
 
 vec3 ray_at(Ray ray, float t) { return ray.origin + t * ray.dir; }

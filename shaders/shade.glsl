@@ -6,7 +6,9 @@
 #ifndef VKRAY_SHADE_GLSL
 #define VKRAY_SHADE_GLSL
 
-#include "scene.glsl"
+#include "primitives.glsl"
+#include "resources.glsl"
+#include "traversal.glsl"
 
 const float PI = 3.14159265358979;
 
@@ -29,7 +31,7 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
   uint i = 0u;
   if (frame.light_count > 0u) do {
     int base = int(i) * VKRAY_TEXELS_PER_LIGHT;
-    vec3 light_pos = texelFetch(lights, base).xyz;
+    vec3 light_pos = texelFetch(lights, base + VKRAY_LIGHT_POSITION).xyz;
     vec3 to_light = light_pos - x;
     float r2 = dot(to_light, to_light);
     float cos_theta = dot(n, to_light * inversesqrt(r2));
@@ -42,7 +44,7 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
       // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
       lit = !trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon);
     }
-    if (lit) irradiance += texelFetch(lights, base + 1).rgb * (cos_theta / (PI * r2));
+    if (lit) irradiance += texelFetch(lights, base + VKRAY_LIGHT_INTENSITY).rgb * (cos_theta / (PI * r2));
   } while (++i < frame.light_count);
   return surface.albedo * irradiance;
 }

@@ -3,10 +3,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
-#include "shared/types.h"
 #include "shared/sampling.h"
+#include "shared/types.h"
 #include "camera.glsl"
+#include "resources.glsl"
 #include "shade.glsl"
+#include "traversal.glsl"
 
 layout(local_size_x = VKRAY_WORKGROUP_X, local_size_y = VKRAY_WORKGROUP_Y, local_size_z = 1) in;
 
@@ -14,7 +16,7 @@ layout(push_constant) uniform Tile { TileConstants tile; };
 layout(std430, set = 0, binding = VKRAY_BINDING_OUTPUT) writeonly buffer Output { vec4 radiance[]; };
 
 void main() {
-  frame = frame_block;
+  load_frame();
   // The workgroup's place in the tile: its row permuted (TileConstants::row_stride).
   uvec2 group = uvec2(gl_WorkGroupID.x, (gl_WorkGroupID.y * tile.row_stride) % gl_NumWorkGroups.y);
   uvec2 local = group * uvec2(VKRAY_WORKGROUP_X, VKRAY_WORKGROUP_Y) + gl_LocalInvocationID.xy;

@@ -1,19 +1,21 @@
 // The renderer's ray-triangle and ray-sphere routines (shaders/intersect.glsl), run on the device.
 #include <cmath>
+#include <cstddef>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
+#include "shaders/intersect_case.h"
 #include "support/compute_kernel.h"
 #include "support/gpu_fixture.h"
 
 namespace vkray::test {
 namespace {
 
-struct Case {  // matches `Case` in tests/shaders/intersect_test.comp
-  glm::vec4 origin, dir, a, b, c, range;
-};
+using Case = gpu::IntersectCase;
+static_assert(sizeof(Case) == 96 && offsetof(Case, dir) == 16 && offsetof(Case, a) == 32 && offsetof(Case, b) == 48 &&
+              offsetof(Case, c) == 64 && offsetof(Case, range) == 80);
 
 constexpr float kFar = 1e30f;
 

@@ -234,20 +234,20 @@ TEST_F(RenderTest, WithoutShadowRaysEveryLightIsVisible) {
 }
 
 TEST_F(RenderTest, GeneratedCodeThatDoesNotCompileIsAShaderError) {
-  // A shader folder whose scene.glsl no longer gives the generated code what it calls: its own
+  // A shader folder whose traversal.glsl no longer gives the generated code what it calls: its own
   // SPIR-V compiles (nothing after the include calls shear_point), the scene's does not, and the
   // message says where.
   TempDir dir;
   std::filesystem::copy(VKRAY_SHADER_DIR, dir.path(), std::filesystem::copy_options::recursive);
   std::string text;
   {
-    std::ifstream in(dir / "scene.glsl");
+    std::ifstream in(dir / "traversal.glsl");
     text.assign(std::istreambuf_iterator<char>(in), {});
   }
   const std::string include = "#include \"inline_scene.glsl\"";
   ASSERT_NE(text.find(include), std::string::npos);
   text.replace(text.find(include), 0, "#define shear_point(a, k, s) missing_function(a)\n");
-  std::ofstream(dir / "scene.glsl") << text;
+  std::ofstream(dir / "traversal.glsl") << text;
 
   const auto shader = gpu::compile_compute_shader(dir / "trace.comp", {dir.path()});
   const gpu::TracePipeline pipeline(ctx(), dir.path(), shader.spirv);

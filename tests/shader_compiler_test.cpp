@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -50,12 +51,15 @@ TEST(ShaderCompilerTest, CompilesTheTracerAndListsEveryIncludedFile) {
   const gpu::CompiledShader shader = gpu::compile_compute_shader(dir / "trace.comp", {dir});
   EXPECT_GT(shader.spirv.size(), 100u);
   EXPECT_EQ(shader.spirv[0], 0x07230203u);  // SPIR-V magic
-  for (const char* file : {"trace.comp", "shared/types.h", "shared/sampling.h", "camera.glsl", "shade.glsl",
-                           "scene.glsl", "intersect.glsl", "ray.glsl", "inline_scene.glsl"}) {
+  const char* files[] = {"trace.comp",     "shared/glsl_cpp.h", "shared/types.h",  "shared/scene_layout.h",
+                         "shared/sampling.h", "camera.glsl",     "ray.glsl",        "resources.glsl",
+                         "shade.glsl",      "primitives.glsl",   "intersect.glsl",  "traversal.glsl",
+                         "inline_scene.glsl"};
+  for (const char* file : files) {
     const auto expected = (dir / file).lexically_normal();
     EXPECT_NE(std::find(shader.sources.begin(), shader.sources.end(), expected), shader.sources.end()) << file;
   }
-  EXPECT_EQ(shader.sources.size(), 9u);  // each once, though several are included more than once
+  EXPECT_EQ(shader.sources.size(), std::size(files));  // each once, though several are included more than once
 }
 
 TEST(ShaderCompilerTest, ErrorInAnIncludedFileNamesThatFileAndLine) {
@@ -78,7 +82,7 @@ TEST(ShaderCompilerTest, ErrorInTheEntryFile) {
 
 TEST(ShaderCompilerTest, MissingIncludeNamesTheIncludingLine) {
   ShaderCopy copy;
-  const int line = copy.edit("shade.glsl", "#include \"scene.glsl\"", "#include \"no_such_file.glsl\"");
+  const int line = copy.edit("shade.glsl", "#include \"traversal.glsl\"", "#include \"no_such_file.glsl\"");
   const std::string message = compile_error(copy.path());
   const std::string expected = (copy.path() / "shade.glsl").lexically_normal().string() + ":" + std::to_string(line) + ":";
   EXPECT_NE(message.find(expected), std::string::npos) << message;

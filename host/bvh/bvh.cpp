@@ -35,7 +35,7 @@ class Builder {
     if (is_leaf(link)) {  // everything fits one leaf: a root with one empty child
       bvh_.nodes[0].child[0] = all;
       bvh_.nodes[0].link[0] = link;
-      bvh_.nodes[0].link[1] = kLeafBit;  // count 0: never entered, its box is empty
+      bvh_.nodes[0].link[1] = leaf_link(0, 0);  // count 0: never entered, its box is empty
       bvh_.depth = 1;
     }
     return std::move(bvh_);
@@ -55,7 +55,7 @@ class Builder {
     bvh_.depth = std::max(bvh_.depth, depth);
     uint32_t mid = 0;
     if (count <= 2 || !split(begin, end, box, depth, mid)) {
-      if (count <= kMaxLeafSize) return kLeafBit | (begin << kLeafCountBits) | count;
+      if (count <= kMaxLeafSize) return leaf_link(begin, count);
       mid = median_split(begin, end);
     }
     const uint32_t index = depth == 1 ? 0 : uint32_t(bvh_.nodes.size());

@@ -9,7 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/scene.h"
-#include "shared/types.h"
+#include "shared/scene_layout.h"
 
 namespace vkray {
 
@@ -30,20 +30,18 @@ struct Aabb {
   }
 };
 
-// A child link: an inner node's index, or a leaf (kLeafBit | first << kLeafCountBits | count),
-// where first is the index of its first primitive in Bvh::order and count is 1..kMaxLeafSize.
-constexpr uint32_t kLeafBit = VKRAY_LEAF_BIT;
-constexpr uint32_t kLeafCountBits = VKRAY_LEAF_COUNT_BITS;
-constexpr uint32_t kMaxLeafSize = (1u << kLeafCountBits) - 1;
-constexpr uint32_t kMaxPrimitives = 1u << (31 - kLeafCountBits);
+// A child link: an inner node's index, or a leaf naming its first primitive in Bvh::order and its
+// count, 1..kMaxLeafSize. The encoding is the one the shader decodes (shared/scene_layout.h).
+using gpu::is_leaf;
+using gpu::leaf_count;
+using gpu::leaf_first;
+using gpu::leaf_link;
+constexpr uint32_t kMaxLeafSize = (1u << VKRAY_LEAF_COUNT_BITS) - 1;
+constexpr uint32_t kMaxPrimitives = 1u << (31 - VKRAY_LEAF_COUNT_BITS);
 static_assert(kMaxScenePrimitives == kMaxPrimitives - 1, "the scene's limit is the leaf encoding's");
 // The builder keeps the depth (levels of inner nodes) below this; the GPU's traversal stack is sized
 // for it (VKRAY_TRAVERSAL_STACK).
 constexpr uint32_t kMaxDepth = 64;
-
-inline bool is_leaf(uint32_t link) { return (link & kLeafBit) != 0; }
-inline uint32_t leaf_first(uint32_t link) { return (link & ~kLeafBit) >> kLeafCountBits; }
-inline uint32_t leaf_count(uint32_t link) { return link & kMaxLeafSize; }
 
 struct BvhNode {
   Aabb child[2];

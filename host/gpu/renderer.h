@@ -62,7 +62,7 @@ class TracePipeline {
   const vk::raii::PipelineLayout& layout() const { return layout_; }
   // The pipeline for `variant`, compiled now if not kept from before. Callers that time compilation
   // apart from tracing call this before rendering. Throws ShaderError when the shaders do not compile
-  // with a scene's generated code (a shader folder whose scene.glsl no longer fits the contract in
+  // with a scene's generated code (a shader folder whose traversal.glsl no longer fits the contract in
   // inline_scene.glsl). The few most recent variants with a scene compiled in are kept.
   std::shared_ptr<const vk::raii::Pipeline> pipeline(const ShaderVariant& variant) const;
 

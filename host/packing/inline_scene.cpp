@@ -35,7 +35,7 @@ std::string inline_scene_glsl(const PackedScene& packed) {
   std::vector<uint32_t> order(count);
   std::iota(order.begin(), order.end(), 0u);
   const auto scene_index = [&](uint32_t p) {
-    return std::bit_cast<uint32_t>(packed.primitives[size_t(p) * VKRAY_TEXELS_PER_PRIMITIVE + 1].w);
+    return primitive_scene_index(packed.primitives[size_t(p) * VKRAY_TEXELS_PER_PRIMITIVE + 1]);
   };
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return scene_index(a) < scene_index(b); });
 
@@ -60,8 +60,8 @@ std::string inline_scene_glsl(const PackedScene& packed) {
   };
   for (const uint32_t p : order) {
     const glm::vec4* t = &packed.primitives[size_t(p) * VKRAY_TEXELS_PER_PRIMITIVE];
-    if (std::bit_cast<uint32_t>(t[0].w) & VKRAY_PRIM_SPHERE) {
-      out += "  t = intersect_sphere(ray, " + vec3_literal(t[0]) + ", " + literal(t[1].x) + ", t_min, bound);\n";
+    if (primitive_flags(t[0]) & VKRAY_PRIM_SPHERE) {
+      out += "  t = intersect_sphere(ray, " + vec3_literal(t[0]) + ", " + literal(sphere_radius(t[1])) + ", t_min, bound);\n";
     } else {
       const std::string a = vertex(t[0]), b = vertex(t[1]), c = vertex(t[2]);
       out += "  t = sheared_triangle(" + a + ", " + b + ", " + c + ", t_min, bound);\n";

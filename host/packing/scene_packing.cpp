@@ -11,18 +11,8 @@
 namespace vkray::gpu {
 namespace {
 
-float bits(uint32_t v) { return std::bit_cast<float>(v); }
-
-// The word holding the children's high sides along `axis`: byte c of (lo.x, lo.y, lo.z, hi.x) in
-// texel 2 and of (hi.y, hi.z) in texel 3 (shaders/shared/types.h).
-template <typename Texel>
-auto* hi_word(Texel* node, int axis) {
-  return axis == 0 ? &node[2].w : &node[3][axis - 1];
-}
-
-// Corner q (0..255) of a quantized box along one axis, computed as the shader does. q * scale is
-// exact (8 bits times a power of two), so fused or not, the sum is rounded once.
-float dequantize(float origin, float scale, uint32_t q) { return origin + float(q) * scale; }
+// Side q (0..255) of a quantized box along one axis, decoded by the shader's own code.
+float dequantize(float origin, float scale, uint32_t q) { return node_child_sides(origin, scale, q).x; }
 
 // The smallest power of two `scale` with 254 * scale >= extent: a box side spans at most 254 steps,
 // leaving one step of room for rounding outward. Returned as a biased float exponent (1..254).
@@ -79,16 +69,13 @@ class NodePacker {
     for (int c = 0; c < count; ++c) all.grow(children[c].box);
     glm::uvec4* t = &texels_[size_t(wide) * VKRAY_TEXELS_PER_NODE];
     uint32_t exponents = 0;
-    glm::vec3 scale;
-    for (int axis = 0; axis < 3; ++axis) {
-      const uint32_t e = scale_exponent(double(all.max[axis]) - double(all.min[axis]));
-      exponents |= e << (8 * axis);
-      scale[axis] = std::bit_cast<float>(e << 23);
-      t[0][axis] = std::bit_cast<uint32_t>(all.min[axis]);
-    }
-    t[0].w = exponents;
+    for (int axis = 0; axis < 3; ++axis)
+      exponents |= scale_exponent(double(all.max[axis]) - double(all.min[axis])) << (8 * axis);
+    t[VKRAY_NODE_HEADER] = glm::uvec4(floatBitsToUint(all.min), exponents);
+    const glm::vec3 scale = node_scale(exponents);
+    NodeCorners corners{glm::uvec3(0u), glm::uvec3(0u)};
     for (int c = 0; c < count; ++c) {
-      t[1][c] = children[c].link;
+      t[VKRAY_NODE_LINKS][c] = children[c].link;
       for (int axis = 0; axis < 3; ++axis) {
         const float origin = all.min[axis], lo = children[c].box.min[axis], hi = children[c].box.max[axis];
         // Round outward: the largest step at or below lo, the smallest at or above hi.
@@ -97,10 +84,13 @@ class NodePacker {
         uint32_t q_hi = uint32_t(std::clamp(std::ceil((double(hi) - origin) / scale[axis]), 0.0, 255.0));
         while (q_hi < 255 && dequantize(origin, scale[axis], q_hi) < hi) ++q_hi;
         VKRAY_CHECK(dequantize(origin, scale[axis], q_hi) >= hi, "BVH node quantization lost a box side");
-        set_byte(t[2][axis], c, q_lo);
-        set_byte(*hi_word(t, axis), c, q_hi);
+        set_byte(corners.lo[axis], c, q_lo);
+        set_byte(corners.hi[axis], c, q_hi);
       }
     }
+    const NodeCornerTexels corner_texels = node_corner_texels(corners);
+    t[VKRAY_NODE_CORNERS] = corner_texels.first;
+    t[VKRAY_NODE_CORNERS + 1] = corner_texels.second;
   }
 
   static void set_byte(uint32_t& word, int c, uint32_t value) { word |= value << (8 * c); }
@@ -114,12 +104,13 @@ class NodePacker {
 std::vector<glm::uvec4> pack_nodes(const Bvh& bvh) { return NodePacker(bvh).pack(); }
 
 Aabb unpack_child_box(const glm::uvec4* node, int c) {
+  const glm::vec3 origin = uintBitsToFloat(glm::uvec3(node[VKRAY_NODE_HEADER]));
+  const glm::vec3 scale = node_scale(node[VKRAY_NODE_HEADER].w);
+  const NodeCorners corners = node_corners(node[VKRAY_NODE_CORNERS], node[VKRAY_NODE_CORNERS + 1]);
   Aabb box;
   for (int axis = 0; axis < 3; ++axis) {
-    const float origin = std::bit_cast<float>(node[0][axis]);
-    const float scale = std::bit_cast<float>(((node[0].w >> (8 * axis)) & 0xffu) << 23);
-    box.min[axis] = dequantize(origin, scale, (node[2][axis] >> (8 * c)) & 0xffu);
-    box.max[axis] = dequantize(origin, scale, (*hi_word(node, axis) >> (8 * c)) & 0xffu);
+    box.min[axis] = node_child_sides(origin[axis], scale[axis], corners.lo[axis])[c];
+    box.max[axis] = node_child_sides(origin[axis], scale[axis], corners.hi[axis])[c];
   }
   return box;
 }
@@ -163,25 +154,24 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
   if (any_smooth) packed.normals.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
   for (size_t slot = 0; slot < bvh.order.size(); ++slot) {
     const uint32_t p = bvh.order[slot];
+    PrimitiveTexels texels;
     if (p < triangle_count) {
       const Triangle& t = scene.triangles[p];
-      packed.primitives.emplace_back(t.v[0], bits(t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u)));
-      packed.primitives.emplace_back(t.v[1], bits(p));
-      packed.primitives.emplace_back(t.v[2], 0.0f);
+      texels = triangle_texels(t.v[0], t.v[1], t.v[2], t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u), p);
       if (t.smooth)
         for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
     } else {
       const Sphere& s = scene.spheres[p - triangle_count];
-      packed.primitives.emplace_back(s.center, bits(s.material | VKRAY_PRIM_SPHERE));
-      packed.primitives.emplace_back(s.radius, 0.0f, 0.0f, bits(p));
-      packed.primitives.emplace_back(0.0f);
+      texels = sphere_texels(s.center, s.radius, s.material, p);
     }
+    packed.primitives.insert(packed.primitives.end(), {texels.a, texels.b, texels.c});
   }
   packed.nodes = pack_nodes(bvh);
   for (const Material& m : scene.materials) packed.materials.emplace_back(m.albedo, 0.0f);
-  for (const PointLight& l : scene.lights) {
-    packed.lights.emplace_back(l.position, 0.0f);
-    packed.lights.emplace_back(l.intensity, 0.0f);
+  packed.lights.resize(scene.lights.size() * VKRAY_TEXELS_PER_LIGHT);
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    packed.lights[i * VKRAY_TEXELS_PER_LIGHT + VKRAY_LIGHT_POSITION] = glm::vec4(scene.lights[i].position, 0.0f);
+    packed.lights[i * VKRAY_TEXELS_PER_LIGHT + VKRAY_LIGHT_INTENSITY] = glm::vec4(scene.lights[i].intensity, 0.0f);
   }
   return packed;
 }

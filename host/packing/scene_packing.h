@@ -1,4 +1,4 @@
-// The scene in the layout the shader reads (shaders/shared/types.h): texel arrays, frame uniforms
+// The scene in the layout the shader reads (shaders/shared/scene_layout.h, types.h): texel arrays, frame uniforms
 // and the tile constants' row order. No Vulkan here, so it is testable without a device.
 #pragma once
 
@@ -9,34 +9,24 @@
 
 #include "bvh/bvh.h"
 #include "scene/scene.h"
+#include "shared/scene_layout.h"
 #include "shared/types.h"
 
 namespace vkray::gpu {
 
-// std140 layout of FrameUniforms, checked member by member.
-static_assert(offsetof(FrameUniforms, origin) == 0);
-static_assert(offsetof(FrameUniforms, forward) == 48);
-static_assert(offsetof(FrameUniforms, ambient) == 80);
-static_assert(offsetof(FrameUniforms, width) == 96);
-static_assert(offsetof(FrameUniforms, primitive_count) == 108);
-static_assert(offsetof(FrameUniforms, strata_y) == 120);
-static_assert(offsetof(FrameUniforms, epsilon) == 136);
-static_assert(sizeof(FrameUniforms) == 140);
-static_assert(sizeof(TileConstants) == 20);
-
 // The scene's buffers; the per-frame uniforms come from pack_frame().
 struct PackedScene {
-  std::vector<glm::vec4> primitives;  // VKRAY_TEXELS_PER_PRIMITIVE texels each, in BVH leaf order
+  std::vector<glm::vec4> primitives;  // PrimitiveTexels (shared/scene_layout.h) each, in BVH leaf order
   std::vector<glm::vec4> normals;     // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when nothing is smooth
   std::vector<glm::uvec4> nodes;      // VKRAY_TEXELS_PER_NODE texels each (pack_nodes)
-  std::vector<glm::vec4> materials;   // one texel each
+  std::vector<glm::vec4> materials;   // VKRAY_TEXELS_PER_MATERIAL texels each
   std::vector<glm::vec4> lights;      // VKRAY_TEXELS_PER_LIGHT texels each
 };
 
 PackedScene pack_scene(const Scene& scene, const Bvh& bvh);
 
 // The binary BVH as the shader reads it: 4-wide nodes, each a binary node with its children's
-// children, child boxes quantized to 8 bits per side (layout in shaders/shared/types.h). Empty when
+// children, child boxes quantized to 8 bits per side (layout in shaders/shared/scene_layout.h). Empty when
 // the BVH is.
 std::vector<glm::uvec4> pack_nodes(const Bvh& bvh);
 

@@ -9,14 +9,9 @@
 #ifndef VKRAY_SHARED_SAMPLING_H
 #define VKRAY_SHARED_SAMPLING_H
 
-#include "types.h"
+#include "glsl_cpp.h"
 
-#ifdef __cplusplus
-namespace vkray::gpu {
-#define VKRAY_INLINE inline
-#else
-#define VKRAY_INLINE
-#endif
+VKRAY_SHARED_BEGIN
 
 // PCG-RXS-M-XS 32-bit hash (Jarzynski & Olano, "Hash Functions for GPU Rendering", JCGT 2020).
 VKRAY_INLINE uint pcg_hash(uint v) {
@@ -40,7 +35,5 @@ VKRAY_INLINE vec2 sample_offset(uint pixel_index, uint k, uint spp, uint strata_
               (float(cell_y) + hash_to_unit(h2)) * inv_strata_y);
 }
 
-#ifdef __cplusplus
-}  // namespace vkray::gpu
-#endif
+VKRAY_SHARED_END
 #endif  // VKRAY_SHARED_SAMPLING_H

@@ -1,27 +1,24 @@
-// Everything that crosses between the C++ host and the GLSL shaders: binding numbers, workgroup size,
-// the uniform and push-constant structs, and the texel layout of the scene buffers. Both languages
-// include this file, so a binding number or a struct member is written exactly once. The C++ side
-// static_asserts the std140 layout in host/packing/scene_packing.h.
+// The interface between the C++ host and trace.comp: binding numbers, specialization constants,
+// workgroup size, and the uniform and push-constant structs, each written once for both languages
+// (the scene buffers' texel layouts are in scene_layout.h). The C++ side static_asserts every
+// member's std140 offset right here; gpu/bindings.h holds each binding's descriptor type, and the
+// shader's own declarations are checked against it when it is compiled.
 #ifndef VKRAY_SHARED_TYPES_H
 #define VKRAY_SHARED_TYPES_H
 
-#ifdef __cplusplus
-#include <cstdint>
-#include <glm/glm.hpp>
-namespace vkray::gpu {
-using uint = std::uint32_t;
-using glm::vec2;
-using glm::vec3;
-using glm::vec4;
-#endif
+#include "glsl_cpp.h"
+
+VKRAY_SHARED_BEGIN
 
 // ---- Descriptor bindings (set 0) -------------------------------------------------------------
+// Scene data is in uniform texel buffers, which llvmpipe reads about twice as fast as storage
+// buffers (docs/design.md, "Scene buffers").
 #define VKRAY_BINDING_FRAME 0       // uniform buffer: FrameUniforms
-#define VKRAY_BINDING_PRIMITIVES 1  // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_PRIMITIVE each, in BVH order
-#define VKRAY_BINDING_NORMALS 2     // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_PRIMITIVE each (smooth triangles)
-#define VKRAY_BINDING_NODES 3       // uniform texel buffer, RGBA32UI, VKRAY_TEXELS_PER_NODE each
-#define VKRAY_BINDING_MATERIALS 4   // uniform texel buffer, RGBA32F, one texel (albedo) each
-#define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F, VKRAY_TEXELS_PER_LIGHT each
+#define VKRAY_BINDING_PRIMITIVES 1  // uniform texel buffer, RGBA32F: PrimitiveTexels, in BVH leaf order
+#define VKRAY_BINDING_NORMALS 2     // uniform texel buffer, RGBA32F: vertex normals of smooth triangles
+#define VKRAY_BINDING_NODES 3       // uniform texel buffer, RGBA32UI: 4-wide BVH nodes
+#define VKRAY_BINDING_MATERIALS 4   // uniform texel buffer, RGBA32F: albedos
+#define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F: point lights
 #define VKRAY_BINDING_OUTPUT 6      // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
 
 // ---- Specialization constants ------------------------------------------------------------------
@@ -31,40 +28,11 @@ using glm::vec4;
 // `vkray bench`): the pipeline has no shadow-ray code, which would cost every lane, masked.
 #define VKRAY_SPEC_SHADOWS 1
 
-// Texel buffers rather than storage buffers: with the triangles in a storage buffer instead, a
-// 1024x1024 render on Mesa 22.3.6 lavapipe (2 cores) took 1.8-2.3x as long (README, "How the GPU
-// path works").
-//
-// Primitive, in BVH leaf order: a triangle is (v0.xyz, flags), (v1.xyz, index), (v2.xyz, 0), vertices
-// rather than edges, since the watertight test needs every triangle sharing a vertex to see bitwise
-// the same coordinates; a sphere is (center.xyz, flags), (radius, 0, 0, index), (0). `index` is the
-// primitive's place in the scene (bits of a uint), which decides ties (VKRAY_TIE).
-// flags = material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH.
-#define VKRAY_TEXELS_PER_PRIMITIVE 3
-#define VKRAY_PRIM_SPHERE 0x80000000u
-#define VKRAY_PRIM_SMOOTH 0x40000000u  // a triangle with vertex normals in the normals buffer
-#define VKRAY_PRIM_MATERIAL_MASK 0x3fffffffu
-// BVH node, 4-wide (host/packing/scene_packing.cpp collapses the binary BVH two levels at a time), in a
-// RGBA32UI texel buffer, VKRAY_TEXELS_PER_NODE texels each:
-//   0: (origin.xyz as float bits, e), e = ex | ey << 8 | ez << 16, biased float exponents
-//   1: the four child links; 0 = no child (no node links to the root)
-//   2: (lo.x, lo.y, lo.z, hi.x), 3: (hi.y, hi.z, 0, 0): byte c of each is child c's box corner in
-//      steps of 2^(e - 127) from the origin, rounded outward, so a child's box always contains its
-//      primitives: origin + q * 2^(e - 127) is exact up to the one rounding of the sum.
-// A link is an inner node's index, or VKRAY_LEAF_BIT | first << VKRAY_LEAF_COUNT_BITS | count.
-#define VKRAY_TEXELS_PER_NODE 4
-#define VKRAY_NODE_WIDTH 4
-#define VKRAY_LEAF_BIT 0x80000000u
-#define VKRAY_LEAF_COUNT_BITS 4u
-// A node pushes at most VKRAY_NODE_WIDTH - 1 children, and the binary BVH is at most 64 levels
-// deep (host/bvh/bvh.h), so at most 32 wide ones.
-#define VKRAY_TRAVERSAL_STACK 96
+// ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
 // precision: a ray along the line where two walls meet, coplanar surfaces); the primitive that
 // comes first in the scene wins, so the result does not depend on traversal order.
 #define VKRAY_TIE 1e-5
-// Light: (position.xyz, 0), (intensity.rgb, 0).
-#define VKRAY_TEXELS_PER_LIGHT 2
 
 // ---- Workgroup ---------------------------------------------------------------------------------
 #define VKRAY_WORKGROUP_X 8
@@ -90,7 +58,29 @@ struct FrameUniforms {
   float inv_strata_y;
   float inv_samples_per_pixel;
   float epsilon;    // self-intersection offset, scaled to the scene's extent
+  uint unused;      // std140 rounds the struct up to a multiple of 16 bytes; the buffer holds all of it
 };
+#ifdef __cplusplus
+static_assert(offsetof(FrameUniforms, origin) == 0);
+static_assert(offsetof(FrameUniforms, right) == 16);
+static_assert(offsetof(FrameUniforms, up) == 32);
+static_assert(offsetof(FrameUniforms, forward) == 48);
+static_assert(offsetof(FrameUniforms, background) == 64);
+static_assert(offsetof(FrameUniforms, ambient) == 80);
+static_assert(offsetof(FrameUniforms, width) == 96);
+static_assert(offsetof(FrameUniforms, height) == 100);
+static_assert(offsetof(FrameUniforms, samples_per_pixel) == 104);
+static_assert(offsetof(FrameUniforms, primitive_count) == 108);
+static_assert(offsetof(FrameUniforms, light_count) == 112);
+static_assert(offsetof(FrameUniforms, strata_x) == 116);
+static_assert(offsetof(FrameUniforms, strata_y) == 120);
+static_assert(offsetof(FrameUniforms, inv_strata_x) == 124);
+static_assert(offsetof(FrameUniforms, inv_strata_y) == 128);
+static_assert(offsetof(FrameUniforms, inv_samples_per_pixel) == 132);
+static_assert(offsetof(FrameUniforms, epsilon) == 136);
+static_assert(offsetof(FrameUniforms, unused) == 140);
+static_assert(sizeof(FrameUniforms) == 144);
+#endif
 
 // ---- Push constants: the tile this dispatch covers ---------------------------------------------
 struct TileConstants {
@@ -104,8 +94,14 @@ struct TileConstants {
   // cheap and costly pixels, so no thread finishes long before the others (gpu::row_stride).
   uint row_stride;
 };
-
 #ifdef __cplusplus
-}  // namespace vkray::gpu
+static_assert(offsetof(TileConstants, x0) == 0);
+static_assert(offsetof(TileConstants, y0) == 4);
+static_assert(offsetof(TileConstants, width) == 8);
+static_assert(offsetof(TileConstants, height) == 12);
+static_assert(offsetof(TileConstants, row_stride) == 16);
+static_assert(sizeof(TileConstants) == 20);
 #endif
+
+VKRAY_SHARED_END
 #endif  // VKRAY_SHARED_TYPES_H

@@ -1,51 +1,22 @@
-// Scene access and the traversal every ray needs: the BVH (host/bvh/bvh.h) walked front to back for
-// the closest hit (camera rays), or until any hit (shadow rays).
-#ifndef VKRAY_SCENE_GLSL
-#define VKRAY_SCENE_GLSL
+// The BVH (host/bvh/bvh.h, 4-wide on the GPU) walked front to back for the closest hit (camera
+// rays), or until any hit (shadow rays); or, for a scene compiled into the shader, every primitive
+// tested in the scene's order.
+#ifndef VKRAY_TRAVERSAL_GLSL
+#define VKRAY_TRAVERSAL_GLSL
 
-#include "shared/types.h"
-#include "intersect.glsl"
+#include "primitives.glsl"
+#include "resources.glsl"
 
-layout(std140, set = 0, binding = VKRAY_BINDING_FRAME) uniform Frame { FrameUniforms frame_block; };
-// The frame's constants, copied from the uniform block once at the start of main (trace.comp):
-// llvmpipe (Mesa 22.3) reads a uniform block lane by lane, about 20 instructions a value, at every
-// use (bunny 256^2: 3.4% of the shader's instructions, Cornell box 5.4%).
-FrameUniforms frame;
-layout(set = 0, binding = VKRAY_BINDING_PRIMITIVES) uniform samplerBuffer primitives;
-layout(set = 0, binding = VKRAY_BINDING_NORMALS) uniform samplerBuffer normals;
-layout(set = 0, binding = VKRAY_BINDING_NODES) uniform usamplerBuffer nodes;
-layout(set = 0, binding = VKRAY_BINDING_MATERIALS) uniform samplerBuffer materials;
-layout(set = 0, binding = VKRAY_BINDING_LIGHTS) uniform samplerBuffer lights;
-
-// Set per scene by the host (gpu::ShaderVariant): a pipeline for a scene without spheres has no
-// sphere test. On llvmpipe code behind an if runs for every lane (masked), so a test no primitive
-// needs still costs every leaf step (bunny, 256^2: 7% of the shader's instructions).
-layout(constant_id = VKRAY_SPEC_SPHERES) const bool SCENE_HAS_SPHERES = true;
-layout(constant_id = VKRAY_SPEC_SHADOWS) const bool SHADOW_RAYS = true;
-
-// ---- Primitives ---------------------------------------------------------------------------------------
-// A primitive is VKRAY_TEXELS_PER_PRIMITIVE texels (host/packing/scene_packing.cpp): a triangle's three
-// vertices, or a sphere's center and radius; a.w holds its flags, b.w its index in the scene.
-
-// t of the nearest intersection with the primitive in (t_min, t_max), or -1.
-float intersect_primitive(Ray ray, RayShear shear, vec4 a, vec4 b, vec4 c, float t_min, float t_max) {
-  if (SCENE_HAS_SPHERES && (floatBitsToUint(a.w) & VKRAY_PRIM_SPHERE) != 0u)
-    return intersect_sphere(ray, a.xyz, b.x, t_min, t_max);
-  return intersect_triangle(ray, shear, a.xyz, b.xyz, c.xyz, t_min, t_max);
-}
-
-// ---- Traversal ------------------------------------------------------------------------------------------
 // Each step fetches everything it needs at once, before any math: on llvmpipe a texel fetch is a
-// call that spills the caller's vector registers, and adjacent calls share one spill (`vkray bench`,
-// bunny, camera rays: 449 -> 348 ms, median of 6 alternating runs).
+// call that spills the caller's vector registers, and adjacent calls share one spill.
 
 // Tests the primitives of a leaf against the ray, keeping the closest hit (ties go to the primitive
 // that comes first in the scene, VKRAY_TIE; hit_index is the best hit's place in the scene).
 // Returns true when any_hit and something was hit.
 bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max, bool any_hit, inout Hit hit,
                     inout uint hit_index) {
-  uint first = (link & ~VKRAY_LEAF_BIT) >> VKRAY_LEAF_COUNT_BITS;
-  uint end = first + (link & ((1u << VKRAY_LEAF_COUNT_BITS) - 1u));
+  uint first = leaf_first(link);
+  uint end = first + leaf_count(link);
   // A do-while without `continue` (a leaf is never empty): see the light loop in shade.glsl.
   uint prim = first;
   do {
@@ -55,7 +26,7 @@ bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max
     float limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
     float t = intersect_primitive(ray, shear, a, b, c, t_min, limit);
     if (t > 0.0) {
-      uint index = floatBitsToUint(b.w);
+      uint index = primitive_scene_index(b);
       if (any_hit) {
         hit = Hit(t, prim);
         return true;
@@ -103,19 +74,19 @@ vec4 min_no_nan(vec4 a, vec4 b) { return mix(a, b, lessThan(b, a)); }
 vec4 max_no_nan(vec4 a, vec4 b) { return mix(a, b, greaterThan(b, a)); }
 
 Children enter_node(Ray ray, vec3 inv_dir, bvec3 backward, uint node, float t_min, float t_limit) {
-  const uvec4 byte_shift = uvec4(0u, 8u, 16u, 24u);
   int base = int(node) * VKRAY_TEXELS_PER_NODE;
-  uvec4 header = texelFetch(nodes, base), links = texelFetch(nodes, base + 1), q0 = texelFetch(nodes, base + 2),
-        q1 = texelFetch(nodes, base + 3);
-  // The four child boxes, one child per vector component (exact products: q < 256, scale = 2^k).
+  uvec4 header = texelFetch(nodes, base + VKRAY_NODE_HEADER), links = texelFetch(nodes, base + VKRAY_NODE_LINKS);
+  NodeCorners corners =
+      node_corners(texelFetch(nodes, base + VKRAY_NODE_CORNERS), texelFetch(nodes, base + VKRAY_NODE_CORNERS + 1));
+  // The four child boxes, one child per vector component.
   vec3 origin = uintBitsToFloat(header.xyz);
-  vec3 scale = uintBitsToFloat(((uvec3(header.w) >> uvec3(0u, 8u, 16u)) & 0xffu) << 23u);
-  vec4 lo_x = origin.x + vec4((uvec4(q0.x) >> byte_shift) & 0xffu) * scale.x;
-  vec4 lo_y = origin.y + vec4((uvec4(q0.y) >> byte_shift) & 0xffu) * scale.y;
-  vec4 lo_z = origin.z + vec4((uvec4(q0.z) >> byte_shift) & 0xffu) * scale.z;
-  vec4 hi_x = origin.x + vec4((uvec4(q0.w) >> byte_shift) & 0xffu) * scale.x;
-  vec4 hi_y = origin.y + vec4((uvec4(q1.x) >> byte_shift) & 0xffu) * scale.y;
-  vec4 hi_z = origin.z + vec4((uvec4(q1.y) >> byte_shift) & 0xffu) * scale.z;
+  vec3 scale = node_scale(header.w);
+  vec4 lo_x = node_child_sides(origin.x, scale.x, corners.lo.x);
+  vec4 lo_y = node_child_sides(origin.y, scale.y, corners.lo.y);
+  vec4 lo_z = node_child_sides(origin.z, scale.z, corners.lo.z);
+  vec4 hi_x = node_child_sides(origin.x, scale.x, corners.hi.x);
+  vec4 hi_y = node_child_sides(origin.y, scale.y, corners.hi.y);
+  vec4 hi_z = node_child_sides(origin.z, scale.z, corners.hi.z);
   // The slab test for four boxes at once: (t_enter, t_exit) clipped to (t_min, t_limit), a hit when
   // t_enter <= t_exit. t_exit is scaled by 1 + 2 gamma(3) (Ize, "Robust BVH Ray Traversal", JCGT
   // 2013) so float rounding can never reject a box the ray touches, flat boxes included (the box of
@@ -161,12 +132,12 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   // One loop step handles one node or one leaf: leaves are entered like nodes (nearest child next,
   // the others on the stack), so the leaf code exists once. On llvmpipe an `if` is not a branch
   // (both sides run, masked), so every step costs the leaf code plus the node code; 4-wide nodes
-  // take 40% fewer steps than binary ones (README, "Benchmark"). For the same reason there is one pop
+  // take fewer steps than binary ones (docs/design.md). For the same reason there is one pop
   // site for leaves and nodes alike: each site would cost every step a per-lane gather. A leaf popped
   // after a closer hit was found is still tested; the limit in intersect_leaf keeps the result exact.
   for (;;) {
     bool pop = true;
-    if ((node & VKRAY_LEAF_BIT) != 0u) {
+    if (is_leaf(node)) {
       if (intersect_leaf(ray, shear, node, t_min, t_max, any_hit, hit, hit_index)) return hit;
     } else {
       float t_limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
@@ -194,34 +165,5 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
 Hit trace_closest(Ray ray, float t_min, float t_max) { return traverse(ray, t_min, t_max, false); }
 
 bool trace_any(Ray ray, float t_min, float t_max) { return traverse(ray, t_min, t_max, true).prim != NO_HIT; }
-
-// ---- Surface data at a hit --------------------------------------------------------------------------
-struct Surface {
-  vec3 geometric_normal;  // unit, not yet oriented toward the ray
-  vec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal
-  vec3 albedo;
-};
-
-Surface hit_surface(Hit hit, vec3 position) {
-  int base = int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE;
-  vec4 a = texelFetch(primitives, base);
-  uint flags = floatBitsToUint(a.w);
-  Surface s;
-  s.albedo = texelFetch(materials, int(flags & VKRAY_PRIM_MATERIAL_MASK)).rgb;
-  if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
-    s.geometric_normal = (position - a.xyz) / texelFetch(primitives, base + 1).x;
-    s.shading_normal = s.geometric_normal;
-    return s;
-  }
-  vec3 v1 = texelFetch(primitives, base + 1).xyz, v2 = texelFetch(primitives, base + 2).xyz;
-  s.geometric_normal = normalize(cross(v1 - a.xyz, v2 - a.xyz));
-  s.shading_normal = s.geometric_normal;
-  if ((flags & VKRAY_PRIM_SMOOTH) != 0u) {
-    vec2 uv = triangle_barycentrics(position, a.xyz, v1, v2);
-    s.shading_normal = normalize((1.0 - uv.x - uv.y) * texelFetch(normals, base).xyz + uv.x * texelFetch(normals, base + 1).xyz +
-                                 uv.y * texelFetch(normals, base + 2).xyz);
-  }
-  return s;
-}
 
 #endif

@@ -1,0 +1,30 @@
+// Everything trace.comp is given: the frame's constants, the scene's texel buffers and the
+// pipeline's specialization constants (binding numbers in shared/types.h, texel layouts in
+// shared/scene_layout.h).
+#ifndef VKRAY_RESOURCES_GLSL
+#define VKRAY_RESOURCES_GLSL
+
+#include "shared/scene_layout.h"
+#include "shared/types.h"
+
+layout(std140, set = 0, binding = VKRAY_BINDING_FRAME) uniform Frame { FrameUniforms frame_block; };
+layout(set = 0, binding = VKRAY_BINDING_PRIMITIVES) uniform samplerBuffer primitives;
+layout(set = 0, binding = VKRAY_BINDING_NORMALS) uniform samplerBuffer normals;
+layout(set = 0, binding = VKRAY_BINDING_NODES) uniform usamplerBuffer nodes;
+layout(set = 0, binding = VKRAY_BINDING_MATERIALS) uniform samplerBuffer materials;
+layout(set = 0, binding = VKRAY_BINDING_LIGHTS) uniform samplerBuffer lights;
+
+// The frame's constants as every function reads them: a private copy of the uniform block, made
+// by load_frame() before anything else in main. llvmpipe reads a uniform block lane by lane at
+// every use; a private copy is read like any variable (docs/design.md, "What the time goes to").
+FrameUniforms frame;
+
+void load_frame() { frame = frame_block; }
+
+// Set per scene and render by the host (gpu::ShaderVariant), so that a pipeline has no code for
+// what the render cannot need: on llvmpipe code behind an `if` costs every lane, masked, even when
+// no lane takes it.
+layout(constant_id = VKRAY_SPEC_SPHERES) const bool SCENE_HAS_SPHERES = true;
+layout(constant_id = VKRAY_SPEC_SHADOWS) const bool SHADOW_RAYS = true;
+
+#endif

@@ -1,0 +1,123 @@
+// The scene buffers' texel layouts, as code both sides run: the host packs with the functions here
+// (host/packing/scene_packing.cpp) and the shader unpacks with them (shaders/traversal.glsl,
+// surface.glsl, shade.glsl), so a layout is written once and cannot drift between writer and reader.
+#ifndef VKRAY_SHARED_SCENE_LAYOUT_H
+#define VKRAY_SHARED_SCENE_LAYOUT_H
+
+#include "glsl_cpp.h"
+
+VKRAY_SHARED_BEGIN
+
+// ---- Primitives: VKRAY_TEXELS_PER_PRIMITIVE RGBA32F texels each, in BVH leaf order ---------------------
+// A triangle is its vertices rather than its edges (every triangle sharing a vertex must see bitwise
+// the same coordinates for the watertight test); a sphere is its centre and radius. Each carries its
+// flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH) and its place in the scene, which
+// decides ties (VKRAY_TIE), as the bits of a float.
+#define VKRAY_TEXELS_PER_PRIMITIVE 3
+#define VKRAY_PRIM_SPHERE 0x80000000u
+#define VKRAY_PRIM_SMOOTH 0x40000000u  // a triangle with vertex normals in the normals buffer
+#define VKRAY_PRIM_MATERIAL_MASK 0x3fffffffu
+
+struct PrimitiveTexels {
+  vec4 a;  // triangle: (v0, flags);          sphere: (centre, flags)
+  vec4 b;  // triangle: (v1, scene index);    sphere: (radius, 0, 0, scene index)
+  vec4 c;  // triangle: (v2, 0);              sphere: 0
+};
+
+VKRAY_INLINE PrimitiveTexels triangle_texels(vec3 v0, vec3 v1, vec3 v2, uint flags, uint scene_index) {
+  PrimitiveTexels t;
+  t.a = vec4(v0, uintBitsToFloat(flags));
+  t.b = vec4(v1, uintBitsToFloat(scene_index));
+  t.c = vec4(v2, 0.0f);
+  return t;
+}
+
+VKRAY_INLINE PrimitiveTexels sphere_texels(vec3 centre, float radius, uint flags, uint scene_index) {
+  PrimitiveTexels t;
+  t.a = vec4(centre, uintBitsToFloat(flags | VKRAY_PRIM_SPHERE));
+  t.b = vec4(radius, 0.0f, 0.0f, uintBitsToFloat(scene_index));
+  t.c = vec4(0.0f);
+  return t;
+}
+
+VKRAY_INLINE uint primitive_flags(vec4 a) { return floatBitsToUint(a.w); }
+VKRAY_INLINE uint primitive_scene_index(vec4 b) { return floatBitsToUint(b.w); }
+VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
+
+// Vertex normals of smooth triangles: a second buffer in the same slots as the primitives, one
+// texel per vertex (xyz), present only when some triangle is smooth.
+
+// ---- Materials: one RGBA32F texel each, (albedo, 0) ----------------------------------------------------
+#define VKRAY_TEXELS_PER_MATERIAL 1
+
+// ---- Point lights: VKRAY_TEXELS_PER_LIGHT RGBA32F texels each ---------------------------------------
+#define VKRAY_TEXELS_PER_LIGHT 2
+#define VKRAY_LIGHT_POSITION 0   // (position, 0)
+#define VKRAY_LIGHT_INTENSITY 1  // (intensity, 0), W/sr
+
+// ---- BVH links ---------------------------------------------------------------------------------------
+// A child link is an inner node's index, or a leaf: VKRAY_LEAF_BIT | first << VKRAY_LEAF_COUNT_BITS |
+// count, first the leaf's first primitive in leaf order, count 1 to 2^VKRAY_LEAF_COUNT_BITS - 1.
+#define VKRAY_LEAF_BIT 0x80000000u
+#define VKRAY_LEAF_COUNT_BITS 4u
+
+VKRAY_INLINE uint leaf_link(uint first, uint count) { return VKRAY_LEAF_BIT | (first << VKRAY_LEAF_COUNT_BITS) | count; }
+VKRAY_INLINE bool is_leaf(uint link) { return (link & VKRAY_LEAF_BIT) != 0u; }
+VKRAY_INLINE uint leaf_first(uint link) { return (link & ~VKRAY_LEAF_BIT) >> VKRAY_LEAF_COUNT_BITS; }
+VKRAY_INLINE uint leaf_count(uint link) { return link & ((1u << VKRAY_LEAF_COUNT_BITS) - 1u); }
+
+// ---- BVH nodes: 4-wide, VKRAY_TEXELS_PER_NODE RGBA32UI texels each ---------------------------------
+// The host collapses its binary BVH two levels at a time (host/packing/scene_packing.cpp):
+//   VKRAY_NODE_HEADER:  (origin.xyz as float bits, e), e = ex | ey << 8 | ez << 16, biased float exponents
+//   VKRAY_NODE_LINKS:   the four child links; 0 = no child (no node links to the root)
+//   VKRAY_NODE_CORNERS and the texel after it: the corner words (NodeCorners)
+// Byte c of a corner word is child c's box side along one axis in steps of 2^(e - 127) from the
+// origin, rounded outward, so that a decoded box always contains the child's primitives.
+#define VKRAY_TEXELS_PER_NODE 4
+#define VKRAY_NODE_WIDTH 4
+#define VKRAY_NODE_HEADER 0
+#define VKRAY_NODE_LINKS 1
+#define VKRAY_NODE_CORNERS 2
+// A node pushes at most VKRAY_NODE_WIDTH - 1 children, and the binary BVH is at most 64 levels deep
+// (host/bvh/bvh.h), so at most 32 wide ones.
+#define VKRAY_TRAVERSAL_STACK 96
+
+// The six corner words, low and high side per axis.
+struct NodeCorners {
+  uvec3 lo;
+  uvec3 hi;
+};
+// How they sit in the node's last two texels: (lo.x, lo.y, lo.z, hi.x), (hi.y, hi.z, 0, 0).
+struct NodeCornerTexels {
+  uvec4 first;
+  uvec4 second;
+};
+
+VKRAY_INLINE NodeCornerTexels node_corner_texels(NodeCorners c) {
+  NodeCornerTexels t;
+  t.first = uvec4(c.lo, c.hi.x);
+  t.second = uvec4(c.hi.y, c.hi.z, 0u, 0u);
+  return t;
+}
+
+VKRAY_INLINE NodeCorners node_corners(uvec4 first, uvec4 second) {
+  NodeCorners c;
+  c.lo = uvec3(first.x, first.y, first.z);
+  c.hi = uvec3(first.w, second.x, second.y);
+  return c;
+}
+
+// The step 2^(e - 127) per axis from the header's exponent word.
+VKRAY_INLINE vec3 node_scale(uint exponents) {
+  return uintBitsToFloat(((uvec3(exponents) >> uvec3(0u, 8u, 16u)) & 0xffu) << 23u);
+}
+
+// The four children's box sides along one axis, one child per component, from a corner word. The
+// products are exact (q < 256 times a power of two), so fused or not, each sum is rounded once.
+VKRAY_INLINE vec4 node_child_sides(float origin, float scale, uint corner_word) {
+  return origin + vec4((uvec4(corner_word) >> uvec4(0u, 8u, 16u, 24u)) & 0xffu) * scale;
+}
+
+VKRAY_SHARED_END
+
+#endif  // VKRAY_SHARED_SCENE_LAYOUT_H
