@@ -4,6 +4,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -77,6 +78,36 @@ TEST(CliTest, BrokenShaderExitsOneWithFileAndLineAndWritesNothing) {
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("shaders/shade.glsl:"), std::string::npos) << run.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "out.png"));
+}
+
+// A copy of shaders/ in `dir` with `from` replaced by `to` in `file`.
+void copy_shaders_with_edit(const std::filesystem::path& dir, const std::string& file, const std::string& from,
+                            const std::string& to) {
+  std::filesystem::copy(VKRAY_SHADER_DIR, dir / "shaders", std::filesystem::copy_options::recursive);
+  std::ifstream in(dir / "shaders" / file);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_NE(text.find(from), std::string::npos) << from;
+  text.replace(text.find(from), from.size(), to);
+  std::ofstream(dir / "shaders" / file) << text;
+}
+
+TEST(CliTest, AShaderThatDeclaresABindingOtherwiseThanVkrayBindsItExitsOne) {
+  // Checked against the binding table before any pipeline exists: a message naming the resource,
+  // not a validation error or a crash.
+  TempDir retyped;
+  copy_shaders_with_edit(retyped.path(), "resources.glsl", "binding = VKRAY_BINDING_FRAME) uniform Frame",
+                         "binding = VKRAY_BINDING_FRAME) readonly buffer Frame");
+  const Result run = vkray("render --validate --shader-dir shaders -o out.png", retyped.path());
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("'Frame' at binding 0 is declared as a buffer block; vkray binds a uniform block there"),
+            std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(retyped / "out.png"));
+
+  TempDir moved;
+  copy_shaders_with_edit(moved.path(), "resources.glsl", "binding = VKRAY_BINDING_LIGHTS)", "binding = 9)");
+  const Result run2 = vkray("render --validate --shader-dir shaders -o out.png", moved.path());
+  EXPECT_EQ(run2.exit_code, 1) << run2.err;
+  EXPECT_NE(run2.err.find("'lights' is declared at binding 9, where vkray binds nothing"), std::string::npos) << run2.err;
 }
 
 TEST(CliTest, UsageErrorsExitTwo) {

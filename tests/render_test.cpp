@@ -31,7 +31,7 @@ class RenderTest : public GpuTest {
   const gpu::TracePipeline* pipeline() {
     if (!pipeline_) {
       const auto shader = gpu::compile_compute_shader(std::filesystem::path(VKRAY_SHADER_DIR) / "trace.comp", {VKRAY_SHADER_DIR});
-      pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), VKRAY_SHADER_DIR, shader.spirv);
+      pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), VKRAY_SHADER_DIR, shader);
     }
     return pipeline_.get();
   }
@@ -250,7 +250,7 @@ TEST_F(RenderTest, GeneratedCodeThatDoesNotCompileIsAShaderError) {
   std::ofstream(dir / "traversal.glsl") << text;
 
   const auto shader = gpu::compile_compute_shader(dir / "trace.comp", {dir.path()});
-  const gpu::TracePipeline pipeline(ctx(), dir.path(), shader.spirv);
+  const gpu::TracePipeline pipeline(ctx(), dir.path(), shader);
   const Scene cornell = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
   const gpu::GpuScene scene(ctx(), cornell);
   EXPECT_NO_THROW(pipeline.pipeline(gpu::shader_variant(scene, {64, 64, 1}, gpu::InlineScene::never)));

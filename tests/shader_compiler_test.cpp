@@ -3,12 +3,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "base/errors.h"
 #include "gpu/shader_compiler.h"
+#include "shared/types.h"
 #include "support/temp_dir.h"
 
 namespace vkray::test {
@@ -60,6 +62,28 @@ TEST(ShaderCompilerTest, CompilesTheTracerAndListsEveryIncludedFile) {
     EXPECT_NE(std::find(shader.sources.begin(), shader.sources.end(), expected), shader.sources.end()) << file;
   }
   EXPECT_EQ(shader.sources.size(), std::size(files));  // each once, though several are included more than once
+}
+
+TEST(ShaderCompilerTest, ReflectsTheBindingsTheShaderDeclares) {
+  // What DescriptorTable::check holds against the table of what vkray binds.
+  const std::filesystem::path dir = VKRAY_SHADER_DIR;
+  const gpu::CompiledShader shader = gpu::compile_compute_shader(dir / "trace.comp", {dir});
+  std::map<uint32_t, std::pair<std::string, vk::DescriptorType>> found;
+  for (const auto& b : shader.bindings) {
+    ASSERT_TRUE(b.type.has_value()) << b.name;
+    EXPECT_TRUE(found.emplace(b.binding, std::pair(b.name, *b.type)).second) << "binding " << b.binding << " twice";
+  }
+  using D = vk::DescriptorType;
+  const std::map<uint32_t, std::pair<std::string, vk::DescriptorType>> expected = {
+      {VKRAY_BINDING_FRAME, {"Frame", D::eUniformBuffer}},
+      {VKRAY_BINDING_PRIMITIVES, {"primitives", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_NORMALS, {"normals", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_NODES, {"nodes", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_MATERIALS, {"materials", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_LIGHTS, {"lights", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_OUTPUT, {"Output", D::eStorageBuffer}},
+  };
+  EXPECT_EQ(found, expected);
 }
 
 TEST(ShaderCompilerTest, ErrorInAnIncludedFileNamesThatFileAndLine) {

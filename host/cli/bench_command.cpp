@@ -75,7 +75,7 @@ int run_bench(const BenchCommand& cmd) {
   options.device = cmd.device;
   gpu::Context ctx(options);
   const std::filesystem::path shader_dir = cmd.shader_dir.empty() ? default_shader_dir() : cmd.shader_dir;
-  const gpu::TracePipeline pipeline(ctx, shader_dir, gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir}).spirv);
+  const gpu::TracePipeline pipeline(ctx, shader_dir, gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir}));
   std::cerr << "vkray bench: device " << ctx.device_name() << " (" << ctx.driver_name() << "); CPU reference and "
             << (with_embree ? embree_name() : std::string("no Embree"))
             << " on " << threads << " threads; " << cmd.width << "x" << cmd.height << ", 1 sample per pixel, "

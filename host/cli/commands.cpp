@@ -114,7 +114,7 @@ GpuRun render_gpu(const LoadedScene& loaded, const RenderFlags& flags, const std
     const auto start = Clock::now();
     const std::filesystem::path shader_dir = flags.shader_dir.empty() ? default_shader_dir() : flags.shader_dir;
     const gpu::CompiledShader shader = gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir});
-    const gpu::TracePipeline pipeline(ctx, shader_dir, shader.spirv);
+    const gpu::TracePipeline pipeline(ctx, shader_dir, shader);
     run.compile_ms = ms_since(start);
     const gpu::GpuScene gpu_scene(ctx, loaded.scene, bvh);
     // The scene's pipeline variant compiled now, so that compile_ms counts it (a small scene's own

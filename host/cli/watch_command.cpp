@@ -108,7 +108,7 @@ int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& va
       // Renders wait for their last tile, so no work uses the old pipeline now; wait anyway, so
       // that stays true if rendering ever overlaps with reloading.
       ctx.queue().waitIdle();
-      pipeline = std::make_unique<gpu::TracePipeline>(ctx, shader_dir, compiled.spirv, &pipeline_cache);
+      pipeline = std::make_unique<gpu::TracePipeline>(ctx, shader_dir, compiled, &pipeline_cache);
       prepare_pipeline();
       spirv = std::move(compiled.spirv);
       ctx.check_validation("pipeline creation");

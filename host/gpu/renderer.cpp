@@ -39,6 +39,17 @@ constexpr size_t kKeptInlinePipelines = 4;
 
 constexpr vk::DescriptorType kTexel = vk::DescriptorType::eUniformTexelBuffer;
 
+// The descriptor set shaders/trace.comp declares (binding numbers from shared/types.h).
+constexpr BindingSlot kTraceBindings[] = {
+    {VKRAY_BINDING_FRAME, vk::DescriptorType::eUniformBuffer, "frame"},
+    {VKRAY_BINDING_PRIMITIVES, kTexel, "primitives"},
+    {VKRAY_BINDING_NORMALS, kTexel, "normals"},
+    {VKRAY_BINDING_NODES, kTexel, "nodes"},
+    {VKRAY_BINDING_MATERIALS, kTexel, "materials"},
+    {VKRAY_BINDING_LIGHTS, kTexel, "lights"},
+    {VKRAY_BINDING_OUTPUT, vk::DescriptorType::eStorageBuffer, "output"},
+};
+
 // A texel buffer and its view (RGBA32F for vec4 texels, RGBA32UI for uvec4); never empty (Vulkan
 // has no zero-sized buffers), the shader is told the real count.
 struct TexelBuffer {
@@ -81,24 +92,14 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
 
 }  // namespace
 
-TracePipeline::TracePipeline(const Context& ctx, std::filesystem::path shader_dir, const std::vector<uint32_t>& spirv,
+TracePipeline::TracePipeline(const Context& ctx, std::filesystem::path shader_dir, const CompiledShader& shader,
                              const vk::raii::PipelineCache* cache)
-    : device_(&ctx.device()), cache_(cache), shader_dir_(std::move(shader_dir)) {
-  using S = vk::ShaderStageFlagBits;
-  const vk::DescriptorSetLayoutBinding bindings[] = {
-      {VKRAY_BINDING_FRAME, vk::DescriptorType::eUniformBuffer, 1, S::eCompute},
-      {VKRAY_BINDING_PRIMITIVES, kTexel, 1, S::eCompute},
-      {VKRAY_BINDING_NORMALS, kTexel, 1, S::eCompute},
-      {VKRAY_BINDING_NODES, kTexel, 1, S::eCompute},
-      {VKRAY_BINDING_MATERIALS, kTexel, 1, S::eCompute},
-      {VKRAY_BINDING_LIGHTS, kTexel, 1, S::eCompute},
-      {VKRAY_BINDING_OUTPUT, vk::DescriptorType::eStorageBuffer, 1, S::eCompute},
-  };
-  set_layout_ = vk::raii::DescriptorSetLayout(ctx.device(), vk::DescriptorSetLayoutCreateInfo({}, bindings));
-  const vk::PushConstantRange push(S::eCompute, 0, sizeof(TileConstants));
-  const vk::DescriptorSetLayout set_layout = *set_layout_;
+    : device_(&ctx.device()), cache_(cache), shader_dir_(std::move(shader_dir)), descriptors_(ctx.device(), kTraceBindings) {
+  descriptors_.check(shader, shader_dir_ / "trace.comp");
+  const vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, sizeof(TileConstants));
+  const vk::DescriptorSetLayout set_layout = *descriptors_.layout();
   layout_ = vk::raii::PipelineLayout(ctx.device(), vk::PipelineLayoutCreateInfo({}, set_layout, push));
-  module_ = vk::raii::ShaderModule(ctx.device(), vk::ShaderModuleCreateInfo({}, spirv));
+  module_ = vk::raii::ShaderModule(ctx.device(), vk::ShaderModuleCreateInfo({}, shader.spirv));
 }
 
 TracePipeline::~TracePipeline() = default;
@@ -136,9 +137,10 @@ std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVari
   // A scene compiled in is a module of its own; the module may go once the pipeline exists.
   vk::raii::ShaderModule inline_module{nullptr};
   if (!variant.inline_scene.empty()) {
-    const auto spirv =
-        compile_compute_shader(shader_dir_ / "trace.comp", {shader_dir_}, {{"inline_scene.glsl", variant.inline_scene}}).spirv;
-    inline_module = vk::raii::ShaderModule(*device_, vk::ShaderModuleCreateInfo({}, spirv));
+    const CompiledShader shader =
+        compile_compute_shader(shader_dir_ / "trace.comp", {shader_dir_}, {{"inline_scene.glsl", variant.inline_scene}});
+    descriptors_.check(shader, shader_dir_ / "trace.comp");
+    inline_module = vk::raii::ShaderModule(*device_, vk::ShaderModuleCreateInfo({}, shader.spirv));
   }
   const vk::ShaderModule module = variant.inline_scene.empty() ? *module_ : *inline_module;
   const VkBool32 constants[] = {variant.spheres, variant.shadows};
@@ -216,28 +218,18 @@ Image render(Context& ctx, const TracePipeline& pipeline, const GpuScene& gpu_sc
   const Buffer output = create_buffer(ctx, pixel_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible,
                                       M::eHostCached);
 
-  const vk::DescriptorPoolSize pool_sizes[] = {{vk::DescriptorType::eUniformBuffer, 1},
-                                               {kTexel, 5},
-                                               {vk::DescriptorType::eStorageBuffer, 1}};
-  // eFreeDescriptorSet: vk::raii::DescriptorSets frees its set when destroyed.
-  const vk::raii::DescriptorPool pool(device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, pool_sizes));
-  const vk::DescriptorSetLayout set_layout = *pipeline.set_layout();
-  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pool, set_layout));
-  const vk::DescriptorSet set = *sets[0];
-  const vk::DescriptorBufferInfo frame_info(*frame_buffer.buffer, 0, VK_WHOLE_SIZE);
-  const vk::DescriptorBufferInfo output_info(*output.buffer, 0, VK_WHOLE_SIZE);
   const GpuScene::Buffers& b = *gpu_scene.buffers_;
-  const vk::BufferView views[] = {*b.primitives.view, *b.normals.view, *b.nodes.view, *b.materials.view, *b.lights.view};
-  const vk::WriteDescriptorSet writes[] = {
-      {set, VKRAY_BINDING_FRAME, 0, vk::DescriptorType::eUniformBuffer, {}, frame_info},
-      {set, VKRAY_BINDING_PRIMITIVES, 0, kTexel, {}, {}, views[0]},
-      {set, VKRAY_BINDING_NORMALS, 0, kTexel, {}, {}, views[1]},
-      {set, VKRAY_BINDING_NODES, 0, kTexel, {}, {}, views[2]},
-      {set, VKRAY_BINDING_MATERIALS, 0, kTexel, {}, {}, views[3]},
-      {set, VKRAY_BINDING_LIGHTS, 0, kTexel, {}, {}, views[4]},
-      {set, VKRAY_BINDING_OUTPUT, 0, vk::DescriptorType::eStorageBuffer, {}, output_info},
-  };
-  device.updateDescriptorSets(writes, {});
+  const DescriptorSet descriptor_set = pipeline.descriptors()
+                                           .writer()
+                                           .buffer(VKRAY_BINDING_FRAME, *frame_buffer.buffer)
+                                           .texel_buffer(VKRAY_BINDING_PRIMITIVES, *b.primitives.view)
+                                           .texel_buffer(VKRAY_BINDING_NORMALS, *b.normals.view)
+                                           .texel_buffer(VKRAY_BINDING_NODES, *b.nodes.view)
+                                           .texel_buffer(VKRAY_BINDING_MATERIALS, *b.materials.view)
+                                           .texel_buffer(VKRAY_BINDING_LIGHTS, *b.lights.view)
+                                           .buffer(VKRAY_BINDING_OUTPUT, *output.buffer)
+                                           .write();
+  const vk::DescriptorSet set = descriptor_set.get();
   stats.upload_seconds = seconds_since(start);
 
   // ---- trace, one submission per tile ----

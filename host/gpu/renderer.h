@@ -18,6 +18,8 @@
 
 #include "base/errors.h"
 #include "gpu/context.h"
+#include "gpu/descriptors.h"
+#include "gpu/shader_compiler.h"
 #include "packing/inline_scene.h"
 #include "image/image.h"
 #include "scene/scene.h"
@@ -54,11 +56,12 @@ class TracePipeline {
   // `spirv`: shader_dir/trace.comp compiled as it is (compile_compute_shader); variants with a
   // scene compiled in are compiled from shader_dir when first needed. `cache` (optional; it must
   // outlive this) makes re-creating a pipeline from SPIR-V seen before in this process cheap.
-  TracePipeline(const Context& ctx, std::filesystem::path shader_dir, const std::vector<uint32_t>& spirv,
+  // Throws ShaderError when the shader declares its bindings otherwise than vkray binds them.
+  TracePipeline(const Context& ctx, std::filesystem::path shader_dir, const CompiledShader& shader,
                 const vk::raii::PipelineCache* cache = nullptr);
   ~TracePipeline();
 
-  const vk::raii::DescriptorSetLayout& set_layout() const { return set_layout_; }
+  const DescriptorTable& descriptors() const { return descriptors_; }
   const vk::raii::PipelineLayout& layout() const { return layout_; }
   // The pipeline for `variant`, compiled now if not kept from before. Callers that time compilation
   // apart from tracing call this before rendering. Throws ShaderError when the shaders do not compile
@@ -72,7 +75,7 @@ class TracePipeline {
   const vk::raii::Device* device_;
   const vk::raii::PipelineCache* cache_;
   std::filesystem::path shader_dir_;
-  vk::raii::DescriptorSetLayout set_layout_{nullptr};
+  DescriptorTable descriptors_;
   vk::raii::PipelineLayout layout_{nullptr};
   vk::raii::ShaderModule module_{nullptr};
   mutable std::mutex mutex_;

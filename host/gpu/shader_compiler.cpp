@@ -102,6 +102,43 @@ std::string format_log(const std::string& log) {
   return out;
 }
 
+// The descriptor type of a uniform that is not a block, from its GL type as glslang's reflection
+// gives it (the values of GL_SAMPLER_BUFFER and its kin in the OpenGL headers).
+std::optional<vk::DescriptorType> descriptor_type(int gl_type) {
+  switch (gl_type) {
+    case 0x8DC2:  // GL_SAMPLER_BUFFER
+    case 0x8DD0:  // GL_INT_SAMPLER_BUFFER
+    case 0x8DD8:  // GL_UNSIGNED_INT_SAMPLER_BUFFER
+      return vk::DescriptorType::eUniformTexelBuffer;
+    case 0x9051:  // GL_IMAGE_BUFFER
+    case 0x905C:  // GL_INT_IMAGE_BUFFER
+    case 0x9067:  // GL_UNSIGNED_INT_IMAGE_BUFFER
+      return vk::DescriptorType::eStorageTexelBuffer;
+    default:
+      return std::nullopt;
+  }
+}
+
+// Every resource in a descriptor set that the linked program uses. Block members and push-constant
+// blocks have no binding and are left out.
+std::vector<ShaderBinding> reflect_bindings(glslang::TProgram& program) {
+  program.buildReflection(EShReflectionSeparateBuffers);
+  std::vector<ShaderBinding> bindings;
+  for (int i = 0; i < program.getNumUniformVariables(); ++i) {
+    const glslang::TObjectReflection& u = program.getUniform(i);
+    if (u.getBinding() >= 0) bindings.push_back({uint32_t(u.getBinding()), descriptor_type(u.glDefineType), u.name});
+  }
+  for (int i = 0; i < program.getNumUniformBlocks(); ++i) {
+    const glslang::TObjectReflection& b = program.getUniformBlock(i);
+    if (b.getBinding() >= 0) bindings.push_back({uint32_t(b.getBinding()), vk::DescriptorType::eUniformBuffer, b.name});
+  }
+  for (int i = 0; i < program.getNumBufferBlocks(); ++i) {
+    const glslang::TObjectReflection& b = program.getBufferBlock(i);
+    if (b.getBinding() >= 0) bindings.push_back({uint32_t(b.getBinding()), vk::DescriptorType::eStorageBuffer, b.name});
+  }
+  return bindings;
+}
+
 }  // namespace
 
 CompiledShader compile_compute_shader(const std::filesystem::path& entry,
@@ -141,6 +178,7 @@ CompiledShader compile_compute_shader(const std::filesystem::path& entry,
   glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), result.spirv, &logger, &options);
   const std::string spv_messages = logger.getAllMessages();
   if (result.spirv.empty()) throw ShaderError(entry_path.string() + ": SPIR-V generation failed: " + spv_messages);
+  result.bindings = reflect_bindings(program);
   return result;
 }
 

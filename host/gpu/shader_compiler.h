@@ -3,15 +3,27 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <vulkan/vulkan_raii.hpp>
+
 namespace vkray::gpu {
+
+// A resource the shader declares in a descriptor set (not its push constants), from glslang's
+// reflection of the code `main` uses.
+struct ShaderBinding {
+  uint32_t binding;
+  std::optional<vk::DescriptorType> type;  // none: a kind of resource vkray never binds (an image, a sampler)
+  std::string name;
+};
 
 struct CompiledShader {
   std::vector<uint32_t> spirv;
   // The entry file and every file it included, once each: what a change to must trigger a rebuild.
   std::vector<std::filesystem::path> sources;
+  std::vector<ShaderBinding> bindings;
 };
 
 // Text served for an #include of `name` in place of any file of that name (code the host generates).

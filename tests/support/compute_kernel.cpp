@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "gpu/buffer.h"
+#include "gpu/descriptors.h"
 #include "gpu/shader_compiler.h"
 
 namespace vkray::test {
@@ -11,16 +12,16 @@ namespace vkray::test {
 std::vector<float> run_kernel(gpu::Context& ctx, const std::filesystem::path& shader, const void* input,
                               size_t input_bytes, uint32_t count, size_t outputs_per_item) {
   const auto& device = ctx.device();
-  const auto spirv = gpu::compile_compute_shader(shader, {VKRAY_SHADER_DIR}).spirv;
+  const gpu::CompiledShader compiled = gpu::compile_compute_shader(shader, {VKRAY_SHADER_DIR});
   using S = vk::ShaderStageFlagBits;
-  using D = vk::DescriptorType;
-  const vk::DescriptorSetLayoutBinding bindings[] = {{0, D::eStorageBuffer, 1, S::eCompute},
-                                                     {1, D::eStorageBuffer, 1, S::eCompute}};
-  const vk::raii::DescriptorSetLayout set_layout(device, vk::DescriptorSetLayoutCreateInfo({}, bindings));
+  constexpr gpu::BindingSlot kBindings[] = {{0, vk::DescriptorType::eStorageBuffer, "input"},
+                                            {1, vk::DescriptorType::eStorageBuffer, "output"}};
+  const gpu::DescriptorTable descriptors(device, kBindings);
+  descriptors.check(compiled, shader);
   const vk::PushConstantRange push(S::eCompute, 0, sizeof(uint32_t));
-  const vk::DescriptorSetLayout raw_layout = *set_layout;
+  const vk::DescriptorSetLayout raw_layout = *descriptors.layout();
   const vk::raii::PipelineLayout layout(device, vk::PipelineLayoutCreateInfo({}, raw_layout, push));
-  const vk::raii::ShaderModule module(device, vk::ShaderModuleCreateInfo({}, spirv));
+  const vk::raii::ShaderModule module(device, vk::ShaderModuleCreateInfo({}, compiled.spirv));
   const vk::raii::Pipeline pipeline(device, nullptr,
                                     vk::ComputePipelineCreateInfo({}, {{}, S::eCompute, *module, "main"}, *layout));
 
@@ -30,20 +31,14 @@ std::vector<float> run_kernel(gpu::Context& ctx, const std::filesystem::path& sh
   const gpu::Buffer out = gpu::create_buffer(ctx, out_bytes, vk::BufferUsageFlagBits::eStorageBuffer,
                                              M::eHostVisible | M::eHostCoherent);
 
-  const vk::DescriptorPoolSize sizes(D::eStorageBuffer, 2);
-  const vk::raii::DescriptorPool pool(device, {vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, sizes});
-  vk::raii::DescriptorSets sets(device, {*pool, raw_layout});
-  const vk::DescriptorBufferInfo in_info(*in.buffer, 0, VK_WHOLE_SIZE), out_info(*out.buffer, 0, VK_WHOLE_SIZE);
-  device.updateDescriptorSets({vk::WriteDescriptorSet(*sets[0], 0, 0, D::eStorageBuffer, {}, in_info),
-                               vk::WriteDescriptorSet(*sets[0], 1, 0, D::eStorageBuffer, {}, out_info)},
-                              {});
+  const gpu::DescriptorSet set = descriptors.writer().buffer(0, *in.buffer).buffer(1, *out.buffer).write();
 
   const vk::raii::CommandPool command_pool(device, {{}, ctx.queue_family()});
   vk::raii::CommandBuffers cbs(device, {*command_pool, vk::CommandBufferLevel::ePrimary, 1});
   const auto& cb = cbs[0];
   cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
   cb.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline);
-  cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *layout, 0, *sets[0], {});
+  cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *layout, 0, set.get(), {});
   cb.pushConstants<uint32_t>(*layout, S::eCompute, 0, count);
   cb.dispatch((count + 63) / 64, 1, 1);
   const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);

@@ -13,7 +13,7 @@ void ParityTest::TearDown() {
 ParityRun ParityTest::run(const Scene& scene, const ImageSettings& image, gpu::InlineScene inline_scene) {
   if (!pipeline_) {
     const std::filesystem::path dir = VKRAY_SHADER_DIR;
-    pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), dir, gpu::compile_compute_shader(dir / "trace.comp", {dir}).spirv);
+    pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), dir, gpu::compile_compute_shader(dir / "trace.comp", {dir}));
   }
   ParityRun result;
   const Bvh bvh = build_bvh(primitive_boxes(scene));  // one hierarchy, traversed by both renderers
