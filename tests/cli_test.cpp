@@ -117,6 +117,7 @@ TEST(CliTest, UsageErrorsExitTwo) {
   EXPECT_EQ(vkray("render --spp 0", dir.path()).exit_code, 2);
   EXPECT_EQ(vkray("render --width -3", dir.path()).exit_code, 2);
   EXPECT_EQ(vkray("render --no-such-flag", dir.path()).exit_code, 2);
+  EXPECT_EQ(vkray("watch --threads 2", dir.path()).exit_code, 2);  // watch has no CPU renderer
   const Result bad_path = vkray("render --inline-scene sometimes", dir.path());
   EXPECT_EQ(bad_path.exit_code, 2);
   EXPECT_NE(bad_path.err.find("sometimes not in {auto,always,never}"), std::string::npos) << bad_path.err;

@@ -30,7 +30,7 @@ Case sphere(glm::vec3 o, glm::vec3 d, glm::vec3 center, float radius, float t_mi
 class IntersectTest : public GpuTest {
  protected:
   std::vector<float> run(const std::vector<Case>& cases) {
-    return run_kernel(ctx(), std::filesystem::path(VKRAY_TEST_SHADER_DIR) / "intersect_test.comp", cases.data(),
+    return run_kernel(session().context(), std::filesystem::path(VKRAY_TEST_SHADER_DIR) / "intersect_test.comp", cases.data(),
                       cases.size() * sizeof(Case), uint32_t(cases.size()), 1);
   }
   float run_one(const Case& c) { return run({c})[0]; }

@@ -35,7 +35,7 @@ Scene scaled(Scene s, float k) {
 struct SceneCase {
   std::string file;
   uint32_t spp;
-  bool compiled_in = false;  // gpu::InlineScene::always (the scene small enough), else the BVH
+  bool compiled_in = false;  // InlineScene::always (the scene small enough), else the BVH
 };
 void PrintTo(const SceneCase& c, std::ostream* os) {
   *os << c.file << " at " << c.spp << " spp" << (c.compiled_in ? ", compiled into the shader" : "");
@@ -46,9 +46,9 @@ class SceneParityTest : public ParityTest, public ::testing::WithParamInterface<
 TEST_P(SceneParityTest, WithinTolerance) {
   const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / GetParam().file);
   const bool compiled_in = GetParam().compiled_in;
-  const ParityRun r =
-      run(scene, {256, 256, GetParam().spp}, compiled_in ? gpu::InlineScene::always : gpu::InlineScene::never);
-  EXPECT_EQ(r.inline_scene, compiled_in);
+  const ParityResult r =
+      run(scene, {256, 256, GetParam().spp}, compiled_in ? InlineScene::always : InlineScene::never);
+  EXPECT_EQ(r.gpu.stats.inline_scene, compiled_in);
   expect_parity(r, scene.name + "-" + std::to_string(GetParam().spp) + "spp" + (compiled_in ? "-inline" : ""));
   EXPECT_EQ(r.metrics.interior_over_2, 0u);
 }
@@ -76,15 +76,15 @@ INSTANTIATE_TEST_SUITE_P(Scenes, SceneParityTest, ::testing::ValuesIn(scene_case
                          });
 
 // ---- Adversarial cases, on both GPU paths ------------------------------------------------------------
-// Each case runs with the BVH and with the scene compiled into the shader (gpu::InlineScene); every
-// scene fits in kMaxInlinePrimitives (the shared-edge case is a smaller grid for it), and each run
+// Each case runs with the BVH and with the scene compiled into the shader (InlineScene); every
+// scene fits in gpu::kMaxInlinePrimitives (the shared-edge case is a smaller grid for it), and each run
 // checks that it took the path it asked for.
-class AdversarialParityTest : public ParityTest, public ::testing::WithParamInterface<gpu::InlineScene> {
+class AdversarialParityTest : public ParityTest, public ::testing::WithParamInterface<InlineScene> {
  protected:
-  ParityRun check(const Scene& scene, const std::string& name, ImageSettings image = {128, 128, 1}) {
-    const bool compiled_in = GetParam() == gpu::InlineScene::always;
-    ParityRun r = run(scene, image, GetParam());
-    EXPECT_EQ(r.inline_scene, compiled_in);
+  ParityResult check(const Scene& scene, const std::string& name, ImageSettings image = {128, 128, 1}) {
+    const bool compiled_in = GetParam() == InlineScene::always;
+    ParityResult r = run(scene, image, GetParam());
+    EXPECT_EQ(r.gpu.stats.inline_scene, compiled_in);
     expect_parity(r, name + (compiled_in ? "-inline" : ""));
     return r;
   }
@@ -103,7 +103,7 @@ TEST_P(AdversarialParityTest, SharedEdgesHaveNoCracks) {
   Scene s = cornell();
   s.triangles.clear();
   s.background = {1, 0, 1};
-  const int n = GetParam() == gpu::InlineScene::always ? 4 : 40;
+  const int n = GetParam() == InlineScene::always ? 4 : 40;
   auto p = [&](int i, int j) { return glm::vec3(-3.0f + 6.0f * float(i) / float(n), -3.0f + 6.0f * float(j) / float(n), 0.3f * std::sin(float(i + j))); };
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
@@ -111,11 +111,11 @@ TEST_P(AdversarialParityTest, SharedEdgesHaveNoCracks) {
       s.triangles.push_back({{p(i, j), p(i + 1, j + 1), p(i, j + 1)}, 6});
     }
   s.camera.position = {0.13f, -0.07f, -3.0f};
-  const ParityRun r = check(s, "shared-edges");
-  for (const Image* image : {&r.gpu, &r.cpu.image}) {
+  const ParityResult r = check(s, "shared-edges");
+  for (const Image* image : {&r.gpu.image, &r.cpu.image}) {
     size_t background = 0;
     for (const auto& px : image->pixels) background += (px == glm::vec3(1, 0, 1));
-    EXPECT_EQ(background, 0u) << (image == &r.gpu ? "GPU" : "CPU") << " image has cracks";
+    EXPECT_EQ(background, 0u) << (image == &r.gpu.image ? "GPU" : "CPU") << " image has cracks";
   }
 }
 
@@ -154,9 +154,9 @@ TEST_P(AdversarialParityTest, LargeSceneScale) { check(scaled(cornell(), 1e4f), 
 TEST_P(AdversarialParityTest, LightBehindASurface) {
   Scene s = cornell();
   s.lights[0].position = {0.0f, -0.5f, 1.5f};  // behind the back wall: only ambient reaches the room
-  const ParityRun r = check(s, "light-behind-surface");
+  const ParityResult r = check(s, "light-behind-surface");
   EXPECT_NEAR(r.cpu.image.at(64, 40).r, 0.75f * 0.1f, 1e-6f);  // the back wall, ambient only
-  EXPECT_NEAR(r.gpu.at(64, 40).r, 0.75f * 0.1f, 1e-6f);
+  EXPECT_NEAR(r.gpu.image.at(64, 40).r, 0.75f * 0.1f, 1e-6f);
 }
 
 TEST_P(AdversarialParityTest, SixteenLights) {
@@ -169,9 +169,9 @@ TEST_P(AdversarialParityTest, SixteenLights) {
   check(s, "sixteen-lights");
 }
 
-INSTANTIATE_TEST_SUITE_P(Paths, AdversarialParityTest, ::testing::Values(gpu::InlineScene::never, gpu::InlineScene::always),
-                         [](const ::testing::TestParamInfo<gpu::InlineScene>& param) {
-                           return param.param == gpu::InlineScene::always ? "inline" : "bvh";
+INSTANTIATE_TEST_SUITE_P(Paths, AdversarialParityTest, ::testing::Values(InlineScene::never, InlineScene::always),
+                         [](const ::testing::TestParamInfo<InlineScene>& param) {
+                           return param.param == InlineScene::always ? "inline" : "bvh";
                          });
 
 // ---- The comparison itself can fail -------------------------------------------------------------------
@@ -182,12 +182,12 @@ class ComparisonTest : public ParityTest {
     run_ = run(cornell(), {128, 128, 1});
     ASSERT_TRUE(run_.metrics.pass);
   }
-  ParityMetrics compare(const Image& gpu) { return compare_images(gpu, run_.cpu.image, run_.cpu.signatures); }
-  ParityRun run_;
+  ParityMetrics compare(const Image& gpu) { return compare_images(gpu, run_.cpu.image, run_.signatures); }
+  ParityResult run_;
 };
 
 TEST_F(ComparisonTest, CatchesImageTwoPercentTooBright) {
-  Image brighter = run_.gpu;
+  Image brighter = run_.gpu.image;
   for (auto& p : brighter.pixels) p *= 1.02f;
   const ParityMetrics m = compare(brighter);
   EXPECT_FALSE(m.pass);
@@ -195,7 +195,7 @@ TEST_F(ComparisonTest, CatchesImageTwoPercentTooBright) {
 }
 
 TEST_F(ComparisonTest, CatchesOneWrongPixelAwayFromEdges) {
-  Image one = run_.gpu;
+  Image one = run_.gpu.image;
   one.at(64, 40) += glm::vec3(0.5f);  // the back wall, far from any edge
   const ParityMetrics m = compare(one);
   EXPECT_FALSE(m.pass);
@@ -205,7 +205,7 @@ TEST_F(ComparisonTest, CatchesOneWrongPixelAwayFromEdges) {
 }
 
 TEST_F(ComparisonTest, AcceptsNoiseBelowOneStep) {
-  Image noisy = run_.gpu;
+  Image noisy = run_.gpu.image;
   for (auto& p : noisy.pixels) p += glm::vec3(1e-6f);
   EXPECT_TRUE(compare(noisy).pass);
 }

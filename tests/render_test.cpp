@@ -10,37 +10,18 @@
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
-#include "gpu/renderer.h"
-#include "gpu/shader_compiler.h"
 #include "base/errors.h"
+#include "packing/inline_scene.h"
+#include "session/session.h"
 #include "support/gpu_fixture.h"
 #include "support/temp_dir.h"
-#include "cpu/reference.h"
 
 namespace vkray::test {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-class RenderTest : public GpuTest {
- protected:
-  Image render(const Scene& scene, ImageSettings image, gpu::RenderOptions options = {}, bool cpu = false) {
-    if (cpu) return cpu::render_reference(scene, image).image;
-    return gpu::render(ctx(), *pipeline(), scene, image, options);
-  }
-  const gpu::TracePipeline* pipeline() {
-    if (!pipeline_) {
-      const auto shader = gpu::compile_compute_shader(std::filesystem::path(VKRAY_SHADER_DIR) / "trace.comp", {VKRAY_SHADER_DIR});
-      pipeline_ = std::make_unique<gpu::TracePipeline>(ctx(), VKRAY_SHADER_DIR, shader);
-    }
-    return pipeline_.get();
-  }
-  void TearDown() override {
-    pipeline_.reset();
-    GpuTest::TearDown();
-  }
-  std::unique_ptr<gpu::TracePipeline> pipeline_;
-};
+using RenderTest = GpuTest;
 
 void expect_radiance(glm::vec3 actual, glm::dvec3 expected, const char* what) {
   for (int c = 0; c < 3; ++c)
@@ -59,8 +40,8 @@ class CornellTest : public RenderTest, public ::testing::WithParamInterface<Rend
   void SetUp() override {
     RenderTest::SetUp();
     scene_ = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
-    gpu::RenderOptions options;
-    options.inline_scene = GetParam() == Renderer::gpu_inline ? gpu::InlineScene::always : gpu::InlineScene::never;
+    RenderOptions options;
+    options.inline_scene = GetParam() == Renderer::gpu_inline ? InlineScene::always : InlineScene::never;
     image_ = render(scene_, {256, 256, 1}, options, /*cpu=*/GetParam() == Renderer::cpu);
   }
   void TearDown() override { RenderTest::TearDown(); }
@@ -160,16 +141,16 @@ TEST_F(RenderTest, OnePipelineServesScenesWithAndWithoutSpheres) {
 TEST_F(RenderTest, TilesCoverTheImageExactly) {
   const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
   const Image whole = render(scene, {100, 76, 2});
-  gpu::RenderOptions options;
+  RenderOptions options;
   options.tile_side = 16;  // 7 x 5 tiles, the last row and column partial
   const Image tiled = render(scene, {100, 76, 2}, options);
   ASSERT_EQ(whole.pixels.size(), tiled.pixels.size());
   for (size_t i = 0; i < whole.pixels.size(); ++i) ASSERT_EQ(whole.pixels[i], tiled.pixels[i]) << "pixel " << i;
 }
 
-// ---- A small scene compiled into the shader (gpu::InlineScene) ----------------------------------------
-gpu::RenderOptions path(gpu::InlineScene inline_scene) {
-  gpu::RenderOptions options;
+// ---- A small scene compiled into the shader (InlineScene) --------------------------------------------
+RenderOptions path(InlineScene inline_scene) {
+  RenderOptions options;
   options.inline_scene = inline_scene;
   return options;
 }
@@ -179,8 +160,8 @@ TEST_F(RenderTest, SceneCompiledInMatchesTheBvhPixelForPixel) {
   // the generated code lost or misplaced a primitive.
   for (const char* file : {"cornell.json", "cornell-spheres.json"}) {
     const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / file);
-    const Image bvh = render(scene, {96, 64, 2}, path(gpu::InlineScene::never));
-    const Image compiled_in = render(scene, {96, 64, 2}, path(gpu::InlineScene::always));
+    const Image bvh = render(scene, {96, 64, 2}, path(InlineScene::never));
+    const Image compiled_in = render(scene, {96, 64, 2}, path(InlineScene::always));
     ASSERT_EQ(bvh.pixels.size(), compiled_in.pixels.size());
     size_t differ = 0;
     for (size_t i = 0; i < bvh.pixels.size(); ++i) differ += bvh.pixels[i] != compiled_in.pixels[i];
@@ -189,24 +170,23 @@ TEST_F(RenderTest, SceneCompiledInMatchesTheBvhPixelForPixel) {
 }
 
 TEST_F(RenderTest, PolicyChoosesThePath) {
-  const Scene cornell = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
-  const gpu::GpuScene small(ctx(), cornell);
-  EXPECT_FALSE(gpu::use_inline_scene(small, {512, 512, 1}, gpu::InlineScene::automatic));  // 2^18 camera rays
-  EXPECT_TRUE(gpu::use_inline_scene(small, {1024, 1024, 1}, gpu::InlineScene::automatic));
-  EXPECT_TRUE(gpu::use_inline_scene(small, {512, 512, 4}, gpu::InlineScene::automatic));
-  EXPECT_TRUE(gpu::use_inline_scene(small, {8, 8, 1}, gpu::InlineScene::always));
-  EXPECT_FALSE(gpu::use_inline_scene(small, {4096, 4096, 1}, gpu::InlineScene::never));
+  const auto cornell = std::make_shared<const Scene>(load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json"));
+  const DeviceScene small = session().upload(cornell);
+  const auto chooses = [&](const DeviceScene& scene, ImageSettings image, InlineScene policy) {
+    return session().compiles_scene_in(scene, with_image(path(policy), image));
+  };
+  EXPECT_FALSE(chooses(small, {512, 512, 1}, InlineScene::automatic));  // 2^18 camera rays
+  EXPECT_TRUE(chooses(small, {1024, 1024, 1}, InlineScene::automatic));
+  EXPECT_TRUE(chooses(small, {512, 512, 4}, InlineScene::automatic));
+  EXPECT_TRUE(chooses(small, {8, 8, 1}, InlineScene::always));
+  EXPECT_FALSE(chooses(small, {4096, 4096, 1}, InlineScene::never));
 
-  Scene larger = cornell;  // one triangle over the limit
+  Scene larger = *cornell;  // one triangle over the limit
   while (larger.triangles.size() <= gpu::kMaxInlinePrimitives) larger.triangles.push_back(larger.triangles.back());
-  const gpu::GpuScene large(ctx(), larger);
-  EXPECT_TRUE(large.inline_scene().empty());
-  EXPECT_FALSE(gpu::use_inline_scene(large, {4096, 4096, 1}, gpu::InlineScene::always));
-  gpu::RenderStats stats;
-  gpu::render(ctx(), *pipeline(), large, {16, 16, 1}, path(gpu::InlineScene::always), &stats);
-  EXPECT_FALSE(stats.inline_scene);
-  gpu::render(ctx(), *pipeline(), small, {16, 16, 1}, path(gpu::InlineScene::always), &stats);
-  EXPECT_TRUE(stats.inline_scene);
+  const DeviceScene large = session().upload(std::make_shared<const Scene>(larger));
+  EXPECT_FALSE(chooses(large, {4096, 4096, 1}, InlineScene::always));
+  EXPECT_FALSE(session().render(large, with_image(path(InlineScene::always), {16, 16, 1})).stats.inline_scene);
+  EXPECT_TRUE(session().render(small, with_image(path(InlineScene::always), {16, 16, 1})).stats.inline_scene);
 }
 
 TEST_F(RenderTest, WithoutShadowRaysEveryLightIsVisible) {
@@ -215,20 +195,22 @@ TEST_F(RenderTest, WithoutShadowRaysEveryLightIsVisible) {
   // 256^2, CornellTest) is lit as the CPU reference without shadow rays has it, and only camera
   // rays are counted; with shadows again, the same pipeline object serves the shadowed image.
   const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
-  cpu::ReferenceOptions reference_options;
+  RenderOptions reference_options;
   reference_options.shadows = false;
-  const Image reference = cpu::render_reference(scene, {256, 256, 1}, reference_options).image;
-  for (const auto inline_scene : {gpu::InlineScene::never, gpu::InlineScene::always}) {
-    gpu::RenderOptions options = path(inline_scene);
+  const Image reference = render(scene, {256, 256, 1}, reference_options, /*cpu=*/true);
+  const DeviceScene on_device = session().upload(std::make_shared<const Scene>(scene));
+  for (const auto inline_scene : {InlineScene::never, InlineScene::always}) {
+    RenderOptions options = with_image(path(inline_scene), {256, 256, 1});
     options.shadows = false;
-    gpu::RenderStats stats;
-    const Image unshadowed = gpu::render(ctx(), *pipeline(), scene, {256, 256, 1}, options, &stats);
-    EXPECT_EQ(stats.rays, 256u * 256u);
+    const RenderResult unshadowed_run = session().render(on_device, options);
+    const Image& unshadowed = unshadowed_run.image;
+    EXPECT_EQ(unshadowed_run.stats.rays, 256u * 256u);
     expect_radiance(unshadowed.at(60, 200), glm::dvec3(reference.at(60, 200)), "floor behind the tall block, lit");
     EXPECT_GT(unshadowed.at(60, 200).g, 1.2f * 0.75f * 0.1f) << "still in shadow (ambient only)";
     options.shadows = true;
-    const Image shadowed = gpu::render(ctx(), *pipeline(), scene, {256, 256, 1}, options, &stats);
-    EXPECT_GT(stats.rays, 256u * 256u);
+    const RenderResult shadowed_run = session().render(on_device, options);
+    const Image& shadowed = shadowed_run.image;
+    EXPECT_GT(shadowed_run.stats.rays, 256u * 256u);
     expect_radiance(shadowed.at(60, 200), glm::dvec3(0.15, 0.75, 0.15) * 0.1, "floor in shadow");
   }
 }
@@ -249,18 +231,23 @@ TEST_F(RenderTest, GeneratedCodeThatDoesNotCompileIsAShaderError) {
   text.replace(text.find(include), 0, "#define shear_point(a, k, s) missing_function(a)\n");
   std::ofstream(dir / "traversal.glsl") << text;
 
-  const auto shader = gpu::compile_compute_shader(dir / "trace.comp", {dir.path()});
-  const gpu::TracePipeline pipeline(ctx(), dir.path(), shader);
-  const Scene cornell = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
-  const gpu::GpuScene scene(ctx(), cornell);
-  EXPECT_NO_THROW(pipeline.pipeline(gpu::shader_variant(scene, {64, 64, 1}, gpu::InlineScene::never)));
-  try {
-    pipeline.pipeline(gpu::shader_variant(scene, {64, 64, 1}, gpu::InlineScene::always));
-    ADD_FAILURE() << "no ShaderError";
-  } catch (const ShaderError& e) {
-    EXPECT_NE(std::string(e.what()).find("inline_scene.glsl (generated):"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("missing_function"), std::string::npos) << e.what();
+  SessionOptions options;
+  options.validation = true;
+  options.shader_dir = dir.path();
+  Session broken(options);
+  {
+    const DeviceScene scene =
+        broken.upload(std::make_shared<const Scene>(load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json")));
+    EXPECT_NO_THROW(broken.prepare(scene, with_image(path(InlineScene::never), {64, 64, 1})));
+    try {
+      broken.prepare(scene, with_image(path(InlineScene::always), {64, 64, 1}));
+      ADD_FAILURE() << "no ShaderError";
+    } catch (const ShaderError& e) {
+      EXPECT_NE(std::string(e.what()).find("inline_scene.glsl (generated):"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("missing_function"), std::string::npos) << e.what();
+    }
   }
+  broken.close();
 }
 
 INSTANTIATE_TEST_SUITE_P(Renderers, CornellTest, ::testing::Values(Renderer::gpu_bvh, Renderer::gpu_inline, Renderer::cpu),

@@ -32,8 +32,8 @@ class WatchTest : public ::testing::Test {
     std::filesystem::copy(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json", dir_ / "cornell.json");
   }
 
-  void start(std::vector<std::string> extra = {}, bool validate = true) {
-    std::vector<std::string> argv = {VKRAY_EXECUTABLE, "watch", "cornell.json", "--shader-dir", "shaders",
+  void start(std::vector<std::string> extra = {}, bool validate = true, const std::string& scene = "cornell.json") {
+    std::vector<std::string> argv = {VKRAY_EXECUTABLE, "watch", scene, "--shader-dir", "shaders",
                                      "-o", "out.pfm", "--width", "64", "--height", "64"};
     if (validate) argv.push_back("--validate");
     argv.insert(argv.end(), extra.begin(), extra.end());
@@ -138,6 +138,62 @@ TEST_F(WatchTest, SceneEditsRerenderAndABrokenSceneIsSurvived) {
   const auto fixed = expect_line("reload 3");
   ASSERT_TRUE(fixed);
   EXPECT_NE(fixed->find("render"), std::string::npos) << *fixed;
+}
+
+TEST_F(WatchTest, ABrokenMeshIsSurvivedLikeABrokenScene) {
+  // A mesh file's error is the scene's: reported naming the mesh file and its line, the last good
+  // image kept, and the next save of the mesh renders again.
+  const std::string quad = "v -1 -1 3\nv 1 -1 3\nv 1 1 3\nv -1 1 3\nf 1 2 3 4\n";
+  save_in_place("quad.obj", quad);
+  save_in_place("mesh.json", R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "focal_length": 1},
+    "ambient": [0.5, 0.5, 0.5], "materials": {"m": {"albedo": [0.8, 0.8, 0.8]}},
+    "objects": [{"type": "mesh", "file": "quad.obj", "material": "m"}]})");
+  start({}, true, "mesh.json");
+  const std::string good_image = read_text(dir_ / "out.pfm");
+
+  save_in_place("quad.obj", "v -1 -1 3\nv 1 -1 nan\nv 1 1 3\nv -1 1 3\nf 1 2 3 4\n");
+  const auto error = expect_line("error:");
+  ASSERT_TRUE(error);
+  EXPECT_NE(error->find("mesh.json: /objects/0/file:"), std::string::npos) << *error;
+  EXPECT_NE(error->find("quad.obj:2: vertex coordinate \"nan\""), std::string::npos) << *error;
+  const auto line = expect_line("reload 1");
+  ASSERT_TRUE(line);
+  EXPECT_NE(line->find("(quad.obj changed): scene has errors"), std::string::npos) << *line;
+  EXPECT_TRUE(child_->running()) << child_->all_output();
+  EXPECT_EQ(read_text(dir_ / "out.pfm"), good_image);
+
+  save_in_place("quad.obj", quad);
+  const auto fixed = expect_line("reload 2");
+  ASSERT_TRUE(fixed);
+  EXPECT_NE(fixed->find("render"), std::string::npos) << *fixed;
+  EXPECT_EQ(read_text(dir_ / "out.pfm"), good_image);
+}
+
+TEST_F(WatchTest, ATileTimeoutIsAnErrorOfItsReloadAndWatchingGoesOn) {
+  // --tile-timeout holds in watch as in render. A render far longer than 1 ms a tile (on lavapipe)
+  // times out: reported, no image written, the watch goes on; what the timed-out work uses stays
+  // alive until it is done, so stopping leaves nothing behind for the validation layer to report.
+  start({"--tile-timeout", "1", "--spp", "256"});
+  const std::string output = child_->all_output();
+  EXPECT_NE(output.find("did not finish within 1 ms"), std::string::npos) << output;
+  EXPECT_NE(output.find("initial: scene"), std::string::npos) << output;
+  EXPECT_NE(output.find("render failed; out.pfm is unchanged"), std::string::npos) << output;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "out.pfm"));
+
+  save_in_place("cornell.json", read_text(dir_ / "cornell.json"));
+  const auto line = expect_line("reload 1");
+  ASSERT_TRUE(line);
+  EXPECT_NE(line->find("render failed"), std::string::npos) << *line;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "out.pfm"));
+  EXPECT_TRUE(child_->running());
+
+  child_->signal(SIGTERM);
+  const auto code = child_->wait_exit(30s);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0) << child_->all_output();
+  EXPECT_NE(child_->all_output().find("stopped"), std::string::npos) << child_->all_output();
+  for (const char* message : {"validation error", "validation warning", "validation message"})
+    EXPECT_EQ(child_->all_output().find(message), std::string::npos) << child_->all_output();
 }
 
 TEST_F(WatchTest, ASceneCompiledIntoTheShaderFollowsGeometryEditsAndShaderEdits) {

@@ -69,6 +69,11 @@ struct DeviceError : Error {
   using Error::Error;
   ExitCode exit_code() const override { return kExitDevice; }
 };
+// The device was lost (a driver reset, a GPU watchdog): nothing on it can be used any more, but a
+// new session may open it again.
+struct DeviceLostError : DeviceError {
+  using DeviceError::DeviceError;
+};
 // A submission did not finish within its timeout. Its work may still be running on the device, so
 // what it uses stays alive (the session keeps it until the device is done with it).
 struct TimeoutError : DeviceError {

@@ -10,22 +10,34 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/errors.h"
+#include "base/timing.h"
 #include "bvh/bvh.h"
 #include "cli/commands.h"
-#include "cpu/reference.h"
-#include "base/errors.h"
-#include "gpu/context.h"
-#include "gpu/renderer.h"
-#include "gpu/shader_compiler.h"
-#include "session/paths.h"
+#include "cli/flags.h"
+#include "cli/stop_signals.h"
 #include "scene/scene.h"
-#include "base/timing.h"
+#include "session/cpu_render.h"
+#include "session/paths.h"
+#include "session/session.h"
 #ifdef VKRAY_HAVE_EMBREE
 #include "embree/embree_tracer.h"
 #endif
 
-namespace vkray {
+namespace vkray::cli {
 namespace {
+
+struct BenchArgs {
+  std::vector<std::string> scenes{"cornell", "bunny", "dragon", "dragon-field"};  // in scenes/
+  uint32_t width = 1024, height = 1024;
+  unsigned repeat = 3;
+  DeviceFlags device;
+  GpuFlags gpu;
+  CpuFlags cpu;  // CPU reference and Embree threads; 0: one per hardware thread
+  bool cpu_reference = true;
+  bool embree = true;
+  bool json = false;
+};
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -60,78 +72,71 @@ std::string fixed(double value, int decimals) {
   return text;
 }
 
-}  // namespace
-
-int run_bench(const BenchCommand& cmd) {
+int run_bench(const BenchArgs& args) {
+  const StopSignals stop;
   const std::filesystem::path scene_dir = default_scene().parent_path();
-  const unsigned threads = cmd.threads ? cmd.threads : std::max(1u, std::thread::hardware_concurrency());
+  RenderOptions measured = render_options(nullptr, &args.gpu, &args.cpu);
+  measured.width = args.width;
+  measured.height = args.height;
+  measured.samples_per_pixel = 1;
+  measured.cancel = [&stop] { return stop.pending(); };
+  const unsigned threads = cpu_threads(measured);
 #ifdef VKRAY_HAVE_EMBREE
-  const bool with_embree = cmd.embree;
+  const bool with_embree = args.embree;
 #else
   const bool with_embree = false;
 #endif
 
-  gpu::ContextOptions options;
-  options.device = cmd.device;
-  gpu::Context ctx(options);
-  const std::filesystem::path shader_dir = cmd.shader_dir.empty() ? default_shader_dir() : cmd.shader_dir;
-  const gpu::TracePipeline pipeline(ctx, shader_dir, gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir}));
-  std::cerr << "vkray bench: device " << ctx.device_name() << " (" << ctx.driver_name() << "); CPU reference and "
-            << (with_embree ? embree_name() : std::string("no Embree"))
-            << " on " << threads << " threads; " << cmd.width << "x" << cmd.height << ", 1 sample per pixel, "
-            << cmd.repeat << " rounds\n";
+  Session session(session_options(args.device));
+  std::cerr << "vkray bench: device " << session.device_description() << "; CPU reference and "
+            << (with_embree ? embree_name() : std::string("no Embree")) << " on " << threads << " threads; "
+            << args.width << "x" << args.height << ", 1 sample per pixel, " << args.repeat << " rounds\n";
 
   std::vector<SceneResult> results;
-  for (const std::string& name : cmd.scenes) {
+  for (const std::string& name : args.scenes) {
     SceneResult r;
     r.name = name;
     auto start = Clock::now();
-    const Scene scene = load_scene(scene_dir / (name + ".json"));
+    const auto scene = std::make_shared<const Scene>(load_scene(scene_dir / (name + ".json")));
     r.load_ms = ms_since(start);
-    r.triangles = scene.triangles.size();
-    const Bvh bvh = build_bvh(primitive_boxes(scene));
+    r.triangles = scene->triangles.size();
+    const Bvh bvh = build_bvh(primitive_boxes(*scene));
     r.bvh_ms = bvh.build_seconds * 1e3;
-    const gpu::GpuScene gpu_scene(ctx, scene, &bvh);
+    const auto on_device = session.upload(scene, &bvh);
 #ifdef VKRAY_HAVE_EMBREE
     std::optional<bench::EmbreeTracer> embree;
     if (with_embree) {
-      embree.emplace(scene);
+      embree.emplace(*scene);
       r.embree_build_ms = embree->build_seconds() * 1e3;
     }
 #endif
-    const ImageSettings image{cmd.width, cmd.height, 1};
     // The path the measured renders take, decided once, so that the warm-up renders (lavapipe
     // compiles on the first dispatch) use the same two pipelines, with and without shadow rays.
-    gpu::RenderOptions warm_up;
-    r.inline_scene = gpu::use_inline_scene(gpu_scene, image, cmd.inline_scene);
-    warm_up.inline_scene = r.inline_scene ? gpu::InlineScene::always : gpu::InlineScene::never;
+    r.inline_scene = session.compiles_scene_in(on_device, measured);
+    RenderOptions options = measured;
+    options.inline_scene = r.inline_scene ? InlineScene::always : InlineScene::never;
+    RenderOptions warm_up = options;
+    warm_up.width = warm_up.height = 64;
     for (const bool shadows : {false, true}) {
       warm_up.shadows = shadows;
-      gpu::render(ctx, pipeline, gpu_scene, {64, 64, 1}, warm_up);
+      session.render(on_device, warm_up);
     }
     std::vector<double> frame_ms[2];
-    for (unsigned round = 0; round < cmd.repeat; ++round) {
+    for (unsigned round = 0; round < args.repeat; ++round) {
       for (int mode = 0; mode < 2; ++mode) {
-        const bool shadows = mode == 1;
-        gpu::RenderOptions render_options = warm_up;
-        render_options.shadows = shadows;
-        gpu::RenderStats stats;
-        gpu::render(ctx, pipeline, gpu_scene, image, render_options, &stats);
-        r.rates[mode].gpu.push_back(double(stats.rays) / stats.trace_seconds * 1e-6);
-        frame_ms[mode].push_back(stats.trace_seconds * 1e3);
+        options.shadows = mode == 1;
+        const RenderStats gpu = session.render(on_device, options).stats;
+        r.rates[mode].gpu.push_back(double(gpu.rays) / gpu.trace_seconds * 1e-6);
+        frame_ms[mode].push_back(gpu.trace_seconds * 1e3);
 #ifdef VKRAY_HAVE_EMBREE
         if (embree) {
-          const auto e = embree->trace(cmd.width, cmd.height, shadows, threads);
+          const auto e = embree->trace(args.width, args.height, options.shadows, threads);
           r.rates[mode].embree.push_back(double(e.rays) / e.seconds * 1e-6);
         }
 #endif
-        if (cmd.cpu_reference) {
-          cpu::ReferenceOptions reference_options;
-          reference_options.bvh = &bvh;
-          reference_options.shadows = shadows;
-          reference_options.threads = threads;
-          const auto c = cpu::render_reference(scene, image, reference_options);
-          r.rates[mode].cpu.push_back(double(c.rays) / c.seconds * 1e-6);
+        if (args.cpu_reference) {
+          const RenderStats cpu = render_on_cpu(*scene, options, &bvh).stats;
+          r.rates[mode].cpu.push_back(double(cpu.rays) / cpu.trace_seconds * 1e-6);
         }
       }
     }
@@ -139,17 +144,19 @@ int run_bench(const BenchCommand& cmd) {
     std::cerr << "vkray bench: " << name << " done\n";
     results.push_back(std::move(r));
   }
+  const std::string device = session.device_name();
+  session.close();
 
-  if (cmd.json) {
+  if (args.json) {
     nlohmann::json out = nlohmann::json::array();
     for (const auto& r : results) {
-      nlohmann::json j = {{"scene", r.name}, {"triangles", r.triangles}, {"width", cmd.width}, {"height", cmd.height},
-                          {"bvh_build_ms", r.bvh_ms}, {"device", ctx.device_name()}, {"threads", threads},
+      nlohmann::json j = {{"scene", r.name}, {"triangles", r.triangles}, {"width", args.width}, {"height", args.height},
+                          {"bvh_build_ms", r.bvh_ms}, {"device", device}, {"threads", threads},
                           {"gpu_path", r.inline_scene ? "inline" : "bvh"}};
       for (int mode = 0; mode < 2; ++mode) {
         const std::string key = mode == 0 ? "primary" : "primary_shadow";
         nlohmann::json m = {{"gpu_mrays", median(r.rates[mode].gpu)}, {"gpu_trace_ms", r.gpu_frame_ms[mode]}};
-        if (cmd.cpu_reference) m["cpu_reference_mrays"] = median(r.rates[mode].cpu);
+        if (args.cpu_reference) m["cpu_reference_mrays"] = median(r.rates[mode].cpu);
         if (with_embree) {
           m["embree_mrays"] = median(r.rates[mode].embree);
           m["gpu_over_embree"] = median(r.rates[mode].gpu) / median(r.rates[mode].embree);
@@ -172,7 +179,7 @@ int run_bench(const BenchCommand& cmd) {
     for (int mode = 0; mode < 2; ++mode) {
       const double gpu = median(r.rates[mode].gpu), embree = median(r.rates[mode].embree);
       std::printf(" | %8s %8s %8s %8s %8s", fixed(gpu, 2).c_str(), fixed(r.gpu_frame_ms[mode], 0).c_str(),
-                  cmd.cpu_reference ? fixed(median(r.rates[mode].cpu), 2).c_str() : "-",
+                  args.cpu_reference ? fixed(median(r.rates[mode].cpu), 2).c_str() : "-",
                   with_embree ? fixed(embree, 2).c_str() : "-", with_embree ? fixed(gpu / embree, 2).c_str() : "-");
     }
     std::printf("\n");
@@ -182,4 +189,26 @@ int run_bench(const BenchCommand& cmd) {
   return kExitOk;
 }
 
-}  // namespace vkray
+}  // namespace
+
+Command add_bench_command(CLI::App& app) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App* command = app.add_subcommand(
+      "bench", "Measure rays per second of the GPU path, the CPU reference and Intel Embree (when built with it) on "
+               "fixed scenes, alternately in one run. Prints a table (or --json); never fails on the numbers.");
+  command->add_option("--scenes", args->scenes, "Scene names in scenes/ (default: cornell bunny dragon dragon-field)")
+      ->delimiter(',');
+  command->add_option("--width", args->width, "Image width")->check(CLI::Range(8, 16384));
+  command->add_option("--height", args->height, "Image height")->check(CLI::Range(8, 16384));
+  command->add_option("--repeat", args->repeat, "Rounds per scene; the median is reported")->check(CLI::Range(1, 100));
+  add_cpu_flags(*command, args->cpu, "Threads for the CPU reference and Embree (default: one per hardware thread)");
+  add_device_flags(*command, args->device, /*validate=*/false);
+  add_gpu_flags(*command, args->gpu);
+  command->add_flag("!--no-cpu-reference", args->cpu_reference, "Leave the CPU reference out");
+  command->add_flag("!--no-embree", args->embree, "Leave Embree out");
+  command->add_flag("--json", args->json, "Print the results as JSON");
+  command->footer(kExitCodes);
+  return {command, [args] { return run_bench(*args); }};
+}
+
+}  // namespace vkray::cli

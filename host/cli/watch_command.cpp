@@ -1,30 +1,37 @@
 // `vkray watch`: render, then re-render whenever a shader, the scene or a file it uses changes,
 // keeping the last good pipeline, scene and image through every mistake.
-#include <poll.h>
-#include <signal.h>
-#include <sys/signalfd.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
-#include "cli/commands.h"
 #include "base/errors.h"
-#include "cli/file_watcher.h"
-#include "gpu/context.h"
-#include "gpu/renderer.h"
-#include "gpu/shader_compiler.h"
-#include "image/image.h"
-#include "session/paths.h"
-#include "scene/scene.h"
-#include "cli/stop_signals.h"
 #include "base/timing.h"
+#include "cli/commands.h"
+#include "cli/file_watcher.h"
+#include "cli/flags.h"
+#include "cli/report.h"
+#include "cli/stop_signals.h"
+#include "image/image.h"
+#include "session/failure.h"
+#include "session/paths.h"
+#include "session/session.h"
 
-namespace vkray {
+namespace vkray::cli {
 namespace {
+
+struct WatchArgs {
+  SceneFlags scene;
+  DeviceFlags device;
+  GpuFlags gpu;
+  std::filesystem::path output;        // empty: <scene name>.png in the current folder
+  std::optional<uint32_t> exit_after;  // stop after this many reloads (scripts and tests)
+};
+
+std::filesystem::path absolute_normal(const std::filesystem::path& p) { return std::filesystem::absolute(p).lexically_normal(); }
 
 std::string names(const std::vector<std::filesystem::path>& files) {
   std::string text;
@@ -32,170 +39,214 @@ std::string names(const std::vector<std::filesystem::path>& files) {
   return text;
 }
 
-int watch(const WatchCommand& cmd, const std::shared_ptr<gpu::ValidationLog>& validation_log) {
-  const StopSignals stop;
-  const std::filesystem::path scene_file =
-      std::filesystem::absolute(cmd.flags.scene.empty() ? default_scene() : cmd.flags.scene).lexically_normal();
-  const std::filesystem::path shader_dir =
-      std::filesystem::absolute(cmd.flags.shader_dir.empty() ? default_shader_dir() : cmd.flags.shader_dir).lexically_normal();
-  const std::filesystem::path output =
-      cmd.output.empty() ? std::filesystem::path(scene_file.stem().string() + ".png") : cmd.output;
-  check_output_path(output);
+// Prints what went wrong in a step of a reload: a shader error as its own `file:line: error:` lines,
+// anything else as the command line reports it.
+void report(const std::exception_ptr& error) {
+  const Failure failure = describe_failure(error);
+  if (failure.multiline)
+    std::cerr << failure.message << "\n";
+  else
+    std::cerr << "vkray: " << failure.headline << ": " << failure.message << "\n";
+}
 
-  gpu::ContextOptions options;
-  options.validation = cmd.flags.validate;
-  options.device = cmd.flags.device;
-  options.validation_log = validation_log;
-  gpu::Context ctx(options);
-  std::cerr << "vkray: device " << ctx.device_name() << " (" << ctx.driver_name() << ")"
-            << (cmd.flags.validate ? ", validation on" : "") << "\n";
-  // Pipelines built from SPIR-V seen before in this session come from here instead of the driver's
-  // compiler (Mesa also keeps its own on-disk shader cache across sessions).
-  const vk::raii::PipelineCache pipeline_cache(ctx.device(), vk::PipelineCacheCreateInfo{});
+class Watch {
+ public:
+  explicit Watch(const WatchArgs& args);
+  int run();
 
-  // The last good state. A failed reload leaves it untouched. The scene lives on the heap because
-  // its GpuScene (BVH and buffers, rebuilt only when the scene changes) points at it.
-  std::unique_ptr<Scene> scene;
-  std::unique_ptr<gpu::GpuScene> gpu_scene;
-  std::unique_ptr<gpu::TracePipeline> pipeline;
-  std::vector<uint32_t> spirv;
-  std::vector<std::filesystem::path> shader_sources{shader_dir / "trace.comp"};
-  bool scene_broken = false, shader_broken = false;
-  // Compiles the pipeline the current scene needs (a small scene's own code, say), so that the time
-  // reported for a reload counts it. A ShaderError here is the shaders' (the generated code follows
-  // the contract in inline_scene.glsl).
-  auto prepare_pipeline = [&] {
-    if (pipeline && gpu_scene)
-      pipeline->pipeline(gpu::shader_variant(*gpu_scene, image_settings(*scene, cmd.flags), cmd.flags.inline_scene));
-  };
+ private:
+  // Each step returns what the reload's line says of it; a failure is printed, and the last good
+  // state stays.
+  std::string reload_scene();
+  std::string compile_shaders();
+  std::string render(bool errors_reported);
+  // Compiles the pipeline the scene needs (a small scene's own code, say), so that the time
+  // reported for a render does not count it. Throws ShaderError.
+  double prepare_pipeline();
+  // Opens the device again after it was lost, with the last good shaders and scene.
+  void reopen_device();
+  bool is_scene_file(const std::filesystem::path& file) const;
+  void watch_current_files();
 
-  auto reload_scene = [&]() -> std::string {
-    const auto start = Clock::now();
-    try {
-      auto loaded = std::make_unique<Scene>(load_scene(scene_file));
-      for (const auto& warning : loaded->warnings) std::cerr << "vkray: warning: " << warning << "\n";
-      auto uploaded = std::make_unique<gpu::GpuScene>(ctx, *loaded);
-      ctx.queue().waitIdle();  // renders wait for their tiles; keep it so if that ever changes
-      gpu_scene = std::move(uploaded);  // the old GpuScene goes first, while its scene still exists
-      scene = std::move(loaded);
-      scene_broken = false;
-    } catch (const SceneError& e) {
-      std::cerr << "vkray: error: " << e.what() << "\n";
-      scene_broken = true;
-      return "scene has errors";
-    }
-    try {
-      prepare_pipeline();
-    } catch (const ShaderError& e) {
-      std::cerr << e.what() << "\n";
-      shader_broken = true;
-      return "scene " + format_ms(ms_since(start)) + ", shader has errors";
-    }
-    return "scene " + format_ms(ms_since(start));
-  };
-  auto recompile = [&]() -> std::string {
-    const auto start = Clock::now();
-    try {
-      gpu::CompiledShader compiled = gpu::compile_compute_shader(shader_dir / "trace.comp", {shader_dir});
-      shader_sources = compiled.sources;
-      shader_broken = false;
-      // The SPIR-V without a scene compiled in says nothing about the one with it (its functions are
-      // not in the other), so a scene that is compiled in is always recompiled.
-      const bool compiled_in = gpu_scene && gpu::use_inline_scene(*gpu_scene, image_settings(*scene, cmd.flags),
-                                                                  cmd.flags.inline_scene);
-      if (pipeline && compiled.spirv == spirv && !compiled_in)
-        return "compile " + format_ms(ms_since(start)) + " (SPIR-V unchanged)";
-      // Renders wait for their last tile, so no work uses the old pipeline now; wait anyway, so
-      // that stays true if rendering ever overlaps with reloading.
-      ctx.queue().waitIdle();
-      pipeline = std::make_unique<gpu::TracePipeline>(ctx, shader_dir, compiled, &pipeline_cache);
-      prepare_pipeline();
-      spirv = std::move(compiled.spirv);
-      ctx.check_validation("pipeline creation");
-      return "compile " + format_ms(ms_since(start));
-    } catch (const ShaderError& e) {
-      std::cerr << e.what() << "\n";
-      shader_broken = true;
-      return "shader has errors";
-    }
-  };
-  // Renders with the last good state and replaces the image; returns what to report.
-  // `errors_reported` says whether this reload's report already named what is broken.
-  auto render = [&](bool errors_reported) -> std::string {
-    if (scene_broken || shader_broken || !gpu_scene || !pipeline) {
-      if (errors_reported) return "not rendered; " + output.string() + " is unchanged";
-      std::string broken = shader_broken || !pipeline ? "shader" : "scene";
-      if ((shader_broken || !pipeline) && (scene_broken || !scene)) broken = "shader and the scene";
-      return "not rendered while the " + broken + " still has errors; " + output.string() + " is unchanged";
-    }
-    const ImageSettings image = image_settings(*scene, cmd.flags);
-    gpu::RenderOptions render_options;
-    render_options.cancel = [&] { return stop.pending(); };
-    render_options.inline_scene = cmd.flags.inline_scene;
-    const auto start = Clock::now();
-    const Image result = gpu::render(ctx, *pipeline, *gpu_scene, image, render_options);
+  const WatchArgs& args_;
+  const StopSignals stop_;
+  const std::filesystem::path scene_file_;
+  const std::filesystem::path output_;
+  SessionOptions session_options_;
+  RenderOptions options_;
+  std::unique_ptr<Session> session_;
+  // The last good state; a failed reload leaves it as it was.
+  std::shared_ptr<const Scene> scene_;
+  std::optional<DeviceScene> on_device_;
+  bool scene_broken_ = false, shader_broken_ = false;
+  FileWatcher watcher_;
+};
+
+Watch::Watch(const WatchArgs& args)
+    : args_(args),
+      scene_file_(absolute_normal(scene_file(args.scene))),
+      output_(args.output.empty() ? std::filesystem::path(scene_file_.stem().string() + ".png") : args.output),
+      session_options_(session_options(args.device)),
+      options_(render_options(&args.scene, &args.gpu, nullptr)) {
+  check_output_path(output_);  // before the device: a typo costs nothing
+  session_options_.shader_dir = absolute_normal(session_options_.shader_dir.empty() ? default_shader_dir()
+                                                                                   : session_options_.shader_dir);
+  options_.cancel = [this] { return stop_.pending(); };
+  session_ = std::make_unique<Session>(session_options_);
+  std::cerr << "vkray: device " << session_->device_description() << (args.device.validate ? ", validation on" : "")
+            << "\n";
+}
+
+std::string Watch::reload_scene() {
+  const auto start = Clock::now();
+  try {
+    auto loaded = std::make_shared<const Scene>(load_scene(scene_file_));
+    for (const auto& warning : loaded->warnings) std::cerr << "vkray: warning: " << warning << "\n";
+    DeviceScene uploaded = session_->upload(loaded, nullptr);
+    scene_ = std::move(loaded);
+    on_device_ = std::move(uploaded);  // the old one goes whenever no render holds it any more
+    scene_broken_ = false;
+  } catch (const DeviceLostError&) {
+    throw;
+  } catch (const Error&) {  // the scene, a mesh, a limit, or a scene too large for the device
+    report(std::current_exception());
+    scene_broken_ = true;
+    return "scene has errors";
+  }
+  try {
+    if (session_->has_shaders()) prepare_pipeline();
+  } catch (const ShaderError&) {
+    report(std::current_exception());
+    shader_broken_ = true;
+    return "scene " + format_ms(ms_since(start)) + ", shader has errors";
+  }
+  return "scene " + format_ms(ms_since(start));
+}
+
+std::string Watch::compile_shaders() {
+  try {
+    const Session::ShaderCompile compiled = session_->compile_shaders();
+    shader_broken_ = false;
+    if (compiled.pipelines_kept) return "compile " + format_ms(compiled.seconds * 1e3) + " (SPIR-V unchanged)";
+    const double prepare_seconds = on_device_ ? prepare_pipeline() : 0.0;
+    return "compile " + format_ms((compiled.seconds + prepare_seconds) * 1e3);
+  } catch (const ShaderError&) {
+    report(std::current_exception());
+    shader_broken_ = true;
+    return "shader has errors";
+  }
+}
+
+double Watch::prepare_pipeline() { return session_->prepare(*on_device_, options_); }
+
+std::string Watch::render(bool errors_reported) {
+  if (scene_broken_ || shader_broken_ || !on_device_ || !session_->has_shaders()) {
+    if (errors_reported) return "not rendered; " + output_.string() + " is unchanged";
+    std::string broken = shader_broken_ || !session_->has_shaders() ? "shader" : "scene";
+    if ((shader_broken_ || !session_->has_shaders()) && (scene_broken_ || !scene_)) broken = "shader and the scene";
+    return "not rendered while the " + broken + " still has errors; " + output_.string() + " is unchanged";
+  }
+  const auto start = Clock::now();
+  try {
+    const RenderResult result = session_->render(*on_device_, options_);
     const double render_ms = ms_since(start);
-    ctx.check_validation("render");
-    write_image(result, output);
-    return "render " + format_ms(render_ms) + " -> " + output.string();
-  };
+    write_image(result.image, output_);
+    return "render " + format_ms(render_ms) + " -> " + output_.string();
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const DeviceLostError&) {
+    throw;
+  } catch (const Error&) {  // a tile past its timeout (a shader that loops), a validation message, the output
+    report(std::current_exception());
+    return "render failed; " + output_.string() + " is unchanged";
+  }
+}
 
-  FileWatcher watcher;
-  // The scene and the files it references count as "the scene"; everything else is a shader.
-  auto is_scene_file = [&](const std::filesystem::path& f) {
-    if (f == scene_file) return true;
-    return scene && std::any_of(scene->referenced_files.begin(), scene->referenced_files.end(), [&](const auto& r) {
-             return std::filesystem::absolute(r).lexically_normal() == f;
-           });
-  };
-  auto watch_current_files = [&] {
-    std::vector<std::filesystem::path> files = shader_sources;
-    files.push_back(scene_file);
-    if (scene) files.insert(files.end(), scene->referenced_files.begin(), scene->referenced_files.end());
-    watcher.set_files(files);
-  };
-  watcher.set_folder(shader_dir, {".comp", ".glsl", ".h", ".inc"});
+void Watch::reopen_device() {
+  std::cerr << "vkray: the device was lost; opening it again\n";
+  on_device_.reset();
+  session_.reset();
+  session_ = std::make_unique<Session>(session_options_);
+  if (scene_) on_device_ = session_->upload(scene_, nullptr);
+  if (!shader_broken_) session_->compile_shaders();
+}
 
+bool Watch::is_scene_file(const std::filesystem::path& file) const {
+  if (file == scene_file_) return true;
+  return scene_ && std::any_of(scene_->referenced_files.begin(), scene_->referenced_files.end(),
+                               [&](const auto& r) { return absolute_normal(r) == file; });
+}
+
+void Watch::watch_current_files() {
+  std::vector<std::filesystem::path> files = session_->shader_sources();
+  files.push_back(scene_file_);
+  if (scene_) files.insert(files.end(), scene_->referenced_files.begin(), scene_->referenced_files.end());
+  watcher_.set_files(files);
+}
+
+int Watch::run() {
+  // A new file that a shader will #include is seen too (the folder, not only today's files).
+  watcher_.set_folder(session_options_.shader_dir, {".comp", ".glsl", ".h", ".inc"});
   try {
     const std::string scene_report = reload_scene();
-    const std::string shader_report = recompile();
-    std::cerr << "vkray: initial: " << scene_report << ", " << shader_report << ", " << render(true) << "\n";
+    const std::string shader_report = compile_shaders();
+    const std::string render_report = render(true);
+    std::cerr << "vkray: initial: " << scene_report << ", " << shader_report << ", " << render_report << "\n";
     watch_current_files();
-    std::cerr << "vkray: watching " << watcher.file_count() << " files in " << watcher.folder_count()
+    std::cerr << "vkray: watching " << watcher_.file_count() << " files in " << watcher_.folder_count()
               << " folders; Ctrl-C to stop\n";
 
-    for (uint32_t reload = 1; !cmd.exit_after || reload <= *cmd.exit_after; ++reload) {
-      const std::vector<std::filesystem::path> changed = watcher.wait(std::chrono::milliseconds(50), stop.fd());
+    for (uint32_t reload = 1; !args_.exit_after || reload <= *args_.exit_after; ++reload) {
+      const std::vector<std::filesystem::path> changed = watcher_.wait(std::chrono::milliseconds(50), stop_.fd());
       if (changed.empty()) break;  // SIGINT or SIGTERM
-      const bool scene_changed = std::any_of(changed.begin(), changed.end(), is_scene_file);
+      const bool scene_changed = std::any_of(changed.begin(), changed.end(), [&](const auto& f) { return is_scene_file(f); });
       const bool shader_changed = std::any_of(changed.begin(), changed.end(), [&](const auto& f) { return !is_scene_file(f); });
-      std::string report;
-      if (scene_changed) report += reload_scene() + ", ";
-      if (shader_changed) report += recompile() + ", ";
-      const bool errors_reported = (scene_changed && scene_broken) || (shader_changed && shader_broken);
-      std::cerr << "vkray: reload " << reload << " (" << names(changed) << " changed): " << report
-                << render(errors_reported) << "\n";
+      std::string line;
+      for (int attempt = 0;; ++attempt) {
+        try {
+          line.clear();
+          if (scene_changed) line += reload_scene() + ", ";
+          if (shader_changed) line += compile_shaders() + ", ";
+          const bool errors_reported = (scene_changed && scene_broken_) || (shader_changed && shader_broken_);
+          line += render(errors_reported);
+          break;
+        } catch (const DeviceLostError&) {
+          if (attempt > 0) throw;  // lost again at once: it cannot be brought back
+          report(std::current_exception());
+          reopen_device();
+        }
+      }
+      std::cerr << "vkray: reload " << reload << " (" << names(changed) << " changed): " << line << "\n";
       watch_current_files();
     }
   } catch (const Cancelled&) {
     // Stopped mid-render: the image on disk is the last complete one.
   }
-  ctx.queue().waitIdle();
+  // As for render: the device's teardown can raise validation messages (objects left alive), and
+  // they must fail the command.
+  on_device_.reset();
+  session_->close();
+  std::cerr << "vkray: stopped\n";
   return kExitOk;
 }
 
 }  // namespace
 
-int run_watch(const WatchCommand& cmd) {
-  // As for render: the device's teardown can raise validation messages (leaked objects), and they
-  // must fail the command.
-  auto validation_log = std::make_shared<gpu::ValidationLog>();
-  const int code = watch(cmd, validation_log);
-  if (validation_log->count() > 0)
-    throw DeviceError(std::to_string(validation_log->count()) + " validation message(s); the first:\n  " +
-                      validation_log->messages().front());
-  std::cerr << "vkray: stopped\n";
-  return code;
+Command add_watch_command(CLI::App& app) {
+  auto args = std::make_shared<WatchArgs>();
+  CLI::App* command = app.add_subcommand(
+      "watch", "Render, then re-render whenever the shaders, the scene or a file it uses changes. A broken shader or "
+               "scene is reported as file:line and the last good image is kept. Ctrl-C stops it.");
+  add_scene_flags(*command, args->scene);
+  command->add_option("-o,--output", args->output, "Output image (default: <scene name>.png in the current folder)");
+  add_device_flags(*command, args->device);
+  add_gpu_flags(*command, args->gpu);
+  command
+      ->add_option("--exit-after", args->exit_after,
+                   "Stop after N reloads (each change that was acted on counts, failed or not); for tests and scripts")
+      ->check(CLI::Range(1, 1000000));
+  command->footer(kExitCodes);
+  return {command, [args] { return Watch(*args).run(); }};
 }
 
-}  // namespace vkray
+}  // namespace vkray::cli

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <thread>
 
+#include "base/errors.h"
 #include "bvh/bvh.h"
 #include "scene/camera.h"
 #include "shared/types.h"
@@ -219,11 +220,12 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
 
   std::atomic<uint32_t> next_row{0};
   std::atomic<uint64_t> total_rays{0};
+  std::atomic<bool> cancelled{false};
   std::mutex progress_mutex;
   uint32_t rows_done = 0;
   auto worker = [&] {
     uint64_t rays = 0;
-    for (uint32_t j; (j = next_row++) < settings.height;) {
+    for (uint32_t j; !cancelled && (j = next_row++) < settings.height;) {
       for (uint32_t i = 0; i < settings.width; ++i) {
         const uint32_t index = j * settings.width + i;
         uint64_t signature = 0xcbf29ce484222325ull;
@@ -238,9 +240,10 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
         result.image.pixels[index] = glm::vec3(sum / double(settings.samples_per_pixel));
         result.signatures[index] = signature;
       }
-      if (options.progress) {
+      if (options.progress || options.cancel) {
         std::lock_guard lock(progress_mutex);
-        options.progress(++rows_done, settings.height);
+        if (options.progress) options.progress(++rows_done, settings.height);
+        if (options.cancel && options.cancel()) cancelled = true;
       }
     }
     total_rays += rays;
@@ -251,6 +254,7 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
   for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();
   pool.clear();  // joins
+  if (cancelled) throw Cancelled();
 
   result.rays = total_rays;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

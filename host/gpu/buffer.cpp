@@ -12,7 +12,6 @@ void Buffer::invalidate(const vk::raii::Device& device) const {
 Buffer create_buffer(const Context& ctx, vk::DeviceSize size, vk::BufferUsageFlags usage,
                      vk::MemoryPropertyFlags required, vk::MemoryPropertyFlags preferred) {
   Buffer b;
-  b.size = size;
   b.buffer = vk::raii::Buffer(ctx.device(), vk::BufferCreateInfo({}, size, usage, vk::SharingMode::eExclusive));
   const vk::MemoryRequirements req = b.buffer.getMemoryRequirements();
   const uint32_t type = ctx.memory_type(req.memoryTypeBits, required, preferred);

@@ -10,7 +10,6 @@ namespace vkray::gpu {
 struct Buffer {
   vk::raii::Buffer buffer{nullptr};
   vk::raii::DeviceMemory memory{nullptr};
-  vk::DeviceSize size = 0;
   void* mapped = nullptr;  // persistently mapped when the memory is host-visible
   bool coherent = true;
 

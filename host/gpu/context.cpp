@@ -76,11 +76,10 @@ vk::raii::Instance make_instance(const vk::raii::Context& context, bool validati
 VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                      VkDebugUtilsMessageTypeFlagsEXT,
                                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
-  auto* self = static_cast<std::pair<ValidationLog*, bool>*>(user);
   const char* level = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
   std::string message = std::string("validation ") + level + ": " + (data->pMessage ? data->pMessage : "");
-  if (self->second) std::cerr << "vkray: " << message << "\n";
-  self->first->add(std::move(message));
+  std::cerr << "vkray: " << message << "\n";
+  static_cast<ValidationLog*>(user)->add(std::move(message));
   return VK_FALSE;  // never abort the call: we report, then fail at the next check
 }
 
@@ -122,19 +121,15 @@ std::vector<DeviceInfo> list_devices() {
   return result;
 }
 
-Context::Context(const ContextOptions& options)
-    : validation_(options.validation),
-      log_(options.validation_log ? options.validation_log : std::make_shared<ValidationLog>()),
-      echo_(options.echo_validation) {
-  instance_ = make_instance(context_, validation_);
-  if (validation_) {
+Context::Context(const ContextOptions& options) : log_(options.validation_log) {
+  instance_ = make_instance(context_, log_ != nullptr);
+  if (log_) {
     using S = vk::DebugUtilsMessageSeverityFlagBitsEXT;
     using T = vk::DebugUtilsMessageTypeFlagBitsEXT;
-    callback_data_ = {log_.get(), echo_};
     messenger_ = vk::raii::DebugUtilsMessengerEXT(
         instance_, vk::DebugUtilsMessengerCreateInfoEXT({}, S::eWarning | S::eError,
                                                         T::eGeneral | T::eValidation | T::ePerformance,
-                                                        &on_validation_message, &callback_data_));
+                                                        &on_validation_message, log_.get()));
   }
 
   // ---- choose the physical device ----
@@ -198,17 +193,8 @@ void Context::wait(const vk::raii::Fence& fence, std::chrono::milliseconds timeo
   const auto ns = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count());
   const vk::Result result = device_.waitForFences({*fence}, VK_TRUE, ns);
   if (result == vk::Result::eTimeout)
-    throw DeviceError(std::string("vkWaitForFences: ") + what + " did not finish within " +
-                      std::to_string(timeout.count()) + " ms (VK_TIMEOUT)");
-}
-
-void Context::check_validation(const char* during) {
-  const auto messages = log_->messages();
-  if (messages.size() == validation_seen_) return;
-  std::string text = std::to_string(messages.size() - validation_seen_) + " validation message(s) during " + during +
-                     "; the first:\n  " + messages[validation_seen_];
-  validation_seen_ = messages.size();
-  throw DeviceError(text);
+    throw TimeoutError(std::string("vkWaitForFences: ") + what + " did not finish within " +
+                       std::to_string(timeout.count()) + " ms (VK_TIMEOUT)");
 }
 
 }  // namespace vkray::gpu

@@ -10,10 +10,12 @@
 
 #include <vulkan/vulkan_raii.hpp>
 
+#include "gpu/device_info.h"
+
 namespace vkray::gpu {
 
-// Messages from the Khronos validation layer. Shared so a test can inspect it after the Context
-// (whose destruction can itself produce messages, such as leaked objects) is gone.
+// Messages from the Khronos validation layer. Shared, so that whoever made the Context can read it
+// after the Context (whose destruction can itself produce messages, such as leaked objects) is gone.
 class ValidationLog {
  public:
   void add(std::string message);
@@ -26,27 +28,11 @@ class ValidationLog {
 };
 
 struct ContextOptions {
-  bool validation = false;  // enable VK_LAYER_KHRONOS_validation; any message is an error
-  std::string device;       // index or case-insensitive name substring; empty: best available
-  std::shared_ptr<ValidationLog> validation_log;  // where messages go; one is made if null
-  bool echo_validation = true;                    // also print each message to stderr
+  std::string device;  // index or case-insensitive name substring; empty: best available
+  // Where the Khronos validation layer's messages go (each is also printed to stderr); null: the
+  // layer is off.
+  std::shared_ptr<ValidationLog> validation_log;
 };
-
-struct DeviceInfo {
-  uint32_t index;
-  std::string name;
-  std::string type;  // "discrete GPU", "integrated GPU", "virtual GPU", "CPU", "other"
-  std::string driver;
-  std::string api_version;
-  bool has_compute_queue;
-  uint32_t max_workgroup_invocations;
-  uint32_t max_texel_buffer_elements;
-  uint64_t max_storage_buffer_range;
-  uint64_t device_local_bytes;
-};
-
-// Every Vulkan device the loader reports, in loader order (the INDEX of --device).
-std::vector<DeviceInfo> list_devices();
 
 class Context {
  public:
@@ -59,26 +45,17 @@ class Context {
   const vk::PhysicalDeviceLimits& limits() const { return properties_.limits; }
   const std::string& device_name() const { return device_name_; }
   const std::string& driver_name() const { return driver_name_; }
-  bool validation_enabled() const { return validation_; }
-  ValidationLog& validation_log() { return *log_; }
 
   // Index of a memory type allowed by `type_bits` with all of `required` (and all of `preferred`
   // if such a type exists). Throws DeviceError if none has `required`.
   uint32_t memory_type(uint32_t type_bits, vk::MemoryPropertyFlags required,
                        vk::MemoryPropertyFlags preferred = {}) const;
 
-  // Waits for a fence with a finite timeout; throws DeviceError naming `what` on timeout.
+  // Waits for a fence with a finite timeout; throws TimeoutError naming `what` on timeout.
   void wait(const vk::raii::Fence& fence, std::chrono::milliseconds timeout, const char* what) const;
 
-  // Throws DeviceError if the validation layer has reported anything since the last call.
-  void check_validation(const char* during);
-
  private:
-  bool validation_;
   std::shared_ptr<ValidationLog> log_;
-  bool echo_;
-  size_t validation_seen_ = 0;
-  std::pair<ValidationLog*, bool> callback_data_{nullptr, true};  // the messenger's user data
   // Declaration order is destruction order reversed: the messenger outlives the device.
   vk::raii::Context context_;
   vk::raii::Instance instance_{nullptr};

@@ -92,7 +92,9 @@ DescriptorSet DescriptorWriter::write() const {
   vk::raii::DescriptorSets sets(*table.device_, vk::DescriptorSetAllocateInfo(*pool, layout));
 
   std::vector<vk::WriteDescriptorSet> writes;
-  for (const auto& [binding, resource] : resources_) {
+  for (const auto& entry : resources_) {
+    const uint32_t binding = entry.first;
+    const auto& resource = entry.second;
     const BindingSlot* slot = table.find(binding);
     VKRAY_CHECK(slot != nullptr, "a descriptor written at a binding its table does not have");
     VKRAY_CHECK(std::count_if(resources_.begin(), resources_.end(), [&](const auto& r) { return r.first == binding; }) == 1,

@@ -11,14 +11,6 @@
 
 namespace vkray::gpu {
 
-// How a scene is traced: by code compiled from it (every primitive tested, its coordinates constants
-// in the shader) or by walking its BVH in the scene buffers.
-enum class InlineScene {
-  automatic,  // compiled in when the scene is small and the render traces enough camera rays to repay the compile
-  always,     // compiled in whenever the scene is small (at most kMaxInlinePrimitives primitives)
-  never,      // always the BVH
-};
-
 // Scenes of at most this many primitives can be compiled into the shader.
 constexpr uint32_t kMaxInlinePrimitives = 32;
 

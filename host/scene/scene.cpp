@@ -22,10 +22,6 @@ namespace {
 
 using json = nlohmann::json;
 
-// Upper bounds that keep later size arithmetic far from overflow; the device's own limits are
-// checked again before anything is allocated.
-constexpr uint32_t kMaxImageSide = 16384;
-constexpr uint32_t kMaxSamplesPerPixel = 65536;
 
 // A JSON value together with its JSON-pointer path, so every message can say where it is.
 struct Value {

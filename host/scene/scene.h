@@ -15,6 +15,11 @@
 
 namespace vkray {
 
+// Upper bounds of a scene's image settings, which keep later size arithmetic far from overflow; the
+// device's own limits are checked again before anything is allocated.
+constexpr uint32_t kMaxImageSide = 16384;
+constexpr uint32_t kMaxSamplesPerPixel = 65536;
+
 // A scene holds at most this many primitives (triangles and spheres together): a BVH leaf names its
 // first primitive in 27 bits (bvh/bvh.h checks that the two agree).
 constexpr size_t kMaxScenePrimitives = (size_t(1) << 27) - 1;

@@ -10,7 +10,7 @@ Failure describe_failure(const std::exception_ptr& error) {
   try {
     std::rethrow_exception(error);
   } catch (const Cancelled& e) {
-    return {e.exit_code(), "interrupted", "no image written", false};
+    return {e.exit_code(), "interrupted; no image written", "", false};
   } catch (const ShaderError& e) {
     return {e.exit_code(), "shader compilation failed", e.what(), true};
   } catch (const DeviceError& e) {

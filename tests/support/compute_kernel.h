@@ -11,7 +11,7 @@
 namespace vkray::test {
 
 // The shader's local_size_x must be 64.
-std::vector<float> run_kernel(gpu::Context& ctx, const std::filesystem::path& shader, const void* input,
+std::vector<float> run_kernel(const gpu::Context& ctx, const std::filesystem::path& shader, const void* input,
                               size_t input_bytes, uint32_t count, size_t outputs_per_item);
 
 }  // namespace vkray::test

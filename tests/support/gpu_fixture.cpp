@@ -1,18 +1,37 @@
 #include "support/gpu_fixture.h"
 
+#include "base/errors.h"
+#include "session/cpu_render.h"
+
 namespace vkray::test {
 
+RenderOptions with_image(RenderOptions options, const ImageSettings& image) {
+  options.width = image.width;
+  options.height = image.height;
+  options.samples_per_pixel = image.samples_per_pixel;
+  return options;
+}
+
 void GpuTest::SetUp() {
-  log_ = std::make_shared<gpu::ValidationLog>();
-  gpu::ContextOptions options;
+  SessionOptions options;
   options.validation = true;
-  options.validation_log = log_;
-  ctx_ = std::make_unique<gpu::Context>(options);  // no device is a failure, never a skip
+  options.shader_dir = VKRAY_SHADER_DIR;
+  session_ = std::make_unique<Session>(options);  // no device is a failure, never a skip
 }
 
 void GpuTest::TearDown() {
-  ctx_.reset();
-  for (const auto& message : log_->messages()) ADD_FAILURE() << message;
+  try {
+    session_->close();
+  } catch (const Error& e) {
+    ADD_FAILURE() << e.what();
+  }
+  session_.reset();
+}
+
+Image GpuTest::render(const Scene& scene, const ImageSettings& image, RenderOptions options, bool cpu) {
+  options = with_image(std::move(options), image);
+  if (cpu) return render_on_cpu(scene, options).image;
+  return session().render(session().upload(std::make_shared<const Scene>(scene)), options).image;
 }
 
 }  // namespace vkray::test

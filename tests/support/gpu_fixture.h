@@ -1,12 +1,12 @@
-// A GoogleTest fixture for tests that use the device: validation on, and any validation message
-// (during the test or while the device is torn down) fails the test.
+// A GoogleTest fixture for tests that use the device: a session with the validation layer on, where
+// any validation message (during the test or while the device is torn down) fails the test.
 #pragma once
 
 #include <memory>
 
 #include <gtest/gtest.h>
 
-#include "gpu/context.h"
+#include "session/session.h"
 
 namespace vkray::test {
 
@@ -14,11 +14,15 @@ class GpuTest : public ::testing::Test {
  protected:
   void SetUp() override;
   void TearDown() override;
-  gpu::Context& ctx() { return *ctx_; }
+  Session& session() { return *session_; }
+  // The scene's image at `image`, rendered on the device or with the CPU reference.
+  Image render(const Scene& scene, const ImageSettings& image, RenderOptions options = {}, bool cpu = false);
 
  private:
-  std::shared_ptr<gpu::ValidationLog> log_;
-  std::unique_ptr<gpu::Context> ctx_;
+  std::unique_ptr<Session> session_;
 };
+
+// `options` with the image settings overridden by `image`.
+RenderOptions with_image(RenderOptions options, const ImageSettings& image);
 
 }  // namespace vkray::test

@@ -1,0 +1,80 @@
+#include "cli/flags.h"
+
+#include <map>
+
+#include "session/paths.h"
+
+namespace vkray::cli {
+
+const char* const kExitCodes =
+    "Exit codes:\n"
+    "  0  success\n"
+    "  1  bad input: scene, mesh or shader file, an output file that cannot be written, or an input past a\n"
+    "     limit (primitives, sizes, host memory, inotify watches)\n"
+    "  2  usage: unknown command or option, bad option value\n"
+    "  3  Vulkan or device failure (no device, failed call, timeout, validation message)\n"
+    "  4  parity: the GPU and CPU images differ beyond the documented tolerance\n"
+    "  70  internal error: a bug in vkray (please report it)\n"
+    "  130  interrupted by SIGINT (Ctrl-C) or SIGTERM; nothing was written\n";
+
+void add_scene_flags(CLI::App& command, SceneFlags& flags) {
+  command.add_option("scene", flags.scene, "Scene file (default: the Cornell box, scenes/cornell.json)");
+  command.add_option("--width", flags.width, "Image width in pixels (overrides the scene)")->check(CLI::Range(1u, kMaxImageSide));
+  command.add_option("--height", flags.height, "Image height in pixels (overrides the scene)")->check(CLI::Range(1u, kMaxImageSide));
+  command.add_option("--spp", flags.spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1u, kMaxSamplesPerPixel));
+}
+
+void add_device_flags(CLI::App& command, DeviceFlags& flags, bool validate) {
+  command.add_option("--device", flags.device, "Vulkan device: index or part of its name (see `vkray devices`)");
+  command.add_option("--shader-dir", flags.shader_dir, "Folder with trace.comp and its includes");
+  if (validate) command.add_flag("--validate", flags.validate, "Enable the Khronos validation layer; any message is an error");
+}
+
+void add_gpu_flags(CLI::App& command, GpuFlags& flags) {
+  command
+      .add_option("--tile-timeout", flags.tile_timeout_ms,
+                  "Longest one GPU submission (a tile) may run, in milliseconds, before the render fails with exit 3 "
+                  "(default 60000)")
+      ->check(CLI::Range(1, 3600000));
+  static const std::map<std::string, InlineScene> names{
+      {"auto", InlineScene::automatic}, {"always", InlineScene::always}, {"never", InlineScene::never}};
+  command
+      .add_option_function<std::string>(
+          "--inline-scene", [&flags](const std::string& name) { flags.inline_scene = names.at(name); },
+          "GPU path for scenes of at most 32 primitives: compile the scene into the shader (every primitive "
+          "tested, no BVH) 'always', 'never', or 'auto' (default: when the render has at least 2^20 camera "
+          "rays, so that the longer compile pays off)")
+      ->option_text("auto|always|never")
+      ->check(CLI::IsMember({"auto", "always", "never"}));
+}
+
+void add_cpu_flags(CLI::App& command, CpuFlags& flags, const std::string& description) {
+  command.add_option("--threads", flags.threads, description)->check(CLI::Range(1, 256));
+}
+
+std::filesystem::path scene_file(const SceneFlags& flags) { return flags.scene.empty() ? default_scene() : flags.scene; }
+
+SessionOptions session_options(const DeviceFlags& flags) {
+  SessionOptions options;
+  options.device = flags.device;
+  options.validation = flags.validate;
+  options.shader_dir = flags.shader_dir;
+  return options;
+}
+
+RenderOptions render_options(const SceneFlags* scene, const GpuFlags* gpu, const CpuFlags* cpu) {
+  RenderOptions options;
+  if (scene) {
+    options.width = scene->width;
+    options.height = scene->height;
+    options.samples_per_pixel = scene->spp;
+  }
+  if (gpu) {
+    options.tile_timeout = std::chrono::milliseconds(gpu->tile_timeout_ms);
+    options.inline_scene = gpu->inline_scene;
+  }
+  if (cpu) options.threads = cpu->threads;
+  return options;
+}
+
+}  // namespace vkray::cli

@@ -1,0 +1,58 @@
+#include "cli/report.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+
+#include "base/errors.h"
+#include "image/image.h"
+
+namespace vkray::cli {
+
+void check_output_path(const std::filesystem::path& output) {
+  if (!is_supported_image_path(output)) throw OutputError(output.string() + ": unknown image type (expected .png or .pfm)");
+  const auto dir = output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) throw OutputError(output.string() + ": folder " + dir.string() + " does not exist");
+}
+
+LoadedScene load_scene_file(const std::filesystem::path& file) {
+  const auto start = Clock::now();
+  LoadedScene loaded;
+  loaded.scene = std::make_shared<const Scene>(load_scene(file));
+  for (const auto& warning : loaded.scene->warnings) std::cerr << "vkray: warning: " << warning << "\n";
+  loaded.load_ms = ms_since(start);
+  return loaded;
+}
+
+std::string describe(const Scene& scene, const ImageSettings& image) {
+  return scene.file.string() + ": " + std::to_string(scene.triangles.size()) + " triangles, " +
+         std::to_string(scene.spheres.size()) + " spheres, " + std::to_string(scene.lights.size()) + " lights; " +
+         std::to_string(image.width) + "x" + std::to_string(image.height) + ", " +
+         std::to_string(image.samples_per_pixel) + " spp";
+}
+
+std::string format_rate(uint64_t rays, double seconds) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.2f Mrays/s", seconds > 0 ? double(rays) / seconds * 1e-6 : 0.0);
+  return buffer;
+}
+
+Progress::Progress(bool enabled, const char* what) : enabled_(enabled), tty_(isatty(STDERR_FILENO) == 1), what_(what) {}
+
+Progress::~Progress() {
+  if (shown_ && tty_) std::cerr << "\n";
+}
+
+void Progress::update(uint32_t done, uint32_t total, const char* unit) {
+  const double elapsed = ms_since(start_);
+  if (!enabled_ || elapsed < 1000.0 || (done == total && !shown_)) return;
+  if (!tty_ && elapsed - last_ < 1000.0 && done != total) return;
+  last_ = elapsed;
+  shown_ = true;
+  std::cerr << (tty_ ? "\r" : "") << "vkray: " << what_ << " " << (100 * uint64_t(done) / total) << "% (" << done << "/"
+            << total << " " << unit << ")" << (tty_ ? "" : "\n") << std::flush;
+}
+
+}  // namespace vkray::cli

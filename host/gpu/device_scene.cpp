@@ -1,0 +1,98 @@
+#include "gpu/device_scene.h"
+
+#include <algorithm>
+#include <chrono>
+#include <type_traits>
+#include <vector>
+
+#include "base/checked.h"
+#include "base/errors.h"
+#include "bvh/bvh.h"
+#include "gpu/buffer.h"
+#include "packing/inline_scene.h"
+#include "packing/scene_packing.h"
+#include "shared/types.h"
+
+namespace vkray::gpu {
+namespace {
+
+// A texel buffer and its view (RGBA32F for vec4 texels, RGBA32UI for uvec4); never empty (Vulkan
+// has no zero-sized buffers), the shader is told the real count.
+struct TexelBuffer {
+  Buffer buffer;
+  vk::raii::BufferView view{nullptr};
+};
+
+template <typename Texel>
+TexelBuffer make_texel_buffer(const Context& ctx, const std::vector<Texel>& texels, const char* what) {
+  static_assert(sizeof(Texel) == 16);
+  constexpr vk::Format format = std::is_same_v<Texel, glm::uvec4> ? vk::Format::eR32G32B32A32Uint : vk::Format::eR32G32B32A32Sfloat;
+  if (texels.size() > ctx.limits().maxTexelBufferElements)
+    throw DeviceError(std::string("scene too large for ") + ctx.device_name() + ": " + std::to_string(texels.size()) +
+                      " " + what + " texels, maxTexelBufferElements is " +
+                      std::to_string(ctx.limits().maxTexelBufferElements));
+  static const Texel placeholder(0);
+  const Texel* data = texels.empty() ? &placeholder : texels.data();
+  TexelBuffer t;
+  const vk::DeviceSize bytes = checked_mul(std::max<size_t>(texels.size(), 1), sizeof(Texel), what);
+  t.buffer = upload_buffer(ctx, data, bytes, vk::BufferUsageFlagBits::eUniformTexelBuffer);
+  t.view = vk::raii::BufferView(ctx.device(), vk::BufferViewCreateInfo({}, *t.buffer.buffer, format, 0, bytes));
+  return t;
+}
+
+// Refuses, before allocating anything, a scene whose buffers cannot fit the device's memory.
+void check_memory(const Context& ctx, const PackedScene& packed) {
+  uint64_t texels = packed.nodes.size();
+  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.materials, &packed.lights})
+    texels = checked_add(texels, buffer->size(), "scene buffers");
+  const uint64_t bytes = checked_mul(texels, sizeof(glm::vec4), "scene buffers");
+  const auto memory = ctx.physical_device().getMemoryProperties();
+  uint64_t largest_heap = 0;
+  for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
+    if (memory.memoryHeaps[h].flags & vk::MemoryHeapFlagBits::eDeviceLocal)
+      largest_heap = std::max<uint64_t>(largest_heap, memory.memoryHeaps[h].size);
+  if (bytes > largest_heap)
+    throw DeviceError("scene too large for " + ctx.device_name() + ": its buffers need " + std::to_string(bytes >> 20) +
+                      " MiB, the largest device-local memory heap has " + std::to_string(largest_heap >> 20) + " MiB");
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+struct GpuScene::Buffers {
+  TexelBuffer primitives, normals, nodes, materials, lights;
+};
+
+GpuScene::GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* prebuilt)
+    : ctx_(std::move(ctx)), scene_(std::move(scene)) {
+  const auto start = std::chrono::steady_clock::now();
+  Bvh built;
+  if (!prebuilt) built = build_bvh(primitive_boxes(*scene_));
+  const Bvh& bvh = prebuilt ? *prebuilt : built;
+  bvh_seconds_ = bvh.build_seconds;
+  primitive_count_ = uint32_t(bvh.order.size());
+  const PackedScene packed = pack_scene(*scene_, bvh);
+  if (primitive_count_ <= kMaxInlinePrimitives) inline_scene_ = inline_scene_glsl(packed);
+  check_memory(*ctx_, packed);
+  buffers_ = std::make_unique<Buffers>(Buffers{make_texel_buffer(*ctx_, packed.primitives, "primitive"),
+                                               make_texel_buffer(*ctx_, packed.normals, "normal"),
+                                               make_texel_buffer(*ctx_, packed.nodes, "BVH node"),
+                                               make_texel_buffer(*ctx_, packed.materials, "material"),
+                                               make_texel_buffer(*ctx_, packed.lights, "light")});
+  upload_seconds_ = seconds_since(start);
+}
+
+GpuScene::~GpuScene() = default;
+
+void GpuScene::bind(DescriptorWriter& writer) const {
+  writer.texel_buffer(VKRAY_BINDING_PRIMITIVES, *buffers_->primitives.view)
+      .texel_buffer(VKRAY_BINDING_NORMALS, *buffers_->normals.view)
+      .texel_buffer(VKRAY_BINDING_NODES, *buffers_->nodes.view)
+      .texel_buffer(VKRAY_BINDING_MATERIALS, *buffers_->materials.view)
+      .texel_buffer(VKRAY_BINDING_LIGHTS, *buffers_->lights.view);
+}
+
+}  // namespace vkray::gpu

@@ -1,0 +1,48 @@
+// A scene on the device: its BVH built, packed (host/packing/) and uploaded into texel buffers,
+// ready for any number of renders. It owns what it was built from and keeps its device alive, so
+// whoever holds it need not order it against anything else.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "gpu/context.h"
+#include "gpu/descriptors.h"
+#include "scene/scene.h"
+
+namespace vkray {
+struct Bvh;
+}
+
+namespace vkray::gpu {
+
+class GpuScene {
+ public:
+  // `bvh`: one already built for this scene (parity traverses the same one on the CPU); null builds
+  // one. Throws DeviceError naming the limit when a buffer or the whole does not fit the device.
+  GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* bvh = nullptr);
+  ~GpuScene();
+
+  const Scene& scene() const { return *scene_; }
+  // The code that compiles this scene into the shader (packing/inline_scene.h); empty for a scene
+  // with more than kMaxInlinePrimitives primitives, or none.
+  const std::string& inline_scene() const { return inline_scene_; }
+  uint32_t primitive_count() const { return primitive_count_; }
+  double bvh_seconds() const { return bvh_seconds_; }
+  double upload_seconds() const { return upload_seconds_; }  // BVH build included
+
+  // Adds the scene's buffers at their bindings (shared/types.h).
+  void bind(DescriptorWriter& writer) const;
+
+ private:
+  struct Buffers;
+  std::shared_ptr<const Context> ctx_;  // first: destroyed last
+  std::shared_ptr<const Scene> scene_;
+  std::unique_ptr<Buffers> buffers_;
+  uint32_t primitive_count_ = 0;
+  std::string inline_scene_;
+  double bvh_seconds_ = 0, upload_seconds_ = 0;
+};
+
+}  // namespace vkray::gpu

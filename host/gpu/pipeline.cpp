@@ -1,0 +1,81 @@
+#include "gpu/pipeline.h"
+
+#include "shared/types.h"
+
+namespace vkray::gpu {
+namespace {
+
+// Pipelines kept for scenes compiled in (`vkray watch` makes one for every edit of a small scene).
+constexpr size_t kKeptInlinePipelines = 4;
+
+constexpr vk::DescriptorType kTexel = vk::DescriptorType::eUniformTexelBuffer;
+
+// The descriptor set shaders/trace.comp declares (binding numbers from shared/types.h).
+constexpr BindingSlot kTraceBindings[] = {
+    {VKRAY_BINDING_FRAME, vk::DescriptorType::eUniformBuffer, "frame"},
+    {VKRAY_BINDING_PRIMITIVES, kTexel, "primitives"},
+    {VKRAY_BINDING_NORMALS, kTexel, "normals"},
+    {VKRAY_BINDING_NODES, kTexel, "nodes"},
+    {VKRAY_BINDING_MATERIALS, kTexel, "materials"},
+    {VKRAY_BINDING_LIGHTS, kTexel, "lights"},
+    {VKRAY_BINDING_OUTPUT, vk::DescriptorType::eStorageBuffer, "output"},
+};
+
+}  // namespace
+
+TracePipeline::TracePipeline(std::shared_ptr<const Context> ctx, std::filesystem::path shader_dir,
+                             CompiledShader shader, std::shared_ptr<const vk::raii::PipelineCache> cache)
+    : ctx_(std::move(ctx)),
+      cache_(std::move(cache)),
+      shader_dir_(std::move(shader_dir)),
+      shader_(std::move(shader)),
+      descriptors_(ctx_->device(), kTraceBindings) {
+  descriptors_.check(shader_, shader_dir_ / "trace.comp");
+  const vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, sizeof(TileConstants));
+  const vk::DescriptorSetLayout set_layout = *descriptors_.layout();
+  layout_ = vk::raii::PipelineLayout(ctx_->device(), vk::PipelineLayoutCreateInfo({}, set_layout, push));
+  module_ = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, shader_.spirv));
+}
+
+TracePipeline::~TracePipeline() = default;
+
+std::shared_ptr<const vk::raii::Pipeline> TracePipeline::pipeline(const ShaderVariant& variant) const {
+  const std::lock_guard lock(mutex_);
+  if (const auto found = pipelines_.find(variant); found != pipelines_.end()) return found->second;
+  auto created = create(variant);
+  if (!variant.inline_scene.empty()) {
+    inline_order_.push_back(variant);
+    if (inline_order_.size() > kKeptInlinePipelines) {  // a render still using it holds its own reference
+      pipelines_.erase(inline_order_.front());
+      inline_order_.pop_front();
+    }
+  }
+  return pipelines_.emplace(variant, std::move(created)).first->second;
+}
+
+bool TracePipeline::has_inline_variants() const {
+  const std::lock_guard lock(mutex_);
+  return !inline_order_.empty();
+}
+
+std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVariant& variant) const {
+  // A scene compiled in is a module of its own; the module may go once the pipeline exists.
+  vk::raii::ShaderModule inline_module{nullptr};
+  if (!variant.inline_scene.empty()) {
+    const CompiledShader shader =
+        compile_compute_shader(shader_dir_ / "trace.comp", {shader_dir_}, {{"inline_scene.glsl", variant.inline_scene}});
+    descriptors_.check(shader, shader_dir_ / "trace.comp");
+    inline_module = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, shader.spirv));
+  }
+  const vk::ShaderModule module = variant.inline_scene.empty() ? *module_ : *inline_module;
+  const VkBool32 constants[] = {variant.spheres, variant.shadows};
+  const vk::SpecializationMapEntry entries[] = {{VKRAY_SPEC_SPHERES, 0, sizeof(VkBool32)},
+                                                {VKRAY_SPEC_SHADOWS, sizeof(VkBool32), sizeof(VkBool32)}};
+  const vk::SpecializationInfo specialization(entries, vk::ArrayProxyNoTemporaries<const VkBool32>(constants));
+  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, module, "main", &specialization);
+  return std::make_shared<const vk::raii::Pipeline>(
+      ctx_->device(), cache_ ? vk::Optional<const vk::raii::PipelineCache>(*cache_) : nullptr,
+      vk::ComputePipelineCreateInfo({}, stage, *layout_));
+}
+
+}  // namespace vkray::gpu

@@ -1,0 +1,72 @@
+// The compute pipelines built from trace.comp: one descriptor table and pipeline layout, and a
+// pipeline per ShaderVariant, each compiled the first time a render needs it.
+#pragma once
+
+#include <compare>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan_raii.hpp>
+
+#include "gpu/context.h"
+#include "gpu/descriptors.h"
+#include "gpu/shader_compiler.h"
+
+namespace vkray::gpu {
+
+// What a render needs of the shader: specialization constants (shared/types.h), so that a
+// pipeline has no code for what the render cannot use (on llvmpipe code behind an `if` costs every
+// lane even when no lane takes it), and the scene's own code when it is compiled in.
+struct ShaderVariant {
+  bool spheres = true;       // VKRAY_SPEC_SPHERES
+  bool shadows = true;       // VKRAY_SPEC_SHADOWS
+  std::string inline_scene;  // served as shaders/inline_scene.glsl; empty: that file, and the BVH is walked
+
+  auto operator<=>(const ShaderVariant&) const = default;
+};
+
+class TracePipeline {
+ public:
+  // `shader`: shader_dir/trace.comp as compiled (compile_compute_shader); variants with a scene
+  // compiled in are compiled from shader_dir when first needed. `cache` (optional) makes
+  // re-creating a pipeline from SPIR-V seen before in this process cheap. Throws ShaderError when
+  // the shader declares its bindings otherwise than vkray binds them.
+  TracePipeline(std::shared_ptr<const Context> ctx, std::filesystem::path shader_dir, CompiledShader shader,
+                std::shared_ptr<const vk::raii::PipelineCache> cache = nullptr);
+  ~TracePipeline();
+
+  const DescriptorTable& descriptors() const { return descriptors_; }
+  const vk::raii::PipelineLayout& layout() const { return layout_; }
+  // trace.comp as compiled: the files it read, and its SPIR-V (a reload compares it).
+  const CompiledShader& shader() const { return shader_; }
+
+  // The pipeline for `variant`, compiled now if not kept from before. Throws ShaderError when the
+  // shaders do not compile with a scene's generated code (a shader folder whose traversal.glsl no
+  // longer fits the contract in inline_scene.glsl). The few most recent variants with a scene
+  // compiled in are kept.
+  std::shared_ptr<const vk::raii::Pipeline> pipeline(const ShaderVariant& variant) const;
+  // Whether a variant with a scene compiled in is kept (its SPIR-V is not `shader().spirv`).
+  bool has_inline_variants() const;
+
+ private:
+  std::shared_ptr<const vk::raii::Pipeline> create(const ShaderVariant& variant) const;
+
+  std::shared_ptr<const Context> ctx_;  // first: destroyed last
+  std::shared_ptr<const vk::raii::PipelineCache> cache_;
+  std::filesystem::path shader_dir_;
+  CompiledShader shader_;
+  DescriptorTable descriptors_;
+  vk::raii::PipelineLayout layout_{nullptr};
+  vk::raii::ShaderModule module_{nullptr};
+  mutable std::mutex mutex_;
+  mutable std::map<ShaderVariant, std::shared_ptr<const vk::raii::Pipeline>> pipelines_;
+  mutable std::deque<ShaderVariant> inline_order_;  // variants with a scene compiled in, oldest first
+};
+
+}  // namespace vkray::gpu

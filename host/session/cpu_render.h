@@ -1,0 +1,24 @@
+// Rendering with the CPU reference (host/cpu/reference.h) through the same options and result as
+// the GPU path, so that a face treats both renderers alike.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "scene/scene.h"
+#include "session/options.h"
+
+namespace vkray {
+struct Bvh;
+
+// Throws Cancelled when options.cancel asks (between rows), UsageError for an override out of range.
+// `bvh`: one already built for the scene; null builds one (its time is part of the trace).
+// `signatures`: where to put each pixel's record of what its samples saw (cpu/reference.h), for
+// parity's edge detection.
+RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, const Bvh* bvh = nullptr,
+                           std::vector<uint64_t>* signatures = nullptr);
+
+// The threads the CPU reference uses for `options`.
+unsigned cpu_threads(const RenderOptions& options);
+
+}  // namespace vkray

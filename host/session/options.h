@@ -1,0 +1,72 @@
+// What a caller asks of a render, whichever face it comes from (the command line's flags map onto
+// these in one place, host/cli/flags.cpp), and what a render reports back.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "image/image.h"
+#include "scene/scene.h"
+
+namespace vkray {
+
+// The device a session opens, and the shaders it compiles.
+struct SessionOptions {
+  std::string device;                // index or part of the name (`vkray devices`); empty: the best device
+  bool validation = false;           // the Khronos validation layer; any message it prints is an error
+  std::filesystem::path shader_dir;  // trace.comp and its includes; empty: the installed (or source) shaders
+};
+
+// How the GPU path traces a scene of at most kMaxInlinePrimitives primitives.
+enum class InlineScene {
+  automatic,  // compiled in when the render traces enough camera rays to repay the longer compile
+  always,     // compiled into the shader: every primitive tested with its coordinates as constants
+  never,      // the BVH
+};
+
+struct RenderOptions {
+  // Overrides of the scene file's image settings.
+  std::optional<uint32_t> width, height, samples_per_pixel;
+  // false: no shadow rays, every light counts as visible (benchmarks of camera rays alone).
+  bool shadows = true;
+  // GPU: how a small scene is traced; the longest one submission (a tile) may run; the tile side in
+  // pixels (0: chosen from the scene, so that a tile is a bounded amount of work).
+  InlineScene inline_scene = InlineScene::automatic;
+  std::chrono::milliseconds tile_timeout{60000};
+  uint32_t tile_side = 0;
+  // CPU reference: threads (0: one per hardware thread). The image does not depend on it.
+  unsigned threads = 0;
+  // Called as the render proceeds with the unit ("tiles" on the GPU, "rows" on the CPU), the units
+  // done and the units in all.
+  std::function<void(const char* unit, uint32_t done, uint32_t total)> progress;
+  // Asked between units; when it returns true the render stops with Cancelled, and nothing is left
+  // running.
+  std::function<bool()> cancel;
+};
+
+// The scene's image settings with the options' overrides. Throws UsageError for an override out of
+// the range a scene file may give (1 to 16384 pixels, 1 to 65536 samples).
+ImageSettings image_settings(const Scene& scene, const RenderOptions& options);
+
+struct RenderStats {
+  double bvh_seconds = 0;       // building the BVH (part of upload_seconds, when the render built it)
+  double compile_seconds = 0;   // pipelines compiled for this render
+  double upload_seconds = 0;    // the scene's buffers (when the render uploaded them) and the frame's
+  double trace_seconds = 0;
+  double readback_seconds = 0;
+  uint64_t rays = 0;            // camera rays + shadow rays
+  uint32_t tiles = 0;           // GPU submissions
+  unsigned threads = 0;         // CPU threads
+  bool inline_scene = false;    // the GPU traced code compiled from the scene, not the BVH
+};
+
+struct RenderResult {
+  Image image;  // linear radiance, top row first
+  RenderStats stats;
+};
+
+}  // namespace vkray

@@ -1,0 +1,27 @@
+// Parity: a scene rendered on the session's device and with the CPU reference, both traversing the
+// same BVH, and the two images compared against the tolerance (image/parity_metrics.h).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "image/parity_metrics.h"
+#include "session/options.h"
+#include "session/session.h"
+
+namespace vkray {
+
+struct ParityResult {
+  ImageSettings image;   // what both rendered
+  RenderResult gpu;
+  RenderResult cpu;      // the CPU reference
+  // Per pixel, what the reference's samples saw (cpu/reference.h): neighbours that differ mark an edge.
+  std::vector<uint64_t> signatures;
+  ParityTolerance tolerance;
+  ParityMetrics metrics;
+};
+
+ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scene> scene, const RenderOptions& options);
+
+}  // namespace vkray

@@ -1,0 +1,114 @@
+// vkray's library API, the one every face uses (the command line, and later the Python module and
+// the farm driver): a session opens a device and compiles the shaders once, uploads scenes, and
+// renders them with options, returning images. It owns the device, the pipelines and the
+// validation log, checks the log after every step, and keeps the timeout policy (gpu/renderer.h).
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gpu/device_info.h"
+#include "session/options.h"
+
+namespace vkray {
+struct Bvh;
+namespace gpu {
+class Context;
+class GpuScene;
+class Renderer;
+class TracePipeline;
+class ValidationLog;
+}  // namespace gpu
+
+// A scene on the device (its BVH built, its buffers uploaded), ready for any number of renders: a
+// handle that copies cheaply, owns its Scene and keeps the device alive, so it may be held as long
+// as the caller likes (but released before Session::close()).
+class DeviceScene {
+ public:
+  const Scene& scene() const;
+  double bvh_seconds() const;
+  double upload_seconds() const;  // BVH build included
+
+ private:
+  friend class Session;
+  explicit DeviceScene(std::shared_ptr<const gpu::GpuScene> scene) : scene_(std::move(scene)) {}
+  std::shared_ptr<const gpu::GpuScene> scene_;
+};
+
+class Session {
+ public:
+  // Opens the device. Throws DeviceError (no such device, the validation layer missing). The shaders
+  // are compiled by compile_shaders(), or by the first prepare() or render().
+  explicit Session(const SessionOptions& options);
+  // Releases the device without checking the validation log (close() checks it).
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  const std::string& device_name() const;
+  const std::string& driver_name() const;
+  std::string device_description() const;  // "name (driver)"
+  bool validation() const { return options_.validation; }
+  const std::filesystem::path& shader_dir() const { return shader_dir_; }
+
+  // ---- Shaders ----------------------------------------------------------------------------------
+  struct ShaderCompile {
+    double seconds;
+    bool pipelines_kept;  // the SPIR-V is the running one's: every pipeline compiled before stays
+  };
+  // Compiles shader_dir/trace.comp, again when it was compiled before (vkray watch). Throws
+  // ShaderError, and the shaders in use (if any) stay in use.
+  ShaderCompile compile_shaders();
+  bool has_shaders() const;
+  // trace.comp and every file it included, as last compiled; just trace.comp before that.
+  std::vector<std::filesystem::path> shader_sources() const;
+
+  // ---- Scenes -----------------------------------------------------------------------------------
+  // Builds the scene's BVH (or takes `bvh`, built for this scene) and uploads it.
+  DeviceScene upload(std::shared_ptr<const Scene> scene, const Bvh* bvh = nullptr);
+
+  // ---- Rendering --------------------------------------------------------------------------------
+  // Whether a render of `scene` with `options` traces code compiled from the scene, not the BVH.
+  bool compiles_scene_in(const DeviceScene& scene, const RenderOptions& options) const;
+  // Compiles now the pipeline a render of `scene` with `options` needs, so that a caller can time
+  // compiling apart from tracing; returns the seconds it took. Throws ShaderError.
+  double prepare(const DeviceScene& scene, const RenderOptions& options);
+  // Throws Cancelled, TimeoutError (a tile outlived options.tile_timeout), DeviceLostError,
+  // DeviceError, ShaderError, UsageError.
+  RenderResult render(const DeviceScene& scene, const RenderOptions& options);
+
+  // ---- Ending -----------------------------------------------------------------------------------
+  // Releases the device; nothing else may be called afterwards. Throws DeviceError when the
+  // validation layer reported anything, its report of objects left alive at teardown included.
+  // Every DeviceScene must be released first.
+  void close();
+
+  // The device itself, for tests that run kernels of their own on it.
+  const gpu::Context& context() const { return *ctx_; }
+
+ private:
+  // Throws DeviceError when the validation layer has reported anything since the last check.
+  void check_validation(const char* during);
+
+  SessionOptions options_;
+  std::filesystem::path shader_dir_;
+  std::shared_ptr<gpu::ValidationLog> validation_log_;  // outlives the device, whose teardown may report
+  size_t validation_seen_ = 0;
+  std::shared_ptr<const gpu::Context> ctx_;
+  struct Shaders;
+  std::unique_ptr<Shaders> shaders_;  // the pipeline cache and the current TracePipeline
+  std::unique_ptr<gpu::Renderer> renderer_;
+};
+
+// Whether a render that timed out left work running on a device, work the process will not wait
+// for: it must then end with std::_Exit, since exit handlers (the driver's own) could wait on it
+// without end.
+bool device_work_left_running();
+
+// Every Vulkan device the loader reports, in loader order (the index `SessionOptions::device` takes).
+using gpu::DeviceInfo;
+using gpu::list_devices;
+
+}  // namespace vkray
