@@ -26,8 +26,8 @@ void main() {
 
   // The samples as a do-while: llvmpipe runs a loop's body until no lane is left in it, so a loop
   // that tests its condition first runs the whole body once more, masked, after the last iteration
-  // (here a second camera ray's traversal and shading for every pixel at 1 sample; with the same
-  // in shade.glsl's light loop, 17% of the Cornell box's instructions). samples_per_pixel >= 1.
+  // (here a second camera ray's traversal and shading for every pixel; docs/design.md, "What the
+  // time goes to"). samples_per_pixel >= 1.
   vec3 sum = vec3(0.0);
   uint rays = 0u;
   uint k = 0u;

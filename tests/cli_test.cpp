@@ -267,6 +267,22 @@ TEST(CliTest, SigintDuringARenderExitsCleanlyAndWritesNothing) {
   EXPECT_FALSE(has_image_files(dir.path()));
 }
 
+TEST(CliTest, SigintDuringACpuRenderExitsCleanlyAndWritesNothing) {
+  // The CPU reference stops between rows as the GPU path stops between tiles.
+  TempDir dir;
+  ChildProcess child({VKRAY_EXECUTABLE, "render", kScenes + "/teapot.json", "--renderer", "cpu", "--width", "2048",
+                      "--height", "2048", "--spp", "16", "-o", "out.png"},
+                     dir.path().string());
+  ASSERT_TRUE(child.wait_for_line("CPU reference", std::chrono::seconds(60))) << child.all_output();
+  ASSERT_TRUE(child.wait_for_line("rows)", std::chrono::seconds(60))) << child.all_output();  // rendering now
+  child.signal(SIGINT);
+  const auto code = child.wait_exit(std::chrono::seconds(60));
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 130) << child.all_output();
+  EXPECT_NE(child.all_output().find("interrupted; no image written"), std::string::npos) << child.all_output();
+  EXPECT_FALSE(has_image_files(dir.path()));
+}
+
 TEST(CliTest, HelpDocumentsExitCodes) {
   TempDir dir;
   const Result run = vkray("render --help", dir.path());

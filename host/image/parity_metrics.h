@@ -10,7 +10,7 @@
 
 namespace vkray {
 
-// What may legitimately differ (README, "Parity"): a pixel whose samples straddle a silhouette or
+// What may legitimately differ (README, "Parity: GPU against the CPU reference"): a pixel whose samples straddle a silhouette or
 // shadow edge can flip, since GPU and CPU decide a ray that grazes an edge with different rounding.
 // Everywhere else the two agree to float precision, i.e. to within one step of 8-bit sRGB. The
 // edge allowance is a share of edge pixels, not of all pixels: edges are lines, so their share of

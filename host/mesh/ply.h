@@ -2,7 +2,7 @@
 //
 // Why not a library: the one Debian 12 packages, assimp 5.2.5, has known memory-safety bugs on
 // malformed PLY (upstream #4306, #5310, #5717, #5739, #6620), and fuzz_ply found five of them within
-// minutes (README, "Fuzzing"). PLY is a small format; this reader checks every count against the
+// minutes (docs/design.md, "Why vkray reads PLY itself"). PLY is a small format; this reader checks every count against the
 // bytes that are left before it reads or allocates anything.
 #pragma once
 

@@ -1,7 +1,7 @@
 // Small scenes compiled into the shader: GLSL that tests every primitive of a packed scene, with
-// the primitives' coordinates written as constants. On llvmpipe each BVH step of a small scene
-// costs as much as testing about a dozen triangles with constants (README, "Benchmark"), so below
-// a size the tracer can test them all instead of walking the hierarchy.
+// the primitives' coordinates written as constants. On llvmpipe one BVH step of a small scene costs
+// as much as testing about a dozen triangles with constants (docs/design.md, "Small scenes compiled
+// into the shader"), so below a size the tracer can test them all instead of walking the hierarchy.
 #pragma once
 
 #include <cstdint>
