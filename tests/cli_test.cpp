@@ -229,6 +229,7 @@ TEST(CliTest, BenchPrintsJsonForEachScene) {
   EXPECT_EQ(j[1].at("triangles"), 6322);
   EXPECT_EQ(j[0].at("gpu_path"), "bvh");  // 32 x 32: too few camera rays to compile the Cornell box in
   EXPECT_EQ(j[1].at("gpu_path"), "bvh");
+  EXPECT_EQ(j[0].at("vkray_version").get<std::string>().rfind("0.1.0 (", 0), 0u);  // a report names its build
   for (const char* mode : {"primary", "primary_shadow"}) {
     EXPECT_GT(j[0].at(mode).at("gpu_mrays").get<double>(), 0.0);
     EXPECT_GT(j[0].at(mode).at("cpu_reference_mrays").get<double>(), 0.0);
@@ -281,6 +282,14 @@ TEST(CliTest, SigintDuringACpuRenderExitsCleanlyAndWritesNothing) {
   EXPECT_EQ(*code, 130) << child.all_output();
   EXPECT_NE(child.all_output().find("interrupted; no image written"), std::string::npos) << child.all_output();
   EXPECT_FALSE(has_image_files(dir.path()));
+}
+
+TEST(CliTest, VersionNamesTheCommitItWasBuiltFrom) {
+  TempDir dir;
+  const Result run = vkray("--version", dir.path());
+  EXPECT_EQ(run.exit_code, 0);
+  EXPECT_EQ(run.out.rfind("vkray 0.1.0 (", 0), 0u) << run.out;
+  EXPECT_NE(run.out.find("commit"), std::string::npos) << run.out;
 }
 
 TEST(CliTest, HelpDocumentsExitCodes) {

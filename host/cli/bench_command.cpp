@@ -20,6 +20,7 @@
 #include "session/cpu_render.h"
 #include "session/paths.h"
 #include "session/session.h"
+#include "session/version.h"
 #ifdef VKRAY_HAVE_EMBREE
 #include "embree/embree_tracer.h"
 #endif
@@ -152,7 +153,7 @@ int run_bench(const BenchArgs& args) {
     for (const auto& r : results) {
       nlohmann::json j = {{"scene", r.name}, {"triangles", r.triangles}, {"width", args.width}, {"height", args.height},
                           {"bvh_build_ms", r.bvh_ms}, {"device", device}, {"threads", threads},
-                          {"gpu_path", r.inline_scene ? "inline" : "bvh"}};
+                          {"gpu_path", r.inline_scene ? "inline" : "bvh"}, {"vkray_version", version_string()}};
       for (int mode = 0; mode < 2; ++mode) {
         const std::string key = mode == 0 ? "primary" : "primary_shadow";
         nlohmann::json m = {{"gpu_mrays", median(r.rates[mode].gpu)}, {"gpu_trace_ms", r.gpu_frame_ms[mode]}};

@@ -11,6 +11,7 @@
 #include "cli/flags.h"
 #include "session/failure.h"
 #include "session/session.h"
+#include "session/version.h"
 
 namespace {
 
@@ -19,17 +20,17 @@ int run(int argc, char** argv) {
   CLI::App app("vkray: a raytracer on Vulkan compute shaders, with a headless renderer for any Vulkan device "
                "(lavapipe included).");
   app.footer(cli::kExitCodes);
+  app.set_version_flag("--version", std::string("vkray ") + version_string());
   app.require_subcommand(1);
   const std::vector<cli::Command> commands = {cli::add_render_command(app), cli::add_parity_command(app),
                                               cli::add_watch_command(app), cli::add_bench_command(app),
                                               cli::add_devices_command(app)};
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return kExitUsage;
+    // --help and --version are "errors" whose exit code is 0; CLI11's own codes for usage errors
+    // become the one documented code.
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
   try {
     for (const cli::Command& command : commands)

@@ -17,6 +17,7 @@
 #include "image/image.h"
 #include "session/parity.h"
 #include "session/session.h"
+#include "session/version.h"
 
 namespace vkray::cli {
 namespace {
@@ -59,6 +60,7 @@ nlohmann::json to_json(const ParityResult& r, const std::string& scene, const st
       {"worst_cpu", {worst_cpu.r, worst_cpu.g, worst_cpu.b}},
       {"tolerance", describe_tolerance(r.tolerance)},
       {"pass", m.pass},
+      {"vkray_version", version_string()},
   };
 }
 
