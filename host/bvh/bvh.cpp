@@ -6,6 +6,7 @@
 #include <numeric>
 #include <string>
 
+#include "base/check.h"
 #include "base/errors.h"
 
 namespace vkray {
@@ -52,6 +53,10 @@ class Builder {
   // into nodes[0]; other inner nodes are appended.
   uint32_t subtree(uint32_t begin, uint32_t end, const Aabb& box, uint32_t depth) {
     const uint32_t count = end - begin;
+    // The GPU's traversal stack is sized for kMaxDepth levels (VKRAY_TRAVERSAL_STACK): deeper would
+    // lose nodes silently there.
+    VKRAY_CHECK(depth < kMaxDepth, "the BVH grew deeper than the GPU's traversal stack holds");
+    VKRAY_CHECK(count >= 1, "the BVH builder made an empty subtree");
     bvh_.depth = std::max(bvh_.depth, depth);
     uint32_t mid = 0;
     if (count <= 2 || !split(begin, end, box, depth, mid)) {
