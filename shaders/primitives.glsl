@@ -25,7 +25,7 @@ Surface hit_surface(Hit hit, vec3 position) {
   vec4 a = texelFetch(primitives, base);
   uint flags = primitive_flags(a);
   Surface s;
-  s.albedo = texelFetch(materials, int(flags & VKRAY_PRIM_MATERIAL_MASK)).rgb;
+  s.albedo = texelFetch(materials, material_texel(flags)).rgb;
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     s.geometric_normal = (position - a.xyz) / sphere_radius(texelFetch(primitives, base + 1));
     s.shading_normal = s.geometric_normal;

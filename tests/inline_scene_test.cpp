@@ -1,4 +1,4 @@
-// The GLSL that compiles a small scene into the shader (gpu/inline_scene.h): every primitive tested
+// The GLSL that compiles a small scene into the shader (packing/inline_scene.h): every primitive tested
 // once, in the scene's order, with its place in the primitive buffer; every coordinate written so
 // that it reads back as exactly the same float; each distinct vertex sheared once.
 #include <bit>

@@ -1,4 +1,4 @@
-// The 4-wide, quantized BVH the shader reads (gpu/scene_packing.h): every primitive reachable once,
+// The 4-wide, quantized BVH the shader reads (packing/scene_packing.h): every primitive reachable once,
 // every decoded child box containing what is below it, and no more than two quantization steps
 // looser than it, whatever the scale and offset of the scene.
 #include <random>

@@ -1,7 +1,7 @@
 // Every error vkray raises, one type per kind of failure, and the process exit code of each kind.
-// The library throws only these (session/failure.h turns what a dependency throws into one of
-// them); each face maps them once: the command line to a message and exit_code(), the Python
-// module to its exception classes.
+// What a dependency throws through the library (Vulkan-Hpp's vk::SystemError, std::bad_alloc)
+// gets one of these kinds' exit codes in session/failure.h. Each face maps them once: the command
+// line to a message and an exit code, the Python module to its exception classes.
 #pragma once
 
 #include <stdexcept>

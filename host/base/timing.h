@@ -1,4 +1,4 @@
-// Wall-clock timing for the phase lines vkray prints.
+// Wall-clock timing: the phases a render reports, and the phase lines vkray prints.
 #pragma once
 
 #include <chrono>
@@ -11,6 +11,10 @@ using Clock = std::chrono::steady_clock;
 
 inline double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+inline double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 // "0.27 ms", "8.5 ms", "123 ms": about three significant digits.

@@ -1,6 +1,6 @@
 // A bounding volume hierarchy over the scene's primitives, built on the host with binned SAH and
 // binary nodes that hold both children's boxes. The CPU reference traverses it as it is; the GPU
-// path reads a 4-wide, quantized copy of it (gpu/scene_packing.h).
+// path reads a 4-wide, quantized copy of it (packing/scene_packing.h).
 #pragma once
 
 #include <cstdint>

@@ -199,8 +199,8 @@ Command add_bench_command(CLI::App& app) {
                "fixed scenes, alternately in one run. Prints a table (or --json); never fails on the numbers.");
   command->add_option("--scenes", args->scenes, "Scene names in scenes/ (default: cornell bunny dragon dragon-field)")
       ->delimiter(',');
-  command->add_option("--width", args->width, "Image width")->check(CLI::Range(8, 16384));
-  command->add_option("--height", args->height, "Image height")->check(CLI::Range(8, 16384));
+  command->add_option("--width", args->width, "Image width")->check(CLI::Range(8u, kMaxImageSide));
+  command->add_option("--height", args->height, "Image height")->check(CLI::Range(8u, kMaxImageSide));
   command->add_option("--repeat", args->repeat, "Rounds per scene; the median is reported")->check(CLI::Range(1, 100));
   add_cpu_flags(*command, args->cpu, "Threads for the CPU reference and Embree (default: one per hardware thread)");
   add_device_flags(*command, args->device, /*validate=*/false);

@@ -82,7 +82,8 @@ std::vector<std::filesystem::path> FileWatcher::wait(std::chrono::milliseconds s
     const int timeout = changed.empty() ? -1 : static_cast<int>(settle.count());
     const int ready = ::poll(fds, 2, timeout);
     if (ready < 0 && errno == EINTR) continue;
-    if (ready < 0) throw LimitError(std::string("cannot wait for file changes: poll: ") + std::strerror(errno));
+    if (ready < 0 && errno == ENOMEM) throw LimitError("cannot wait for file changes: poll: out of memory");
+    if (ready < 0) throw InternalError(std::string("cannot wait for file changes: poll: ") + std::strerror(errno));
     if (fds[1].revents & POLLIN) return {};
     if (ready == 0) return {changed.begin(), changed.end()};  // settled
     for (;;) {

@@ -5,7 +5,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
-#include <string_view>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -106,9 +106,16 @@ int run_parity(const ParityArgs& args) {
   Session session(session_options(args.device));
   const std::string device = session.device_description();
   log("device " + device + (args.device.validate ? ", validation on" : ""));
-  Progress tracing(!args.json, "tracing"), reference(!args.json, "CPU reference");
+  // One progress line per renderer, each from the moment that renderer starts.
+  std::optional<Progress> progress;
+  std::string stage;
   options.progress = [&](const char* unit, uint32_t done, uint32_t total) {
-    (std::string_view(unit) == "rows" ? reference : tracing).update(done, total, unit);
+    if (stage != unit) {
+      stage = unit;
+      progress.reset();
+      progress.emplace(!args.json, stage == "rows" ? "CPU reference" : "tracing");
+    }
+    progress->update(done, total, unit);
   };
   const ParityResult result = compare_with_reference(session, loaded.scene, options);
   session.close();

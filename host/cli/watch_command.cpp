@@ -108,14 +108,19 @@ std::string Watch::reload_scene() {
     scene_broken_ = false;
   } catch (const DeviceLostError&) {
     throw;
-  } catch (const Error&) {  // the scene, a mesh, a limit, or a scene too large for the device
+  } catch (const TimeoutError&) {  // a timed-out tile still runs: not the scene's fault
+    report(std::current_exception());
+    return "scene not uploaded while the device is busy";
+  } catch (...) {  // the scene, a mesh, a limit, a scene too large for the device
     report(std::current_exception());
     scene_broken_ = true;
     return "scene has errors";
   }
   try {
     if (session_->has_shaders()) prepare_pipeline();
-  } catch (const ShaderError&) {
+  } catch (const DeviceLostError&) {
+    throw;
+  } catch (...) {  // the shaders do not compile with the scene's generated code
     report(std::current_exception());
     shader_broken_ = true;
     return "scene " + format_ms(ms_since(start)) + ", shader has errors";
@@ -127,10 +132,13 @@ std::string Watch::compile_shaders() {
   try {
     const Session::ShaderCompile compiled = session_->compile_shaders();
     shader_broken_ = false;
-    if (compiled.pipelines_kept) return "compile " + format_ms(compiled.seconds * 1e3) + " (SPIR-V unchanged)";
+    // Also what the scene needs: its code compiled in, say, which follows the files as they are now.
     const double prepare_seconds = on_device_ ? prepare_pipeline() : 0.0;
-    return "compile " + format_ms((compiled.seconds + prepare_seconds) * 1e3);
-  } catch (const ShaderError&) {
+    return "compile " + format_ms((compiled.seconds + prepare_seconds) * 1e3) +
+           (compiled.spirv_changed ? "" : " (SPIR-V unchanged)");
+  } catch (const DeviceLostError&) {
+    throw;
+  } catch (...) {  // a compile error, a binding declared otherwise, a validation message
     report(std::current_exception());
     shader_broken_ = true;
     return "shader has errors";
@@ -156,7 +164,7 @@ std::string Watch::render(bool errors_reported) {
     throw;
   } catch (const DeviceLostError&) {
     throw;
-  } catch (const Error&) {  // a tile past its timeout (a shader that loops), a validation message, the output
+  } catch (...) {  // a tile past its timeout (a shader that loops), a validation message, the output
     report(std::current_exception());
     return "render failed; " + output_.string() + " is unchanged";
   }
@@ -217,7 +225,11 @@ int Watch::run() {
         }
       }
       std::cerr << "vkray: reload " << reload << " (" << names(changed) << " changed): " << line << "\n";
-      watch_current_files();
+      try {
+        watch_current_files();
+      } catch (const Error&) {  // a folder past the inotify limit: watching goes on without it
+        report(std::current_exception());
+      }
     }
   } catch (const Cancelled&) {
     // Stopped mid-render: the image on disk is the last complete one.

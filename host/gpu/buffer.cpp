@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cstring>
 
+#include "base/errors.h"
+
 namespace vkray::gpu {
 
 void Buffer::invalidate(const vk::raii::Device& device) const {
@@ -36,7 +38,7 @@ Buffer upload_buffer(const Context& ctx, const void* data, vk::DeviceSize size, 
   Buffer staging = create_buffer(ctx, size, vk::BufferUsageFlagBits::eTransferSrc, M::eHostVisible | M::eHostCoherent);
   std::memcpy(staging.mapped, data, size);
 
-  const vk::raii::CommandPool pool(ctx.device(), {vk::CommandPoolCreateFlagBits::eTransient, ctx.queue_family()});
+  vk::raii::CommandPool pool(ctx.device(), {vk::CommandPoolCreateFlagBits::eTransient, ctx.queue_family()});
   vk::raii::CommandBuffers cbs(ctx.device(), {*pool, vk::CommandBufferLevel::ePrimary, 1});
   const vk::raii::CommandBuffer& cb = cbs[0];
   cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
@@ -46,10 +48,23 @@ Buffer upload_buffer(const Context& ctx, const void* data, vk::DeviceSize size, 
                                   vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eUniformRead);
   cb.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader, {}, barrier, {}, {});
   cb.end();
-  const vk::raii::Fence fence(ctx.device(), vk::FenceCreateInfo{});
+  vk::raii::Fence fence(ctx.device(), vk::FenceCreateInfo{});
   const vk::CommandBuffer raw = *cb;
   ctx.queue().submit(vk::SubmitInfo({}, {}, raw), *fence);
-  ctx.wait(fence, std::chrono::seconds(60), "buffer upload");
+  try {
+    ctx.wait(fence, std::chrono::seconds(60), "a buffer upload");
+  } catch (const TimeoutError&) {
+    // The copy may still run: leave everything it uses to the process (Context::abandon_work()).
+    for (auto* buffer : {&staging, &target}) {
+      static_cast<void>(buffer->buffer.release());
+      static_cast<void>(buffer->memory.release());
+    }
+    for (auto& command_buffer : cbs) static_cast<void>(command_buffer.release());
+    static_cast<void>(pool.release());
+    static_cast<void>(fence.release());
+    ctx.abandon_work();
+    throw;
+  }
   return target;
 }
 

@@ -12,6 +12,8 @@ namespace {
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
+std::atomic<bool> g_work_left_running{false};
+
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   return s;
@@ -173,6 +175,22 @@ Context::Context(const ContextOptions& options) : log_(options.validation_log) {
   device_ = vk::raii::Device(physical_device_, vk::DeviceCreateInfo({}, queue_info));
   queue_ = vk::raii::Queue(device_, queue_family_, 0);
 }
+
+Context::~Context() {
+  if (!work_abandoned_) return;
+  // Work may still run on the device: leave the device (and the instance it belongs to) to the
+  // process instead of destroying them under it.
+  static_cast<void>(device_.release());
+  static_cast<void>(messenger_.release());
+  static_cast<void>(instance_.release());
+}
+
+void Context::abandon_work() const {
+  work_abandoned_ = true;
+  g_work_left_running = true;
+}
+
+bool work_left_running() { return g_work_left_running; }
 
 uint32_t Context::memory_type(uint32_t type_bits, vk::MemoryPropertyFlags required,
                               vk::MemoryPropertyFlags preferred) const {

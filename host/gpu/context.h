@@ -2,6 +2,7 @@
 // the validation layer's messages. Headless: no surface, no swapchain.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <mutex>
@@ -54,8 +55,15 @@ class Context {
   // Waits for a fence with a finite timeout; throws TimeoutError naming `what` on timeout.
   void wait(const vk::raii::Fence& fence, std::chrono::milliseconds timeout, const char* what) const;
 
+  // Says that work submitted to this device may still be running and will never be waited for
+  // (what it uses has been left alive). The device is then not destroyed with the Context, and the
+  // process must end with std::_Exit (work_left_running()).
+  void abandon_work() const;
+  ~Context();
+
  private:
   std::shared_ptr<ValidationLog> log_;
+  mutable std::atomic<bool> work_abandoned_{false};
   // Declaration order is destruction order reversed: the messenger outlives the device.
   vk::raii::Context context_;
   vk::raii::Instance instance_{nullptr};
@@ -67,5 +75,10 @@ class Context {
   vk::raii::Device device_{nullptr};
   vk::raii::Queue queue_{nullptr};
 };
+
+// Whether any Context of this process has abandoned work (Context::abandon_work()): exit handlers
+// (the driver's own among them) could wait on it without end, so the process must end with
+// std::_Exit.
+bool work_left_running();
 
 }  // namespace vkray::gpu

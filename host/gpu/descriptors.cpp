@@ -47,7 +47,10 @@ void DescriptorTable::check(const CompiledShader& shader, const std::filesystem:
   std::string problems;
   for (const ShaderBinding& declared : shader.bindings) {
     const BindingSlot* slot = find(declared.binding);
-    if (!slot) {
+    if (declared.set != 0) {
+      problems += entry.string() + ": error: '" + declared.name + "' is declared in descriptor set " +
+                  std::to_string(declared.set) + "; vkray binds set 0 only\n";
+    } else if (!slot) {
       std::string bound;
       for (const BindingSlot& s : slots_) bound += (bound.empty() ? "" : ", ") + std::to_string(s.binding) + " " + s.name;
       problems += entry.string() + ": error: '" + declared.name + "' is declared at binding " +
@@ -56,6 +59,10 @@ void DescriptorTable::check(const CompiledShader& shader, const std::filesystem:
       problems += entry.string() + ": error: '" + declared.name + "' at binding " + std::to_string(declared.binding) +
                   " is declared as " + (declared.type ? "a " + describe(*declared.type) : std::string("another kind of resource")) +
                   "; vkray binds a " + describe(slot->type) + " there (" + slot->name + ", shaders/shared/types.h)\n";
+    } else if (declared.count != 1) {
+      problems += entry.string() + ": error: '" + declared.name + "' at binding " + std::to_string(declared.binding) +
+                  " is an array of " + std::to_string(declared.count) + "; vkray binds one " + describe(slot->type) +
+                  " there\n";
     }
   }
   if (!problems.empty()) {

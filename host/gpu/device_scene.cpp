@@ -1,12 +1,12 @@
 #include "gpu/device_scene.h"
 
 #include <algorithm>
-#include <chrono>
 #include <type_traits>
 #include <vector>
 
 #include "base/checked.h"
 #include "base/errors.h"
+#include "base/timing.h"
 #include "bvh/bvh.h"
 #include "gpu/buffer.h"
 #include "packing/inline_scene.h"
@@ -56,10 +56,6 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
                       " MiB, the largest device-local memory heap has " + std::to_string(largest_heap >> 20) + " MiB");
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 }  // namespace
 
 struct GpuScene::Buffers {
@@ -68,7 +64,7 @@ struct GpuScene::Buffers {
 
 GpuScene::GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* prebuilt)
     : ctx_(std::move(ctx)), scene_(std::move(scene)) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   Bvh built;
   if (!prebuilt) built = build_bvh(primitive_boxes(*scene_));
   const Bvh& bvh = prebuilt ? *prebuilt : built;

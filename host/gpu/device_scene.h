@@ -25,6 +25,7 @@ class GpuScene {
   ~GpuScene();
 
   const Scene& scene() const { return *scene_; }
+  const Context& context() const { return *ctx_; }
   // The code that compiles this scene into the shader (packing/inline_scene.h); empty for a scene
   // with more than kMaxInlinePrimitives primitives, or none.
   const std::string& inline_scene() const { return inline_scene_; }

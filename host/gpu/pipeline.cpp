@@ -53,9 +53,10 @@ std::shared_ptr<const vk::raii::Pipeline> TracePipeline::pipeline(const ShaderVa
   return pipelines_.emplace(variant, std::move(created)).first->second;
 }
 
-bool TracePipeline::has_inline_variants() const {
+void TracePipeline::forget_inline_variants() const {
   const std::lock_guard lock(mutex_);
-  return !inline_order_.empty();
+  for (const ShaderVariant& variant : inline_order_) pipelines_.erase(variant);
+  inline_order_.clear();
 }
 
 std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVariant& variant) const {

@@ -51,8 +51,9 @@ class TracePipeline {
   // longer fits the contract in inline_scene.glsl). The few most recent variants with a scene
   // compiled in are kept.
   std::shared_ptr<const vk::raii::Pipeline> pipeline(const ShaderVariant& variant) const;
-  // Whether a variant with a scene compiled in is kept (its SPIR-V is not `shader().spirv`).
-  bool has_inline_variants() const;
+  // Drops the variants with a scene compiled in (their code comes from the shader files, which may
+  // have changed though this SPIR-V did not); a render that holds one keeps it.
+  void forget_inline_variants() const;
 
  private:
   std::shared_ptr<const vk::raii::Pipeline> create(const ShaderVariant& variant) const;

@@ -1,12 +1,12 @@
 #include "gpu/renderer.h"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cmath>
 
 #include "base/checked.h"
 #include "base/errors.h"
+#include "base/timing.h"
 #include "gpu/buffer.h"
 #include "packing/scene_packing.h"
 #include "shared/types.h"
@@ -14,15 +14,10 @@
 namespace vkray::gpu {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // One submission aims at about this many ray-primitive tests: a fraction of a second on lavapipe
 // with 2 cores, so no single submission runs long.
 constexpr double kTestsPerTile = double(1 << 26);
-
-std::atomic<bool> g_work_left_running{false};
 
 }  // namespace
 
@@ -51,7 +46,7 @@ Renderer::~Renderer() {
   // The device is still running a tile that timed out. Destroying what it uses (or the device)
   // could hang or crash the driver: leave all of it, and the Context it keeps alive, to the process.
   for (auto& frame : abandoned_) static_cast<void>(frame.release());
-  g_work_left_running = true;
+  ctx_->abandon_work();
 }
 
 bool Renderer::busy(std::chrono::milliseconds wait) {
@@ -155,8 +150,6 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   if (stats_out) *stats_out = stats;
   return result;
 }
-
-bool work_left_running() { return g_work_left_running; }
 
 uint32_t tile_side(const Scene& scene, const ImageSettings& image) {
   // With the BVH a ray visits on the order of log2(N) nodes and a few leaves.

@@ -43,7 +43,7 @@ class Renderer {
  public:
   explicit Renderer(std::shared_ptr<const Context> ctx);
   // Work of a timed-out render that is still running keeps what it uses: it is left to the process,
-  // never destroyed under the device (work_left_running() then says so).
+  // never destroyed under the device (Context::abandon_work()).
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -64,11 +64,6 @@ class Renderer {
   std::shared_ptr<const Context> ctx_;
   std::vector<std::unique_ptr<Frame>> abandoned_;  // frames whose last tile timed out
 };
-
-// Whether this process left work running on a device that it will not wait for. The process must
-// then end with std::_Exit: exit handlers (the driver's own among them) could wait on that work
-// without end.
-bool work_left_running();
 
 // Tile side in pixels (a multiple of the workgroup size) so that one submission stays near a fixed
 // budget of ray-primitive tests whatever the scene size and sample count.

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include <glslang/Include/Types.h>
 #include <glslang/Public/ResourceLimits.h>
 #include <glslang/Public/ShaderLang.h>
 #include <glslang/SPIRV/GlslangToSpv.h>
@@ -119,6 +120,14 @@ std::optional<vk::DescriptorType> descriptor_type(int gl_type) {
   }
 }
 
+// A resource as reflected: its set (0 when the shader gives none), binding and array size.
+ShaderBinding binding_of(const glslang::TObjectReflection& object, std::optional<vk::DescriptorType> type) {
+  const glslang::TType& t = *object.getType();
+  const uint32_t set = t.getQualifier().hasSet() ? t.getQualifier().layoutSet : 0;
+  const uint32_t count = t.isArray() ? uint32_t(std::max(1, t.getCumulativeArraySize())) : 1;
+  return {set, uint32_t(object.getBinding()), type, count, object.name};
+}
+
 // Every resource in a descriptor set that the linked program uses. Block members and push-constant
 // blocks have no binding and are left out.
 std::vector<ShaderBinding> reflect_bindings(glslang::TProgram& program) {
@@ -126,15 +135,15 @@ std::vector<ShaderBinding> reflect_bindings(glslang::TProgram& program) {
   std::vector<ShaderBinding> bindings;
   for (int i = 0; i < program.getNumUniformVariables(); ++i) {
     const glslang::TObjectReflection& u = program.getUniform(i);
-    if (u.getBinding() >= 0) bindings.push_back({uint32_t(u.getBinding()), descriptor_type(u.glDefineType), u.name});
+    if (u.getBinding() >= 0) bindings.push_back(binding_of(u, descriptor_type(u.glDefineType)));
   }
   for (int i = 0; i < program.getNumUniformBlocks(); ++i) {
     const glslang::TObjectReflection& b = program.getUniformBlock(i);
-    if (b.getBinding() >= 0) bindings.push_back({uint32_t(b.getBinding()), vk::DescriptorType::eUniformBuffer, b.name});
+    if (b.getBinding() >= 0) bindings.push_back(binding_of(b, vk::DescriptorType::eUniformBuffer));
   }
   for (int i = 0; i < program.getNumBufferBlocks(); ++i) {
     const glslang::TObjectReflection& b = program.getBufferBlock(i);
-    if (b.getBinding() >= 0) bindings.push_back({uint32_t(b.getBinding()), vk::DescriptorType::eStorageBuffer, b.name});
+    if (b.getBinding() >= 0) bindings.push_back(binding_of(b, vk::DescriptorType::eStorageBuffer));
   }
   return bindings;
 }

@@ -14,8 +14,10 @@ namespace vkray::gpu {
 // A resource the shader declares in a descriptor set (not its push constants), from glslang's
 // reflection of the code `main` uses.
 struct ShaderBinding {
+  uint32_t set;
   uint32_t binding;
   std::optional<vk::DescriptorType> type;  // none: a kind of resource vkray never binds (an image, a sampler)
+  uint32_t count;                          // descriptors: more than 1 for an array
   std::string name;
 };
 

@@ -167,7 +167,9 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
     packed.primitives.insert(packed.primitives.end(), {texels.a, texels.b, texels.c});
   }
   packed.nodes = pack_nodes(bvh);
-  for (const Material& m : scene.materials) packed.materials.emplace_back(m.albedo, 0.0f);
+  packed.materials.resize(scene.materials.size() * VKRAY_TEXELS_PER_MATERIAL);
+  for (size_t i = 0; i < scene.materials.size(); ++i)
+    packed.materials[i * VKRAY_TEXELS_PER_MATERIAL] = glm::vec4(scene.materials[i].albedo, 0.0f);
   packed.lights.resize(scene.lights.size() * VKRAY_TEXELS_PER_LIGHT);
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     packed.lights[i * VKRAY_TEXELS_PER_LIGHT + VKRAY_LIGHT_POSITION] = glm::vec4(scene.lights[i].position, 0.0f);

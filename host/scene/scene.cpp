@@ -318,16 +318,12 @@ void SceneParser::check_primitive_count(const Value& where, size_t adding) const
 }
 
 void SceneParser::add_triangles(const Value& where, std::vector<Triangle>& triangles) {
-  check_primitive_count(where, triangles.size());
-  size_t degenerate = 0;
-  for (const Triangle& t : triangles) {
-    if (glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f) {
-      ++degenerate;
-      continue;
-    }
-    scene_.triangles.push_back(t);
-  }
-  if (degenerate > 0) warn(where, std::to_string(degenerate) + " degenerate (zero-area) triangles left out");
+  const auto degenerate = [](const Triangle& t) { return glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f; };
+  const size_t left_out = size_t(std::count_if(triangles.begin(), triangles.end(), degenerate));
+  check_primitive_count(where, triangles.size() - left_out);
+  for (const Triangle& t : triangles)
+    if (!degenerate(t)) scene_.triangles.push_back(t);
+  if (left_out > 0) warn(where, std::to_string(left_out) + " degenerate (zero-area) triangles left out");
 }
 
 void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {

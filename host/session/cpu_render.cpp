@@ -23,7 +23,6 @@ RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, con
   cpu::ReferenceResult reference = cpu::render_reference(scene, image_settings(scene, options), reference_options);
   RenderResult result;
   result.image = std::move(reference.image);
-  result.stats.bvh_seconds = reference.bvh_seconds;
   result.stats.trace_seconds = reference.seconds;
   result.stats.rays = reference.rays;
   result.stats.threads = reference_options.threads;

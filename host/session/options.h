@@ -53,9 +53,7 @@ struct RenderOptions {
 ImageSettings image_settings(const Scene& scene, const RenderOptions& options);
 
 struct RenderStats {
-  double bvh_seconds = 0;       // building the BVH (part of upload_seconds, when the render built it)
-  double compile_seconds = 0;   // pipelines compiled for this render
-  double upload_seconds = 0;    // the scene's buffers (when the render uploaded them) and the frame's
+  double upload_seconds = 0;    // the frame's uniforms and output (a scene's own: DeviceScene)
   double trace_seconds = 0;
   double readback_seconds = 0;
   uint64_t rays = 0;            // camera rays + shadow rays

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "base/errors.h"
+#include "base/timing.h"
 #include "bvh/bvh.h"
 #include "gpu/context.h"
 #include "gpu/device_scene.h"
@@ -13,10 +14,6 @@
 
 namespace vkray {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // Runs `work` on the device, turning Vulkan-Hpp's report of a lost device into vkray's.
 template <typename Work>
@@ -40,10 +37,11 @@ struct Session::Shaders {
   // compiler (Mesa also keeps its own on-disk cache across processes).
   std::shared_ptr<const vk::raii::PipelineCache> cache;
   std::shared_ptr<const gpu::TracePipeline> pipeline;
+  std::vector<std::filesystem::path> sources;  // of the last compile that succeeded
 };
 
 Session::Session(const SessionOptions& options)
-    : options_(options), shader_dir_(options.shader_dir.empty() ? default_shader_dir() : options.shader_dir) {
+    : shader_dir_(options.shader_dir.empty() ? default_shader_dir() : options.shader_dir) {
   gpu::ContextOptions context_options;
   context_options.device = options.device;
   if (options.validation) validation_log_ = std::make_shared<gpu::ValidationLog>();
@@ -56,38 +54,51 @@ Session::Session(const SessionOptions& options)
 
 Session::~Session() = default;
 
-const std::string& Session::device_name() const { return ctx_->device_name(); }
-const std::string& Session::driver_name() const { return ctx_->driver_name(); }
+const gpu::Context& Session::device() const {
+  if (!ctx_) throw UsageError("the session is closed: its device is gone");
+  return *ctx_;
+}
+
+const std::string& Session::device_name() const { return device().device_name(); }
+const std::string& Session::driver_name() const { return device().driver_name(); }
 std::string Session::device_description() const { return device_name() + " (" + driver_name() + ")"; }
 
-bool Session::has_shaders() const { return shaders_->pipeline != nullptr; }
+bool Session::has_shaders() const { return ctx_ && shaders_->pipeline != nullptr; }
 
 std::vector<std::filesystem::path> Session::shader_sources() const {
   if (!has_shaders()) return {shader_dir_ / "trace.comp"};
-  return shaders_->pipeline->shader().sources;
+  return shaders_->sources;
 }
 
 Session::ShaderCompile Session::compile_shaders() {
+  device();
   const auto start = Clock::now();
   gpu::CompiledShader compiled = gpu::compile_compute_shader(shader_dir_ / "trace.comp", {shader_dir_});
-  // The same SPIR-V keeps every pipeline, unless one has a scene compiled in: its code comes from
-  // the shader files as they are now, which this SPIR-V (without a scene) says nothing about.
-  const bool kept = has_shaders() && compiled.spirv == shaders_->pipeline->shader().spirv &&
-                    !shaders_->pipeline->has_inline_variants();
-  if (!kept) {
+  std::vector<std::filesystem::path> sources = compiled.sources;
+  const bool changed = !has_shaders() || compiled.spirv != shaders_->pipeline->shader().spirv;
+  if (changed) {
     shaders_->pipeline = on_device([&] {
       return std::make_shared<const gpu::TracePipeline>(ctx_, shader_dir_, std::move(compiled), shaders_->cache);
     });
     check_validation("shader module creation");
+  } else {
+    // The same SPIR-V keeps its pipelines, but not those with a scene compiled in: their code
+    // comes from the shader files as they are now, which this SPIR-V (without a scene) does not show.
+    shaders_->pipeline->forget_inline_variants();
   }
-  return {seconds_since(start), kept};
+  shaders_->sources = std::move(sources);
+  return {seconds_since(start), changed};
 }
 
 const Scene& DeviceScene::scene() const { return scene_->scene(); }
-double DeviceScene::bvh_seconds() const { return scene_->bvh_seconds(); }
 double DeviceScene::upload_seconds() const { return scene_->upload_seconds(); }
 
 DeviceScene Session::upload(std::shared_ptr<const Scene> scene, const Bvh* bvh) {
+  device();
+  // An upload may go through the queue, behind a tile that timed out and still runs: refuse at
+  // once rather than wait behind it.
+  if (renderer_->busy(std::chrono::milliseconds(0)))
+    throw TimeoutError("the device is still running a render tile that timed out; the scene was not uploaded");
   DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::GpuScene>(ctx_, std::move(scene), bvh); }));
   check_validation("scene upload");
   return uploaded;
@@ -113,14 +124,20 @@ gpu::ShaderVariant shader_variant(const gpu::GpuScene& scene, const RenderOption
 
 }  // namespace
 
+const gpu::GpuScene& Session::own(const DeviceScene& scene) const {
+  if (&scene.scene_->context() != &device()) throw UsageError("a scene uploaded by another session");
+  return *scene.scene_;
+}
+
 bool Session::compiles_scene_in(const DeviceScene& scene, const RenderOptions& options) const {
-  return use_inline_scene(*scene.scene_, image_settings(scene.scene(), options), options.inline_scene);
+  return use_inline_scene(own(scene), image_settings(scene.scene(), options), options.inline_scene);
 }
 
 double Session::prepare(const DeviceScene& scene, const RenderOptions& options) {
+  const gpu::GpuScene& on_device_scene = own(scene);
   const auto start = Clock::now();
   if (!has_shaders()) compile_shaders();
-  on_device([&] { return shaders_->pipeline->pipeline(shader_variant(*scene.scene_, options)); });
+  on_device([&] { return shaders_->pipeline->pipeline(shader_variant(on_device_scene, options)); });
   check_validation("pipeline creation");
   return seconds_since(start);
 }
@@ -128,16 +145,15 @@ double Session::prepare(const DeviceScene& scene, const RenderOptions& options) 
 RenderResult Session::render(const DeviceScene& scene, const RenderOptions& options) {
   gpu::TraceRequest request;
   request.image = image_settings(scene.scene(), options);
-  request.variant = shader_variant(*scene.scene_, options);
+  request.variant = shader_variant(own(scene), options);
   request.tile_timeout = options.tile_timeout;
   request.tile_side = options.tile_side;
   if (options.progress)
     request.progress = [&options](uint32_t done, uint32_t total) { options.progress("tiles", done, total); };
   request.cancel = options.cancel;
-  RenderResult result;
-  result.stats.inline_scene = !request.variant.inline_scene.empty();
-  result.stats.compile_seconds = prepare(scene, options);  // nothing when prepared before
+  prepare(scene, options);  // nothing to do when prepared before
   gpu::TraceStats trace;
+  RenderResult result;
   result.image = on_device([&] { return renderer_->render(shaders_->pipeline, scene.scene_, request, &trace); });
   check_validation("render");
   result.stats.upload_seconds = trace.upload_seconds;
@@ -145,6 +161,7 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
   result.stats.readback_seconds = trace.readback_seconds;
   result.stats.rays = trace.rays;
   result.stats.tiles = trace.tiles;
+  result.stats.inline_scene = !request.variant.inline_scene.empty();
   return result;
 }
 
@@ -161,12 +178,14 @@ void Session::check_validation(const char* during) {
 void Session::close() {
   if (!ctx_) return;
   // Everything that keeps the device alive goes first, so that the device is destroyed here and the
-  // validation layer's report of what was left alive arrives before the check below.
+  // validation layer's report of what was left alive arrives before the check below. Work a
+  // timed-out tile left running keeps its part alive (gpu/renderer.h): the device stays then.
+  const bool work_left = renderer_->busy(std::chrono::milliseconds(0));
   renderer_.reset();
   shaders_.reset();
   const bool last = ctx_.use_count() == 1;
   ctx_.reset();
-  if (!last && !gpu::work_left_running())
+  if (!last && !work_left)
     throw InternalError("Session::close() while a DeviceScene is still held: the device outlives the session");
   check_validation("device teardown");
 }

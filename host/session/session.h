@@ -28,7 +28,6 @@ class ValidationLog;
 class DeviceScene {
  public:
   const Scene& scene() const;
-  double bvh_seconds() const;
   double upload_seconds() const;  // BVH build included
 
  private:
@@ -50,13 +49,13 @@ class Session {
   const std::string& device_name() const;
   const std::string& driver_name() const;
   std::string device_description() const;  // "name (driver)"
-  bool validation() const { return options_.validation; }
-  const std::filesystem::path& shader_dir() const { return shader_dir_; }
 
   // ---- Shaders ----------------------------------------------------------------------------------
   struct ShaderCompile {
     double seconds;
-    bool pipelines_kept;  // the SPIR-V is the running one's: every pipeline compiled before stays
+    // false: the SPIR-V is the running one's, and the pipelines compiled from it stay (those with a
+    // scene compiled in are compiled again when next needed, from the files as they are now).
+    bool spirv_changed;
   };
   // Compiles shader_dir/trace.comp, again when it was compiled before (vkray watch). Throws
   // ShaderError, and the shaders in use (if any) stay in use.
@@ -66,10 +65,11 @@ class Session {
   std::vector<std::filesystem::path> shader_sources() const;
 
   // ---- Scenes -----------------------------------------------------------------------------------
-  // Builds the scene's BVH (or takes `bvh`, built for this scene) and uploads it.
+  // Builds the scene's BVH (or takes `bvh`, built for this scene) and uploads it. Throws
+  // TimeoutError at once while a tile that timed out still runs on the device.
   DeviceScene upload(std::shared_ptr<const Scene> scene, const Bvh* bvh = nullptr);
 
-  // ---- Rendering --------------------------------------------------------------------------------
+  // ---- Rendering (of a scene uploaded by this session; another's is a UsageError) ----------------
   // Whether a render of `scene` with `options` traces code compiled from the scene, not the BVH.
   bool compiles_scene_in(const DeviceScene& scene, const RenderOptions& options) const;
   // Compiles now the pipeline a render of `scene` with `options` needs, so that a caller can time
@@ -80,19 +80,22 @@ class Session {
   RenderResult render(const DeviceScene& scene, const RenderOptions& options);
 
   // ---- Ending -----------------------------------------------------------------------------------
-  // Releases the device; nothing else may be called afterwards. Throws DeviceError when the
-  // validation layer reported anything, its report of objects left alive at teardown included.
-  // Every DeviceScene must be released first.
+  // Releases the device; afterwards every call but close() throws UsageError. Throws DeviceError
+  // when the validation layer reported anything, its report of objects left alive at teardown
+  // included. Every DeviceScene must be released first (InternalError otherwise).
   void close();
 
   // The device itself, for tests that run kernels of their own on it.
-  const gpu::Context& context() const { return *ctx_; }
+  const gpu::Context& context() const { return device(); }
 
  private:
+  // The device; UsageError once the session is closed.
+  const gpu::Context& device() const;
+  // `scene`'s buffers, when this session uploaded it.
+  const gpu::GpuScene& own(const DeviceScene& scene) const;
   // Throws DeviceError when the validation layer has reported anything since the last check.
   void check_validation(const char* during);
 
-  SessionOptions options_;
   std::filesystem::path shader_dir_;
   std::shared_ptr<gpu::ValidationLog> validation_log_;  // outlives the device, whose teardown may report
   size_t validation_seen_ = 0;

@@ -1,6 +1,6 @@
 // The scene buffers' texel layouts, as code both sides run: the host packs with the functions here
 // (host/packing/scene_packing.cpp) and the shader unpacks with them (shaders/traversal.glsl,
-// surface.glsl, shade.glsl), so a layout is written once and cannot drift between writer and reader.
+// primitives.glsl, shade.glsl), so a layout is written once and cannot drift between writer and reader.
 #ifndef VKRAY_SHARED_SCENE_LAYOUT_H
 #define VKRAY_SHARED_SCENE_LAYOUT_H
 
@@ -47,8 +47,11 @@ VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 // Vertex normals of smooth triangles: a second buffer in the same slots as the primitives, one
 // texel per vertex (xyz), present only when some triangle is smooth.
 
-// ---- Materials: one RGBA32F texel each, (albedo, 0) ----------------------------------------------------
+// ---- Materials: VKRAY_TEXELS_PER_MATERIAL RGBA32F texels each, (albedo, 0) -----------------------------
 #define VKRAY_TEXELS_PER_MATERIAL 1
+
+// The first texel of the material a primitive's flags name.
+VKRAY_INLINE int material_texel(uint flags) { return int(flags & VKRAY_PRIM_MATERIAL_MASK) * VKRAY_TEXELS_PER_MATERIAL; }
 
 // ---- Point lights: VKRAY_TEXELS_PER_LIGHT RGBA32F texels each ---------------------------------------
 #define VKRAY_TEXELS_PER_LIGHT 2

@@ -1,8 +1,8 @@
 // The interface between the C++ host and trace.comp: binding numbers, specialization constants,
 // workgroup size, and the uniform and push-constant structs, each written once for both languages
 // (the scene buffers' texel layouts are in scene_layout.h). The C++ side static_asserts every
-// member's std140 offset right here; gpu/bindings.h holds each binding's descriptor type, and the
-// shader's own declarations are checked against it when it is compiled.
+// member's std140 offset right here. The binding table in host/gpu/pipeline.cpp gives each binding
+// its descriptor type, and the shader's own declarations are checked against it when it is compiled.
 #ifndef VKRAY_SHARED_TYPES_H
 #define VKRAY_SHARED_TYPES_H
 
