@@ -12,7 +12,8 @@
 
 namespace vkray::test {
 
-ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::string& cwd) {
+ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::string& cwd,
+                           const std::vector<std::string>& env) {
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe2 failed");
   pid_ = fork();
@@ -23,6 +24,7 @@ ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::stri
     dup2(null, STDOUT_FILENO);
     dup2(null, STDIN_FILENO);
     if (chdir(cwd.c_str()) != 0) _exit(127);
+    for (const auto& variable : env) putenv(const_cast<char*>(variable.c_str()));
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
@@ -89,10 +91,10 @@ bool ChildProcess::running() {
   return true;
 }
 
-long ChildProcess::rss_kib() const {
+long ChildProcess::anon_rss_kib() const {
   std::ifstream status("/proc/" + std::to_string(pid_) + "/status");
   for (std::string line; std::getline(status, line);)
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+    if (line.rfind("RssAnon:", 0) == 0) return std::stol(line.substr(8));
   return -1;
 }
 

@@ -13,8 +13,9 @@ namespace vkray::test {
 
 class ChildProcess {
  public:
-  // Runs `argv` in `cwd`; stdout is discarded, stderr is captured.
-  ChildProcess(const std::vector<std::string>& argv, const std::string& cwd);
+  // Runs `argv` in `cwd` with `env` ("NAME=value") added to this process's environment; stdout is
+  // discarded, stderr is captured.
+  ChildProcess(const std::vector<std::string>& argv, const std::string& cwd, const std::vector<std::string>& env = {});
   ~ChildProcess();  // kills the process if it is still running
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
@@ -26,8 +27,9 @@ class ChildProcess {
   std::optional<int> wait_exit(std::chrono::milliseconds timeout);
   void signal(int sig) const;
   bool running();
-  // Resident set size in KiB, from /proc.
-  long rss_kib() const;
+  // Resident anonymous memory in KiB (RssAnon in /proc/PID/status): what the process allocated,
+  // without the pages of shared libraries it has touched so far.
+  long anon_rss_kib() const;
   const std::string& all_output() const { return output_; }
 
  private:
