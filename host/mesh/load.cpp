@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "base/errors.h"
+#include "base/input_file.h"
 #include "mesh/obj.h"
 #include "mesh/ply.h"
 
@@ -35,14 +34,9 @@ Mesh parse_mesh(std::string_view bytes, const std::filesystem::path& name) {
 }
 
 Mesh load_mesh(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec)) fail(file, "is a directory, not a mesh file");
-  if (!std::filesystem::is_regular_file(file, ec)) fail(file, "mesh file not found");
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (!in) fail(file, "cannot read mesh file");
-  return parse_mesh(bytes.str(), file);
+  const InputFile input = read_input_file(file, kMaxMeshFileBytes);
+  if (!input.error.empty()) fail(file, input.error == "not found" ? "mesh file not found" : input.error);
+  return parse_mesh(input.text, file);
 }
 
 }  // namespace vkray

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
-#include <fstream>
 #include <initializer_list>
 #include <limits>
 #include <map>
@@ -13,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/errors.h"
+#include "base/input_file.h"
 #include "mesh/load.h"
 #include "mesh/normals.h"
 #include "scene/transform.h"
@@ -440,14 +440,10 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& file)
 }
 
 Scene load_scene(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec)) throw SceneError(file.string() + ": is a directory, not a scene file");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneError(file.string() + ": cannot open scene file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw SceneError(file.string() + ": read error");
-  return parse_scene(text.str(), file);
+  if (file.empty()) throw SceneError("the scene file name is empty");
+  const InputFile input = read_input_file(file, kMaxSceneFileBytes);
+  if (!input.error.empty()) throw SceneError(file.string() + ": " + input.error);
+  return parse_scene(input.text, file);
 }
 
 }  // namespace vkray

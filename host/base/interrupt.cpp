@@ -1,0 +1,67 @@
+#include "base/interrupt.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <mutex>
+#include <vector>
+
+#include "base/errors.h"
+
+namespace vkray {
+namespace {
+
+std::atomic<bool> requested{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "request_interrupt() must be async-signal-safe");
+
+struct TemporaryFiles {
+  std::mutex mutex;
+  std::vector<std::filesystem::path> files;
+  bool closed = false;  // set by remove_temporary_files(): the process is about to end
+};
+TemporaryFiles& temporary_files() {
+  static TemporaryFiles* files = new TemporaryFiles;  // never destroyed: a forced exit may use it late
+  return *files;
+}
+
+}  // namespace
+
+void request_interrupt() noexcept { requested.store(true, std::memory_order_relaxed); }
+bool interrupt_requested() noexcept { return requested.load(std::memory_order_relaxed); }
+void clear_interrupt() noexcept { requested.store(false, std::memory_order_relaxed); }
+void throw_if_interrupted() {
+  if (interrupt_requested()) throw Cancelled();
+}
+
+void register_temporary_file(const std::filesystem::path& file) {
+  TemporaryFiles& t = temporary_files();
+  const std::lock_guard lock(t.mutex);
+  t.files.push_back(file);
+}
+
+void unregister_temporary_file(const std::filesystem::path& file) {
+  TemporaryFiles& t = temporary_files();
+  const std::lock_guard lock(t.mutex);
+  t.files.erase(std::remove(t.files.begin(), t.files.end(), file), t.files.end());
+}
+
+void commit_unless_interrupted(const std::filesystem::path& file, const std::function<void()>& commit) {
+  TemporaryFiles& t = temporary_files();
+  const std::lock_guard lock(t.mutex);
+  if (t.closed || interrupt_requested()) throw Cancelled();
+  commit();
+  t.files.erase(std::remove(t.files.begin(), t.files.end(), file), t.files.end());
+}
+
+void remove_temporary_files() noexcept {
+  TemporaryFiles& t = temporary_files();
+  // Held for good: no commit may start after this, and the process ends right after.
+  t.mutex.lock();
+  t.closed = true;
+  for (const auto& file : t.files) ::unlink(file.c_str());
+  t.files.clear();
+  t.mutex.unlock();
+}
+
+}  // namespace vkray

@@ -1,0 +1,33 @@
+// Ctrl-C and SIGTERM as the library sees them: one process-wide request to stop. A face turns the
+// process's signals into a request here (the command line in cli/stop_signals.h); every long loop
+// of the library (reading files, parsing meshes, building the BVH, packing, both renderers, writing
+// images) polls it and throws Cancelled, so whatever stage a signal arrives in ends within a
+// fraction of a second, unwinding normally and writing nothing.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+
+namespace vkray {
+
+// Async-signal-safe: a lock-free atomic store.
+void request_interrupt() noexcept;
+bool interrupt_requested() noexcept;
+// Forgets a request (a face that goes on after one, e.g. `vkray watch` ending a render).
+void clear_interrupt() noexcept;
+// Throws Cancelled when a stop was requested.
+void throw_if_interrupted();
+
+// ---- Files that must not outlive a forced exit -----------------------------------------------------
+// A temporary output registers itself while it exists. If a stage cannot stop in time and the face
+// ends the process without unwinding (cli/stop_signals.h), it first removes these files, so even
+// then nothing is left behind.
+void register_temporary_file(const std::filesystem::path& file);
+void unregister_temporary_file(const std::filesystem::path& file);
+// Runs `commit` (the rename of a temporary file into place) unless a stop was requested, and
+// unregisters `file`; atomic with respect to remove_temporary_files(). Throws Cancelled.
+void commit_unless_interrupted(const std::filesystem::path& file, const std::function<void()>& commit);
+// Removes every registered file and blocks later commits: the first step of a forced exit.
+void remove_temporary_files() noexcept;
+
+}  // namespace vkray
