@@ -1,6 +1,7 @@
 // The bad-input corpus (tests/bad-inputs/expectations.txt): every malformed or hostile scene or
 // mesh ends in exit code 1 (or 2), one line on stderr that names the file and the key, line or
-// element, and no output file. Odd but valid inputs (tests/odd-inputs/) render.
+// element, and no output file, the same on both renderers. Odd but valid inputs (tests/odd-inputs/)
+// render.
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -55,6 +56,12 @@ TEST_P(CorpusTest, FailsCleanlyNamingWhatIsWrong) {
   EXPECT_NE(lines[0].find(c.file), std::string::npos) << "the message must name the file: " << lines[0];
   EXPECT_NE(lines[0].find(c.expected), std::string::npos) << "expected \"" << c.expected << "\" in: " << lines[0];
   EXPECT_TRUE(std::filesystem::is_empty(out.path())) << "a failed render left a file behind";
+  // Both renderers take the same scenes: the CPU reference refuses this one with the same message.
+  const CommandResult cpu =
+      run_vkray("render --renderer cpu '" + c.file + "' -q -o '" + (out / "out.png").string() + "'", kCorpus);
+  EXPECT_EQ(cpu.exit_code, run.exit_code);
+  EXPECT_EQ(cpu.err, run.err);
+  EXPECT_TRUE(std::filesystem::is_empty(out.path())) << "a failed CPU render left a file behind";
 }
 
 INSTANTIATE_TEST_SUITE_P(BadInputs, CorpusTest, ::testing::ValuesIn(cases()),

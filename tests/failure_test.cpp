@@ -59,5 +59,25 @@ TEST(FailureTest, OversizedArithmeticIsAnInputError) {
   }
 }
 
+// User text reaches the terminal printable and short, whatever the file held: escape sequences,
+// newlines, bytes that are not UTF-8, megabytes of one line.
+TEST(FailureTest, MessagesArePrintableAndBrief) {
+  EXPECT_EQ(printable("caf\xc3\xa9 \x1b[31mred\n"), "caf\xc3\xa9 ?[31mred?");
+  EXPECT_EQ(printable("bad \xff\xc3 byte"), "bad ?? byte");
+  EXPECT_EQ(printable("\xc2\x9b C1 control"), "? C1 control");
+  EXPECT_EQ(printable(std::string(100, 'x'), 10), "xxxxxxxxxx...");
+  EXPECT_EQ(printable("ab\xc3\xa9", 3), "ab?...");  // never half a character
+
+  const Failure one = failure_of(SceneError("s.json: \x1b]0;title\x07" + std::string(5'000'000, 'x')));
+  EXPECT_LT(one.message.size(), 1100u);
+  EXPECT_EQ(one.message.find('\x1b'), std::string::npos);
+  std::string many_lines;
+  for (int i = 0; i < 10000; ++i) many_lines += "a.glsl:" + std::to_string(i) + ": error: \x1b[2J\n";
+  const Failure shader = failure_of(ShaderError(many_lines));
+  EXPECT_LT(shader.message.size(), 10000u);
+  EXPECT_EQ(shader.message.find('\x1b'), std::string::npos);
+  EXPECT_NE(shader.message.find("a.glsl:0: error: ?[2J\na.glsl:1: error:"), std::string::npos) << shader.message;
+}
+
 }  // namespace
 }  // namespace vkray

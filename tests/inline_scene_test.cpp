@@ -134,7 +134,7 @@ TEST(InlineSceneTest, AwkwardFloatsReadBackExactly) {
   // Literals glslang reads as doubles and rounds to float: 17 significant digits make that exact.
   Scene scene = cornell();
   scene.triangles.resize(1);
-  scene.triangles[0].v = {glm::vec3(0.1f, -1e-30f, 1e30f), glm::vec3(1.0f / 3.0f, 16777217.0f, -0.0f),
+  scene.triangles[0].v = {glm::vec3(0.1f, -1e-30f, std::nextafter(kMaxCoordinate, 0.0f)), glm::vec3(1.0f / 3.0f, 16777217.0f, -0.0f),
                           glm::vec3(1e-40f, 2.5f, std::nextafter(1.0f, 2.0f))};
   const Generated g = read_back(inline_scene_glsl(packed(scene)));
   ASSERT_EQ(g.tests.size(), 1u);

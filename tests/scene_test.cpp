@@ -8,6 +8,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "base/errors.h"
+#include "scene/json_document.h"
 #include "scene/scene.h"
 
 namespace vkray {
@@ -252,6 +253,61 @@ TEST(SceneTest, TransformErrors) {
                "/objects/0/transform", "not both");
   expect_error(with_camera(m + R"("objects": [)" + sphere + R"({"rotate": [0, 0]}}])"), "/objects/0/transform/rotate",
                "3 numbers");
+}
+
+// JSON as vkray reads it: nesting and duplicate keys are refused by their JSON pointer, and values
+// are quoted briefly. A deep document overflowed the stack while its error message was built.
+TEST(SceneTest, JsonNestingHasALimit) {
+  const auto nested = [](size_t levels) { return std::string(levels, '[') + std::string(levels, ']'); };
+  // "camera" and "position" take two levels: the array may nest 62 deep.
+  EXPECT_NO_THROW(parse_scene(with_camera("\"x\": " + nested(kMaxJsonDepth - 1)), "test.json"));  // a warning only
+  expect_error(with_camera("\"x\": " + nested(kMaxJsonDepth)), "test.json: /x/0/0", "nesting deeper than 64 levels");
+  expect_error(nested(1'000'000), "test.json: /0/0/0", "nesting deeper than 64 levels");
+  expect_error(std::string(1'000'000, '{'), "test.json:1:2:", "syntax error");
+}
+
+TEST(SceneTest, DuplicateKeysAreRefused) {
+  expect_error(with_camera(R"("image": {"width": 8, "width": 9})"), "test.json: /image: ", "the key \"width\" is given twice");
+  expect_error(with_camera(R"("objects": [1, [2, {"a": 1, "a": 2}]])"), "test.json: /objects/1/1: ", "\"a\" is given twice");
+  expect_error(R"({"camera": {}, "camera": {}})", "test.json: top level: ", "the key \"camera\" is given twice");
+  // The same key in different objects is fine.
+  EXPECT_NO_THROW(parse_scene(with_camera(R"("materials": {"a": {"albedo": [1, 1, 1]}, "b": {"albedo": [1, 1, 1]}})"), "test.json"));
+}
+
+TEST(SceneTest, ValuesAreQuotedBriefly) {
+  EXPECT_EQ(brief(nlohmann::json::parse("[1, 2, 3]")), "[1, 2, 3]");
+  EXPECT_EQ(brief(nlohmann::json("\u001b[31m")), "\"\\u001b[31m\"");
+  std::string long_array = "[1";
+  for (int i = 0; i < 100000; ++i) long_array += ", 1";
+  long_array += "]";
+  EXPECT_LE(brief(nlohmann::json::parse("[" + std::string(100, '[') + std::string(100, ']') + "]")).size(), 63u);
+  EXPECT_LE(brief(nlohmann::json::parse(long_array)).size(), 63u);
+}
+
+// Coordinates whose sums or products overflow a float, although each number is finite, are
+// refused at the key that makes them (README, "Limits"), before any renderer sees them.
+TEST(SceneTest, CoordinatesPastTheLimitAreRefused) {
+  const std::string material = R"("materials": {"m": {"albedo": [1, 1, 1]}}, )";
+  expect_error(with_camera(material + R"("objects": [{"type": "sphere", "center": [1e12, 0, 0], "radius": 1e6, "material": "m"}])"),
+               "/objects/0", "the sphere's bounding box has a coordinate of 1e+12");
+  EXPECT_NO_THROW(parse_scene(with_camera(material + R"("objects": [{"type": "sphere", "center": [5e11, 0, 0], "radius": 1, "material": "m"}])"), "t.json"));
+  expect_error(with_camera(material + R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m", "transform": {"scale": 2e12}}])"),
+               "/objects/0", "has a coordinate of 2e+12");
+  expect_error(with_camera(material + R"("objects": [{"type": "triangles", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [[0, 1, 2]], "material": "m", "transform": {"translate": [0, -3e38, 0], "scale": 3e38}}])"),
+               "/objects/0/indices", "triangle 0 (after the transform) has a coordinate of");
+  expect_error(with_camera(R"("lights": [{"type": "point", "position": [0, 0, 1e13], "intensity": [1, 1, 1]}])"),
+               "/lights/0/position", "the light has a coordinate of 1e+13");
+  // A tiny uniform scale is still a uniform scale; the radius it leaves must be positive.
+  expect_error(with_camera(material + R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1e-30, "material": "m", "transform": {"scale": 1e-30}}])"),
+               "/objects/0", "scales the sphere's radius to zero");
+}
+
+TEST(SceneTest, FocalLengthsThatOverflowAreRefused) {
+  const std::string camera = R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], )";
+  expect_error(camera + R"("focal_length": 3e38}})", "/camera/focal_length", "expected at most 1e6");
+  expect_error(camera + R"("vertical_fov": 1e-30}})", "/camera/vertical_fov", "field of view this narrow");
+  EXPECT_NO_THROW(parse_scene(camera + R"("focal_length": 1e6}})", "t.json"));
+  EXPECT_NO_THROW(parse_scene(camera + R"("vertical_fov": 1e-4}})", "t.json"));
 }
 
 }  // namespace

@@ -93,12 +93,29 @@ struct InternalError : Error {
   ExitCode exit_code() const override { return kExitInternal; }
 };
 
-// Text from a user's file, fit to quote in a one-line message: control and non-ASCII bytes become
-// '?', and long text is shortened.
-inline std::string printable(std::string_view text) {
+// Text from a user's file (or a message quoting it), fit to print on one line: control characters
+// (escape sequences, newlines) and bytes that are not UTF-8 become '?', and text past `max_length`
+// bytes is cut with "...". Valid UTF-8 (a name with accents) prints as it is.
+inline std::string printable(std::string_view text, size_t max_length = 60) {
   std::string out;
-  for (const char c : text.substr(0, 60)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
-  if (text.size() > 60) out += "...";
+  size_t i = 0;
+  while (i < text.size() && i < max_length) {
+    const auto byte = static_cast<unsigned char>(text[i]);
+    // The length of a well-formed UTF-8 sequence starting here (RFC 3629), or 0.
+    size_t length = byte < 0x80 ? 1 : byte >= 0xc2 && byte <= 0xdf ? 2 : byte >= 0xe0 && byte <= 0xef ? 3
+                  : byte >= 0xf0 && byte <= 0xf4 ? 4 : 0;
+    for (size_t k = 1; k < length; ++k)
+      if (i + k >= text.size() || (static_cast<unsigned char>(text[i + k]) & 0xc0) != 0x80) length = 0;
+    const bool control = byte < 0x20 || byte == 0x7f || (byte == 0xc2 && length == 2 && static_cast<unsigned char>(text[i + 1]) < 0xa0);
+    if (length == 0 || control || i + length > max_length) {
+      out += '?';
+      i += length ? length : 1;
+    } else {
+      out.append(text.substr(i, length));
+      i += length;
+    }
+  }
+  if (text.size() > max_length) out += "...";
   return out;
 }
 

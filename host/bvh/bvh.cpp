@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <numeric>
 #include <string>
 
@@ -19,6 +20,13 @@ constexpr uint32_t kSahDepth = 32;
 // SAH costs, relative to one primitive test.
 constexpr float kTraversalCost = 1.0f;
 constexpr float kIntersectionCost = 1.0f;
+
+// The bin of a centroid coordinate, always in [0, kBins): scale and lo are finite for the boxes
+// build_bvh() accepts, and a NaN (which cannot occur then) would still land in a valid bin.
+int bin_of(float coordinate, float lo, float scale) {
+  const float b = (coordinate - lo) * scale;
+  return b >= 0.0f ? int(std::min(b, float(kBins - 1))) : 0;
+}
 
 class Builder {
  public:
@@ -92,7 +100,7 @@ class Builder {
       std::array<uint32_t, kBins> bin_count{};
       for (uint32_t i = begin; i < end; ++i) {
         const uint32_t p = bvh_.order[i];
-        const int b = std::min(kBins - 1, int((centroids_[p][axis] - lo) * scale));
+        const int b = bin_of(centroids_[p][axis], lo, scale);
         bin_box[size_t(b)].grow(boxes_[p]);
         ++bin_count[size_t(b)];
       }
@@ -129,7 +137,7 @@ class Builder {
     const float scale = float(kBins) / (centroid_box.max[best_axis] - lo);
     const auto first = bvh_.order.begin() + begin, last = bvh_.order.begin() + end;
     const auto middle = std::partition(first, last, [&](uint32_t p) {
-      return std::min(kBins - 1, int((centroids_[p][best_axis] - lo) * scale)) <= best_bin;
+      return bin_of(centroids_[p][best_axis], lo, scale) <= best_bin;
     });
     mid = uint32_t(middle - bvh_.order.begin());
     return mid != begin && mid != end;
@@ -157,6 +165,13 @@ Bvh build_bvh(const std::vector<Aabb>& boxes) {
   if (boxes.size() > kMaxScenePrimitives)
     throw LimitError("too many primitives for the BVH: " + std::to_string(boxes.size()) + " (at most " +
                      std::to_string(kMaxScenePrimitives) + ")");
+  // The scene keeps every coordinate within kMaxCoordinate (scene/scene.h); a caller that does not
+  // would make the SAH's sums overflow. Refused here too, so no input reaches the arithmetic below.
+  for (size_t i = 0; i < boxes.size(); ++i)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!(boxes[i].min[axis] <= boxes[i].max[axis] && std::abs(boxes[i].min[axis]) <= kMaxCoordinate &&
+            std::abs(boxes[i].max[axis]) <= kMaxCoordinate))
+        throw LimitError("primitive " + std::to_string(i) + "'s bounds lie outside the coordinates vkray renders (+-1e12)");
   const auto start = std::chrono::steady_clock::now();
   Bvh bvh = Builder(boxes).build();
   bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

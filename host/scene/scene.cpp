@@ -3,18 +3,19 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <initializer_list>
 #include <limits>
 #include <map>
 #include <sstream>
 
 #include <glm/gtc/constants.hpp>
-#include <nlohmann/json.hpp>
 
 #include "base/errors.h"
 #include "base/input_file.h"
 #include "mesh/load.h"
 #include "mesh/normals.h"
+#include "scene/json_document.h"
 #include "scene/transform.h"
 
 namespace vkray {
@@ -22,13 +23,17 @@ namespace {
 
 using json = nlohmann::json;
 
+// The longest focal length, in image heights (a field of view of 5.7e-5 degrees). The camera ray's
+// direction (F * H, x, y) is normalized: F * H (at most 1.6e10) squared stays far inside a float.
+constexpr float kMaxFocalLength = 1e6f;
+
 
 // A JSON value together with its JSON-pointer path, so every message can say where it is.
 struct Value {
   const json& j;
   std::string path;  // "" is the document root
 
-  Value operator[](const std::string& key) const { return {j.at(key), path + "/" + key}; }
+  Value operator[](const std::string& key) const { return {j.at(key), path + "/" + printable(key)}; }
   Value operator[](size_t i) const { return {j.at(i), path + "/" + std::to_string(i)}; }
   bool has(const std::string& key) const { return j.contains(key); }
 };
@@ -44,7 +49,7 @@ class SceneParser {
     throw SceneError(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what);
   }
   void warn(const Value& v, const std::string& what) {
-    scene_.warnings.push_back(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what);
+    scene_.warnings.push_back(printable(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what, 500));
   }
 
   // ---- typed readers -----------------------------------------------------------------------------
@@ -82,21 +87,21 @@ class SceneParser {
   }
   float positive(const Value& v) const {
     const float f = number(v);
-    if (!(f > 0.0f)) fail(v, "expected a number > 0, got " + v.j.dump());
+    if (!(f > 0.0f)) fail(v, "expected a number > 0, got " + brief(v.j));
     return f;
   }
   uint32_t count(const Value& v, uint32_t max) const {
     if (!v.j.is_number_integer() || v.j.get<int64_t>() < 1 || v.j.get<int64_t>() > max)
-      fail(v, "expected an integer from 1 to " + std::to_string(max) + ", got " + v.j.dump());
+      fail(v, "expected an integer from 1 to " + std::to_string(max) + ", got " + brief(v.j));
     return static_cast<uint32_t>(v.j.get<int64_t>());
   }
   glm::vec3 vec3(const Value& v) const {
-    if (!v.j.is_array() || v.j.size() != 3) fail(v, "expected an array of 3 numbers, got " + v.j.dump());
+    if (!v.j.is_array() || v.j.size() != 3) fail(v, "expected an array of 3 numbers, got " + brief(v.j));
     return {number(v[0]), number(v[1]), number(v[2])};
   }
   glm::vec3 color(const Value& v) const {  // non-negative RGB
     const glm::vec3 c = vec3(v);
-    if (c.r < 0.0f || c.g < 0.0f || c.b < 0.0f) fail(v, "expected non-negative values, got " + v.j.dump());
+    if (c.r < 0.0f || c.g < 0.0f || c.b < 0.0f) fail(v, "expected non-negative values, got " + brief(v.j));
     return c;
   }
   std::string string(const Value& v) const {
@@ -115,6 +120,8 @@ class SceneParser {
   void parse_mesh(const Value& v, const glm::mat4& transform);
   // Appends triangles, leaving out zero-area ones (they have no normal and are never hit).
   void add_triangles(const Value& where, std::vector<Triangle>& triangles);
+  // Fails at `where` unless every coordinate of `p` lies within +-kMaxCoordinate (and so is finite).
+  void check_coordinates(const Value& where, const glm::vec3& p, const char* what) const;
   // Fails at `where` when `adding` more primitives would pass kMaxScenePrimitives.
   void check_primitive_count(const Value& where, size_t adding) const;
 
@@ -161,6 +168,7 @@ void SceneParser::parse_camera(const Value& v) {
   check_keys(v, {"position", "look_at", "direction", "up", "vertical_fov", "focal_length"});
   Camera& cam = scene_.camera;
   cam.position = vec3(require(v, "position"));
+  check_coordinates(v["position"], cam.position, "the camera");
 
   const bool by_target = one_of(v, "look_at", "direction");
   const Value aim = by_target ? v["look_at"] : v["direction"];
@@ -183,11 +191,16 @@ void SceneParser::parse_camera(const Value& v) {
 
   if (one_of(v, "vertical_fov", "focal_length")) {
     const float fov = number(v["vertical_fov"]);
-    if (!(fov > 0.0f && fov < 180.0f)) fail(v["vertical_fov"], "expected degrees in (0, 180), got " + v["vertical_fov"].j.dump());
+    if (!(fov > 0.0f && fov < 180.0f)) fail(v["vertical_fov"], "expected degrees in (0, 180), got " + brief(v["vertical_fov"].j));
     // F = (H/2) / tan(fov/2) pixels = focal_length * H.
     cam.focal_length = 0.5f / std::tan(glm::radians(fov) * 0.5f);
+    if (!(cam.focal_length <= kMaxFocalLength))
+      fail(v["vertical_fov"], "a field of view this narrow has a focal length past 1e6 image heights; "
+                              "the smallest vkray renders is 6e-5 degrees");
   } else {
     cam.focal_length = positive(v["focal_length"]);
+    if (!(cam.focal_length <= kMaxFocalLength))
+      fail(v["focal_length"], "expected at most 1e6 (image heights), got " + brief(v["focal_length"].j));
   }
 }
 
@@ -208,7 +221,7 @@ void SceneParser::parse_materials(const Value& v) {
 uint32_t SceneParser::material_ref(const Value& v) const {
   const std::string name = string(v);
   const auto it = material_index_.find(name);
-  if (it == material_index_.end()) fail(v, "undefined material \"" + name + "\"");
+  if (it == material_index_.end()) fail(v, "undefined material \"" + printable(name) + "\"");
   return it->second;
 }
 
@@ -216,9 +229,10 @@ void SceneParser::parse_light(const Value& v) {
   expect_object(v);
   check_keys(v, {"type", "position", "intensity", "power"});
   const Value type = require(v, "type");
-  if (string(type) != "point") fail(type, "unknown light type " + type.j.dump() + " (expected \"point\")");
+  if (string(type) != "point") fail(type, "unknown light type " + brief(type.j) + " (expected \"point\")");
   PointLight light;
   light.position = vec3(require(v, "position"));
+  check_coordinates(v["position"], light.position, "the light");
   if (one_of(v, "intensity", "power")) {
     light.intensity = color(v["intensity"]);
   } else {
@@ -272,6 +286,8 @@ void SceneParser::parse_object(const Value& v) {
       sphere.center = transform_point(transform, sphere.center);
       sphere.radius *= *s;
     }
+    if (!(sphere.radius > 0.0f)) fail(v, "the transform scales the sphere's radius to zero");
+    check_coordinates(v, glm::abs(sphere.center) + sphere.radius, "the sphere's bounding box");
     check_primitive_count(v, 1);
     scene_.spheres.push_back(sphere);
   } else if (type == "triangles") {
@@ -288,14 +304,14 @@ void SceneParser::parse_object(const Value& v) {
     triangles.reserve(indices.j.size());
     for (size_t i = 0; i < indices.j.size(); ++i) {
       const Value tri = indices[i];
-      if (!tri.j.is_array() || tri.j.size() != 3) fail(tri, "expected an array of 3 vertex indices, got " + tri.j.dump());
+      if (!tri.j.is_array() || tri.j.size() != 3) fail(tri, "expected an array of 3 vertex indices, got " + brief(tri.j));
       Triangle t;
       t.material = material;
       for (size_t k = 0; k < 3; ++k) {
         const Value idx = tri[k];
         if (!idx.j.is_number_integer() || idx.j.get<int64_t>() < 0 ||
             idx.j.get<int64_t>() >= static_cast<int64_t>(points.size()))
-          fail(idx, "vertex index " + idx.j.dump() + " is out of range (the object has " +
+          fail(idx, "vertex index " + brief(idx.j) + " is out of range (the object has " +
                         std::to_string(points.size()) + " positions)");
         t.v[k] = points[idx.j.get<size_t>()];
       }
@@ -306,8 +322,18 @@ void SceneParser::parse_object(const Value& v) {
     check_keys(v, {"type", "file", "material", "transform", "smooth"});
     parse_mesh(v, transform);
   } else {
-    fail(type_value, "unknown object type \"" + type + "\" (expected \"sphere\", \"triangles\" or \"mesh\")");
+    fail(type_value, "unknown object type \"" + printable(type) + "\" (expected \"sphere\", \"triangles\" or \"mesh\")");
   }
+}
+
+void SceneParser::check_coordinates(const Value& where, const glm::vec3& p, const char* what) const {
+  for (int c = 0; c < 3; ++c)
+    if (!(std::abs(p[c]) <= kMaxCoordinate)) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", double(p[c]));
+      fail(where, std::string(what) + " has a coordinate of " + value +
+                      "; vkray renders world-space coordinates within +-1e12 (README, \"Limits\")");
+    }
 }
 
 void SceneParser::check_primitive_count(const Value& where, size_t adding) const {
@@ -318,6 +344,9 @@ void SceneParser::check_primitive_count(const Value& where, size_t adding) const
 }
 
 void SceneParser::add_triangles(const Value& where, std::vector<Triangle>& triangles) {
+  for (size_t i = 0; i < triangles.size(); ++i)
+    for (const glm::vec3& p : triangles[i].v)
+      check_coordinates(where, p, ("triangle " + std::to_string(i) + " (after the transform)").c_str());
   const auto degenerate = [](const Triangle& t) { return glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f; };
   const size_t left_out = size_t(std::count_if(triangles.begin(), triangles.end(), degenerate));
   check_primitive_count(where, triangles.size() - left_out);
@@ -379,13 +408,6 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
   add_triangles(file_value, triangles);
 }
 
-// "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error ..." -> "syntax error ..."
-std::string strip_json_prefix(const std::string& what) {
-  const auto column = what.find("column ");
-  const auto colon = what.find(": ", column == std::string::npos ? 0 : column);
-  return colon == std::string::npos ? what : what.substr(colon + 2);
-}
-
 }  // namespace
 
 float Scene::extent() const {
@@ -400,38 +422,7 @@ float Scene::extent() const {
 }
 
 Scene parse_scene(std::string_view json_text, const std::filesystem::path& file) {
-  json root;
-  try {
-    root = json::parse(json_text, /*callback=*/nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& e) {
-    // e.byte is the 1-based offset of the character where parsing stopped.
-    const size_t end = std::min<size_t>(e.byte == 0 ? 0 : e.byte - 1, json_text.size());
-    const auto prefix = json_text.substr(0, end);
-    const size_t line = 1 + static_cast<size_t>(std::count(prefix.begin(), prefix.end(), '\n'));
-    const auto last_newline = prefix.rfind('\n');
-    const size_t column = end - (last_newline == std::string_view::npos ? 0 : last_newline + 1) + 1;
-    throw SceneError(file.string() + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
-                     strip_json_prefix(e.what()));
-  } catch (const json::exception& e) {
-    // A number too large for a double ("number overflow parsing '1e400'"): no position is given,
-    // so point at the number's first occurrence.
-    std::string message = e.what();
-    const auto bracket = message.find("] ");
-    if (bracket != std::string::npos) message = message.substr(bracket + 2);
-    std::string where = file.string();
-    const auto quote = message.find('\'');
-    if (quote != std::string::npos) {
-      const auto end = message.find('\'', quote + 1);
-      const auto at = json_text.find(message.substr(quote + 1, end - quote - 1));
-      if (at != std::string_view::npos) {
-        const auto prefix = json_text.substr(0, at);
-        const size_t line = 1 + static_cast<size_t>(std::count(prefix.begin(), prefix.end(), '\n'));
-        const auto newline = prefix.rfind('\n');
-        where += ":" + std::to_string(line) + ":" + std::to_string(at - (newline == std::string_view::npos ? 0 : newline + 1) + 1);
-      }
-    }
-    throw SceneError(where + ": " + message);
-  }
+  const json root = parse_json_document(json_text, file);
   Scene scene;
   scene.file = file;
   scene.name = file.stem().string();

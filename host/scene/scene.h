@@ -20,6 +20,13 @@ namespace vkray {
 constexpr uint32_t kMaxImageSide = 16384;
 constexpr uint32_t kMaxSamplesPerPixel = 65536;
 
+// Every world-space coordinate (after transforms) lies within +-kMaxCoordinate, and so do the
+// camera and the lights. The intersection math multiplies up to three coordinate differences (a
+// triangle's 3x3 determinant): (2e12)^3 = 8e36 stays below FLT_MAX (3.4e38), so no sum or product
+// in the BVH builder or either renderer can overflow. A scene past it is refused at load, the same
+// for both renderers.
+constexpr float kMaxCoordinate = 1e12f;
+
 // A scene holds at most this many primitives (triangles and spheres together): a BVH leaf names its
 // first primitive in 27 bits (bvh/bvh.h checks that the two agree).
 constexpr size_t kMaxScenePrimitives = (size_t(1) << 27) - 1;

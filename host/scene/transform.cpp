@@ -26,18 +26,20 @@ glm::mat4 matrix_from_row_major(const float (&m)[16]) {
 glm::vec3 transform_point(const glm::mat4& m, glm::vec3 p) { return glm::vec3(m * glm::vec4(p, 1.0f)); }
 
 std::optional<float> uniform_scale_of(const glm::mat4& m) {
-  const glm::mat3 linear(m);
-  const float s = glm::length(linear[0]);
-  if (!(s > 0.0f)) return std::nullopt;
+  // In double: squared lengths of float columns neither overflow nor underflow there (a scale of
+  // 1e-30 or 1e30 is still a uniform scale; whether its result is too large is the scene's check).
+  const glm::dmat3 linear{glm::mat3(m)};
+  const double s = glm::length(linear[0]);
+  if (!(s > 0.0)) return std::nullopt;
   // Columns of s * R are orthogonal and all of length s. Tolerance: a few float ulps of rounding in
   // matrices written with 6-7 significant digits.
-  constexpr float kTolerance = 1e-5f;
+  constexpr double kTolerance = 1e-5;
   for (int i = 0; i < 3; ++i) {
     if (std::abs(glm::length(linear[i]) - s) > kTolerance * s) return std::nullopt;
     for (int j = i + 1; j < 3; ++j)
       if (std::abs(glm::dot(linear[i], linear[j])) > kTolerance * s * s) return std::nullopt;
   }
-  return s;
+  return static_cast<float>(s);
 }
 
 }  // namespace vkray

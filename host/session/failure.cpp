@@ -1,12 +1,39 @@
 #include "session/failure.h"
 
+#include <algorithm>
 #include <new>
+#include <string_view>
 
 #include <vulkan/vulkan_raii.hpp>
 
 namespace vkray {
 
-Failure describe_failure(const std::exception_ptr& error) {
+namespace {
+
+// Messages quote file names and text from the user's files: whatever a file held, what reaches a
+// terminal is printable and of a readable length.
+constexpr size_t kMaxLineLength = 1000;
+constexpr size_t kMaxLines = 100;
+
+Failure fit_to_print(Failure failure) {
+  if (!failure.multiline) {
+    failure.message = printable(failure.message, kMaxLineLength);
+    return failure;
+  }
+  std::string fitted;
+  size_t lines = 0, at = 0;
+  for (; at < failure.message.size() && lines < kMaxLines; ++lines) {
+    const size_t end = std::min(failure.message.find('\n', at), failure.message.size());
+    if (lines > 0) fitted += '\n';
+    fitted += printable(std::string_view(failure.message).substr(at, end - at), kMaxLineLength);
+    at = end + 1;
+  }
+  if (at < failure.message.size()) fitted += "\n... (more lines left out)";
+  failure.message = fitted;
+  return failure;
+}
+
+Failure classify(const std::exception_ptr& error) {
   try {
     std::rethrow_exception(error);
   } catch (const Cancelled& e) {
@@ -30,5 +57,9 @@ Failure describe_failure(const std::exception_ptr& error) {
     return {kExitInternal, "internal error (a bug in vkray; please report it)", "an unknown exception", false};
   }
 }
+
+}  // namespace
+
+Failure describe_failure(const std::exception_ptr& error) { return fit_to_print(classify(error)); }
 
 }  // namespace vkray
