@@ -1,5 +1,7 @@
 // Mesh files: the real test meshes, triangulation, smooth normals, and every way a file can be wrong.
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -77,7 +79,7 @@ TEST_F(MeshFileTest, Errors) {
   std::filesystem::create_directory(dir_ / "folder.obj");
   expect_mesh_error(dir_ / "folder.obj", "is a directory");
   expect_mesh_error(write("mesh.stl", "solid x\n"), "unknown mesh format \".stl\"");
-  expect_mesh_error(write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n"), "face 2: vertex index out of range");
+  expect_mesh_error(write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n"), "range.obj:5: face 2: vertex index 9 is out of range");
   expect_mesh_error(write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), "nan.obj:2: vertex coordinate \"nan\"");
   expect_mesh_error(write("word.obj", "v 0 0 0\nv 1 0 0\nv 0 abc 0\nf 1 2 3\n"), "word.obj:3:");
   expect_mesh_error(write("huge.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n"), "huge.obj:2:");
@@ -93,6 +95,89 @@ TEST_F(MeshFileTest, Errors) {
   std::string bytes((std::istreambuf_iterator<char>(in)), {});
   expect_mesh_error(write("cut.ply", bytes.substr(0, bytes.size() / 2)), "cut.ply");
   expect_mesh_error(write("garbage.ply", std::string("ply\n\x01\x02\xff garbage", 15)), "garbage.ply");
+}
+
+// The fan of a convex polygon covers it exactly: its triangles' areas add up to the polygon's.
+TEST_F(MeshFileTest, AFaceOfThreeHundredCornersIsSplitIntoAFanCoveringIt) {
+  constexpr int kCorners = 300;
+  const double pi = std::acos(-1.0);
+  std::string text, face = "f";
+  for (int i = 0; i < kCorners; ++i) {
+    const double a = 2 * pi * i / kCorners;
+    char vertex[64];
+    std::snprintf(vertex, sizeof vertex, "v %.9f %.9f 0\n", std::cos(a), std::sin(a));
+    text += vertex;
+    face += ' ';
+    face += std::to_string(i + 1);
+  }
+  // A triangle after the polygon, so that a miscounted polygon would shift it.
+  text += face + "\nv 5 5 5\nv 6 5 5\nv 5 6 5\nf -3 -2 -1\n";
+  const Mesh m = load_mesh(write("polygon.obj", text));
+  ASSERT_EQ(m.triangles.size(), size_t(kCorners - 2 + 1));
+  EXPECT_EQ(m.polygons_split, 1u);
+  double area = 0;
+  for (size_t t = 0; t + 1 < m.triangles.size(); ++t) {
+    const auto& tri = m.triangles[t];
+    EXPECT_EQ(tri[0], 0u);
+    area += 0.5 * glm::length(glm::cross(m.positions[tri[1]] - m.positions[tri[0]], m.positions[tri[2]] - m.positions[tri[0]]));
+  }
+  EXPECT_NEAR(area, 0.5 * kCorners * std::sin(2 * pi / kCorners), 1e-4);
+  EXPECT_EQ(m.triangles.back(), (std::array<uint32_t, 3>{kCorners, kCorners + 1, kCorners + 2}));
+}
+
+// "\r\n", "\n" and a lone "\r" (old Mac files) each end one line, for every kind of line.
+TEST_F(MeshFileTest, EveryLineEndingEndsALine) {
+  for (const std::string end : {"\n", "\r\n", "\r"}) {
+    const Mesh m = load_mesh(write("good.obj", "v 0 0 0" + end + "v 1 0 0" + end + "v 0 1 0" + end + "vn 0 0 1" + end +
+                                                   "f 1//1 2//1 3//1" + end));
+    EXPECT_EQ(m.triangles.size(), 1u);
+    EXPECT_EQ(m.corner_normals.size(), 1u);
+    expect_mesh_error(write("coordinate.obj", "v 0 0 0" + end + "v 1 0 0" + end + "v 0 abc 0" + end + "f 1 2 3" + end),
+                      "coordinate.obj:3: vertex coordinate \"abc\"");
+    expect_mesh_error(write("index.obj", "v 0 0 0" + end + "v 1 0 0" + end + "v 0 1 0" + end + "f 1 2 x" + end),
+                      "index.obj:4: face 1: vertex index \"x\" is not an integer");
+    expect_mesh_error(write("normal.obj", "v 0 0 0" + end + "vn 0 zero 1" + end + "f 1 1 1" + end), "normal.obj:2: normal");
+  }
+}
+
+TEST_F(MeshFileTest, EveryFaceIndexIsChecked) {
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  const auto error = [&](const std::string& face, const std::string& what) {
+    expect_mesh_error(write("f.obj", v + "vt 0 0\nvn 0 0 1\n" + face + "\n"), "f.obj:6: face 1: " + what);
+  };
+  error("f 1 2 99999999999999999999", "vertex index 99999999999999999999 is out of range (the file has 3 vertices)");
+  error("f 1 2 -99999999999999999999", "vertex index -99999999999999999999 is out of range");
+  error("f 1 2 4294967298", "vertex index 4294967298 is out of range");
+  error("f 1 2 4", "vertex index 4 is out of range (the file has 3 vertices)");
+  error("f 1 2 -4", "vertex index -4 is out of range");
+  error("f 1 2 0", "vertex index 0 is out of range");
+  error("f 1 2 3x", "vertex index \"3x\" is not an integer");
+  error("f 1 2 +3", "vertex index \"+3\" is not an integer");
+  error("f 1 2 3.0", "vertex index \"3.0\" is not an integer");
+  error("f 1//1 2//1 3//2", "normal index 2 is out of range (the file has 1 normals)");
+  error("f 1/1 2/1 3/99999999999", "texture coordinate index 99999999999 is out of range");
+  error("f 1/ 2/ 3/", "corner \"1/\"");
+  error("f 1//1 2//1 3//", "corner \"3//\"");
+  error("f 1/1/1/1 2 3", "corner \"1/1/1/1\"");
+  error("f 1/1 2//1 3", "corner \"2//1\" does not give the same indices as the first corner \"1/1\"");
+  error("f 1 2", "2 corners, a face needs at least 3");
+  // Relative indices count back from the last vertex read so far, not from the file's end.
+  const Mesh m = load_mesh(write("rel.obj", v + "f -3 -2 -1\nv 2 2 2\nf -4 -3 -2\n"));
+  EXPECT_EQ(m.triangles[0], m.triangles[1]);
+  // A face may use vertices defined after it.
+  EXPECT_EQ(load_mesh(write("ahead.obj", "f 1 2 3\n" + v)).triangles.size(), 1u);
+}
+
+TEST_F(MeshFileTest, NormalsAndTextureCoordinatesAreNumbers) {
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  expect_mesh_error(write("vn.obj", v + "vn 0 0 nan\nf 1//1 2//1 3//1\n"), "vn.obj:4: normal coordinate \"nan\"");
+  expect_mesh_error(write("vn2.obj", v + "vn 0 1\nf 1//1 2//1 3//1\n"), "vn2.obj:4:");
+  expect_mesh_error(write("vt.obj", v + "vt 0 u\nf 1/1 2/1 3/1\n"), "vt.obj:4: texture coordinate \"u\"");
+  expect_mesh_error(write("v.obj", v + "v 1 2 3 garbage\nf 1 2 3\n"), "v.obj:4: vertex coordinate \"garbage\"");
+  // Extra numbers (w, or a colour) and comments are allowed.
+  EXPECT_EQ(load_mesh(write("extra.obj", "v 0 0 0 1\nv 1 0 0 0.5 0.5 0.5\nv 0 1 0  # a comment\n# f 9 9 9\nf 1 2 3\n"))
+                .triangles.size(),
+            1u);
 }
 
 TEST(MeshTest, InputsTheFuzzerFoundAreRefused) {
@@ -148,7 +233,7 @@ TEST_F(MeshFileTest, SceneMeshErrorsNameTheKeyAndTheMeshProblem) {
   } catch (const MeshError& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("s.json: /objects/0/file: "), std::string::npos) << m;
-    EXPECT_NE(m.find("bad.obj: face 1"), std::string::npos) << m;
+    EXPECT_NE(m.find("bad.obj:2: face 1"), std::string::npos) << m;
   }
   write("s2.json", R"({"camera": {"position": [0, 0, -5], "direction": [0, 0, 1], "focal_length": 1},
     "materials": {"m": {"albedo": [1, 1, 1]}},

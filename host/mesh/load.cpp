@@ -23,7 +23,7 @@ Mesh parse_mesh(std::string_view bytes, const std::filesystem::path& name) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   Mesh mesh;
   if (ext == ".obj") {
-    mesh = parse_obj(std::string(bytes), name);
+    mesh = parse_obj(bytes, name);
   } else if (ext == ".ply") {
     mesh = parse_ply(bytes, name);
   } else {

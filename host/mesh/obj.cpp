@@ -1,115 +1,195 @@
 #include "mesh/obj.h"
 
-#include <algorithm>
 #include <cfloat>
 #include <charconv>
-#include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
-
-#include <tiny_obj_loader.h>
+#include <vector>
 
 #include "base/errors.h"
+#include "base/interrupt.h"
 
 namespace vkray {
 namespace {
 
-[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
-  throw MeshError(file.string() + ": " + what);
-}
+// One of the three lists a face corner indexes into.
+struct IndexedList {
+  IndexedList(const char* index_name_, const char* plural_) : index_name(index_name_), plural(plural_) {}
+  const char* index_name;  // in messages: "vertex index 9 is out of range (the file has 3 vertices)"
+  const char* plural;
+  size_t count = 0;        // read so far: a negative index counts back from here
+  // The largest positive index seen, and where, checked once the whole file is read: a face may use
+  // vertices defined after it.
+  int64_t max_index = 0;
+  std::string max_token;
+  size_t max_line = 0, max_face = 0;
+};
 
-std::string trim(std::string s) {
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
-  return s;
-}
+class ObjParser {
+ public:
+  ObjParser(std::string_view text, const std::filesystem::path& file) : text_(text), file_(file) {}
 
-void check_finite(const std::filesystem::path& file, const Mesh& mesh) {
-  for (size_t i = 0; i < mesh.positions.size(); ++i) {
-    const glm::vec3& p = mesh.positions[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-      fail(file, "vertex " + std::to_string(i) + " has a coordinate that is not a finite number");
+  Mesh parse() {
+    for (std::string_view line; next_line(line);) {
+      if (line_number_ % 4096 == 0) throw_if_interrupted();
+      if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+      tokens_.clear();
+      for (size_t at = line.find_first_not_of(kSpace); at != std::string_view::npos; at = line.find_first_not_of(kSpace, at)) {
+        const size_t end = std::min(line.find_first_of(kSpace, at), line.size());
+        tokens_.push_back(line.substr(at, end - at));
+        at = end;
+      }
+      if (tokens_.empty()) continue;
+      const std::string_view keyword = tokens_[0];
+      if (keyword == "v") {
+        numbers("vertex coordinate", 3, 7);  // x y z, then w or a colour (r g b) that vkray does not use
+        mesh_.positions.push_back({coordinates_[0], coordinates_[1], coordinates_[2]});
+        ++lists_[kVertex].count;
+      } else if (keyword == "vn") {
+        numbers("normal coordinate", 3, 3);
+        normals_.push_back({coordinates_[0], coordinates_[1], coordinates_[2]});
+        ++lists_[kNormal].count;
+      } else if (keyword == "vt") {
+        numbers("texture coordinate", 1, 3);
+        ++lists_[kTexture].count;
+      } else if (keyword == "f") {
+        face();
+      }
+      // Anything else (o, g, s, usemtl, mtllib, l, p, ...) says nothing vkray uses.
+    }
+    for (const IndexedList& list : lists_)
+      if (list.max_index > int64_t(list.count)) out_of_range(list, list.max_token, list.max_line, list.max_face);
+    if (all_normals_) {
+      mesh_.corner_normals.reserve(corner_normal_indices_.size());
+      for (const auto& n : corner_normal_indices_) mesh_.corner_normals.push_back({normals_[n[0]], normals_[n[1]], normals_[n[2]]});
+    }
+    return std::move(mesh_);
   }
-}
 
-// tinyobjloader reads a number it cannot parse as 0, silently; check every vertex line first.
-void check_obj_vertices(const std::filesystem::path& file, std::string_view text) {
-  size_t line_number = 0;
-  for (size_t at = 0; at < text.size();) {
-    const size_t end = std::min(text.find('\n', at), text.size());
-    ++line_number;
-    std::string_view line(text.data() + at, end - at);
-    at = end + 1;
-    while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
-    if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
-    line.remove_prefix(2);
-    for (int k = 0; k < 3; ++k) {
-      while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
-      size_t length = 0;
-      while (length < line.size() && !std::isspace(static_cast<unsigned char>(line[length]))) ++length;
-      const std::string_view token = line.substr(0, length);
+ private:
+  static constexpr const char* kSpace = " \t\v\f";
+  enum { kVertex, kTexture, kNormal };
+
+  // A line ends at "\n", "\r\n" or a lone "\r" (old Mac files), the same for every kind of line.
+  bool next_line(std::string_view& line) {
+    if (at_ >= text_.size()) return false;
+    const size_t end = std::min(text_.find_first_of("\r\n", at_), text_.size());
+    line = text_.substr(at_, end - at_);
+    at_ = end + 1;
+    if (end + 1 < text_.size() && text_[end] == '\r' && text_[end + 1] == '\n') ++at_;
+    ++line_number_;
+    return true;
+  }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw MeshError(file_.string() + ":" + std::to_string(line_number_) + ": " + what);
+  }
+
+  // tokens_[1..] as finite 32-bit numbers, from `min` to `max` of them, into coordinates_.
+  void numbers(const char* what, size_t min, size_t max) {
+    coordinates_.clear();
+    for (size_t i = 1; i < tokens_.size(); ++i) {
+      const std::string_view token = tokens_[i];
       double value = 0;
       const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-      if (token.empty() || ec != std::errc() || ptr != token.data() + token.size() || !std::isfinite(value) ||
-          std::abs(value) > FLT_MAX)
-        fail(file.string() + ":" + std::to_string(line_number),
-             "vertex coordinate \"" + printable(token) + "\" is not a finite 32-bit number");
-      line.remove_prefix(length);
+      if (ec != std::errc() || ptr != token.data() + token.size() || !std::isfinite(value) || std::abs(value) > FLT_MAX)
+        fail(std::string(what) + " \"" + printable(token) + "\" is not a finite 32-bit number");
+      coordinates_.push_back(float(value));
+    }
+    if (coordinates_.size() < min || coordinates_.size() > max)
+      fail("expected " + (min == max ? std::to_string(min) : std::to_string(min) + " to " + std::to_string(max)) + " numbers after \"" +
+           std::string(tokens_[0]) + "\", got " + std::to_string(coordinates_.size()));
+  }
+
+  [[noreturn]] void out_of_range(const IndexedList& list, std::string_view token, size_t line, size_t face) const {
+    throw MeshError(file_.string() + ":" + std::to_string(line) + ": face " + std::to_string(face) + ": " + list.index_name +
+                    " " + printable(token) + " is out of range (the file has " + std::to_string(list.count) + " " +
+                    list.plural + (token.front() == '-' ? " before this line)" : ")"));
+  }
+
+  // One index of a corner: 1 is the first element, -1 the last one read so far. A positive index is
+  // checked against the whole file's count at its end.
+  uint32_t index(IndexedList& list, std::string_view token) {
+    int64_t value = 0;
+    const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+    const bool integer = !token.empty() && ptr == token.data() + token.size() && token.front() != '+';
+    if (!integer || (ec != std::errc() && ec != std::errc::result_out_of_range))
+      fail("face " + std::to_string(face_number_) + ": " + list.index_name + " \"" + printable(token) + "\" is not an integer");
+    if (ec == std::errc::result_out_of_range) value = token.front() == '-' ? std::numeric_limits<int64_t>::min()
+                                                                           : std::numeric_limits<int64_t>::max();
+    if (value == 0 || (value < 0 && -(value + 1) >= int64_t(list.count)))
+      out_of_range(list, token, line_number_, face_number_);
+    if (value < 0) return uint32_t(int64_t(list.count) + value);
+    if (value > list.max_index) {
+      list.max_index = value;
+      list.max_token = std::string(token);
+      list.max_line = line_number_;
+      list.max_face = face_number_;
+    }
+    return uint32_t(value - 1);  // when it does not fit, the check at the end fails
+  }
+
+  void face() {
+    ++face_number_;
+    const size_t corners = tokens_.size() - 1;
+    if (corners < 3) fail("face " + std::to_string(face_number_) + ": " + std::to_string(corners) + " corners, a face needs at least 3");
+    vertices_.clear();
+    face_normals_.clear();
+    int first_form = -1;
+    for (size_t c = 1; c < tokens_.size(); ++c) {
+      // v, v/vt, v//vn or v/vt/vn, the same form at every corner of a face.
+      const std::string_view corner = tokens_[c];
+      std::string_view parts[3];
+      size_t count = 0;
+      for (size_t at = 0;; ++count) {
+        const size_t slash = corner.find('/', at);
+        if (count == 3) fail("face " + std::to_string(face_number_) + ": corner \"" + printable(corner) + "\" has more than 3 indices");
+        parts[count] = corner.substr(at, slash == std::string_view::npos ? std::string_view::npos : slash - at);
+        if (slash == std::string_view::npos) break;
+        at = slash + 1;
+      }
+      ++count;
+      const bool has_texture = count >= 2 && !parts[1].empty(), has_normal = count == 3;
+      if (parts[0].empty() || (count == 2 && !has_texture) || (has_normal && parts[2].empty()))
+        fail("face " + std::to_string(face_number_) + ": corner \"" + printable(corner) +
+             "\" is not v, v/vt, v//vn or v/vt/vn");
+      const int form = int(has_texture) + 2 * int(has_normal);
+      if (first_form < 0) first_form = form;
+      if (form != first_form)
+        fail("face " + std::to_string(face_number_) + ": corner \"" + printable(corner) +
+             "\" does not give the same indices as the first corner \"" + printable(tokens_[1]) + "\"");
+      vertices_.push_back(index(lists_[kVertex], parts[0]));
+      if (has_texture) index(lists_[kTexture], parts[1]);
+      if (has_normal) face_normals_.push_back(index(lists_[kNormal], parts[2]));
+    }
+    all_normals_ = all_normals_ && !face_normals_.empty();
+    mesh_.polygons_split += corners > 3;
+    // A fan from the first corner: exact for the convex polygons OBJ files hold.
+    for (size_t c = 1; c + 1 < corners; ++c) {
+      mesh_.triangles.push_back({vertices_[0], vertices_[c], vertices_[c + 1]});
+      if (all_normals_) corner_normal_indices_.push_back({face_normals_[0], face_normals_[c], face_normals_[c + 1]});
     }
   }
-}
+
+  std::string_view text_;
+  const std::filesystem::path& file_;
+  size_t at_ = 0, line_number_ = 0, face_number_ = 0;
+  IndexedList lists_[3] = {{"vertex index", "vertices"}, {"texture coordinate index", "texture coordinates"},
+                           {"normal index", "normals"}};
+  Mesh mesh_;
+  std::vector<glm::vec3> normals_;
+  bool all_normals_ = true;  // every face so far gives a normal at each corner
+  std::vector<std::array<uint32_t, 3>> corner_normal_indices_;
+  // Scratch space for the line being read, kept to save allocations.
+  std::vector<std::string_view> tokens_;
+  std::vector<float> coordinates_;
+  std::vector<uint32_t> vertices_, face_normals_;
+};
 
 }  // namespace
 
-Mesh parse_obj(const std::string& text, const std::filesystem::path& file) {
-  check_obj_vertices(file, text);
-
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = false;  // done below, so that polygons can be counted
-  config.vertex_color = false;
-  tinyobj::ObjReader reader;
-  // tinyobjloader's errors carry the line ("... line 12 ..."); pass them on verbatim.
-  if (!reader.ParseFromString(text, "", config)) fail(file, trim(reader.Error()));
-  const tinyobj::attrib_t& attrib = reader.GetAttrib();
-
-  Mesh mesh;
-  mesh.positions.resize(attrib.vertices.size() / 3);
-  for (size_t i = 0; i < mesh.positions.size(); ++i)
-    mesh.positions[i] = {attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]};
-  check_finite(file, mesh);
-
-  bool all_normals = true;
-  std::vector<std::array<glm::vec3, 3>> normals;
-  size_t face_number = 0;
-  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
-    size_t offset = 0;
-    for (const unsigned char corners : shape.mesh.num_face_vertices) {
-      const auto* face = &shape.mesh.indices[offset];
-      offset += corners;
-      ++face_number;
-      if (corners < 3) fail(file, "face " + std::to_string(face_number) + " has fewer than 3 vertices");
-      mesh.polygons_split += corners > 3;
-      for (unsigned c = 0; c < corners; ++c) {
-        if (face[c].vertex_index < 0 || size_t(face[c].vertex_index) >= mesh.positions.size())
-          fail(file, "face " + std::to_string(face_number) + ": vertex index out of range (the file has " +
-                         std::to_string(mesh.positions.size()) + " vertices)");
-        if (face[c].normal_index < 0 || size_t(face[c].normal_index) * 3 + 2 >= attrib.normals.size()) all_normals = false;
-      }
-      // A fan from the first corner: exact for the convex polygons OBJ files hold.
-      for (unsigned c = 1; c + 1 < corners; ++c) {
-        mesh.triangles.push_back({uint32_t(face[0].vertex_index), uint32_t(face[c].vertex_index),
-                                  uint32_t(face[c + 1].vertex_index)});
-        if (all_normals) {
-          auto n = [&](unsigned k) {
-            const size_t i = size_t(face[k].normal_index) * 3;
-            return glm::vec3(attrib.normals[i], attrib.normals[i + 1], attrib.normals[i + 2]);
-          };
-          normals.push_back({n(0), n(c), n(c + 1)});
-        }
-      }
-    }
-  }
-  if (all_normals && normals.size() == mesh.triangles.size()) mesh.corner_normals = std::move(normals);
-  return mesh;
-}
+Mesh parse_obj(std::string_view text, const std::filesystem::path& file) { return ObjParser(text, file).parse(); }
 
 }  // namespace vkray

@@ -1,4 +1,4 @@
-// libFuzzer target: Wavefront OBJ meshes (vkray's checks, then tinyobjloader).
+// libFuzzer target: Wavefront OBJ meshes (vkray's own reader, host/mesh/obj.h).
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
