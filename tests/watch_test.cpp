@@ -67,6 +67,29 @@ class WatchTest : public ::testing::Test {
 
   Image image() { return read_pfm(dir_ / "out.pfm"); }
 
+  // Saves `broken` as `file` (a shader file) and expects `error` in watch's error line, a reload that
+  // renders nothing and keeps the image, and, once `file` is restored, a reload that renders it again.
+  void expect_shader_error_survived(const std::string& file, const std::string& broken, const std::string& error) {
+    const std::string good_image = read_text(dir_ / "out.pfm");
+    const std::string original = read_text(dir_ / file);
+    save_in_place(file, broken);
+    const auto error_line = expect_line(": error:");
+    ASSERT_TRUE(error_line);
+    EXPECT_NE(error_line->find(error), std::string::npos) << *error_line;
+    const auto line = expect_line("reload 1");
+    ASSERT_TRUE(line);
+    EXPECT_NE(line->find("shader has errors"), std::string::npos) << *line;
+    EXPECT_NE(line->find("not rendered"), std::string::npos) << *line;
+    EXPECT_TRUE(child_->running());
+    EXPECT_EQ(read_text(dir_ / "out.pfm"), good_image) << "the last good image must stay";
+
+    save_in_place(file, original);
+    const auto fixed = expect_line("reload 2");
+    ASSERT_TRUE(fixed);
+    EXPECT_NE(fixed->find("render"), std::string::npos) << *fixed;
+    EXPECT_EQ(read_text(dir_ / "out.pfm"), good_image) << "the same shader must give the same image";
+  }
+
   // `count` reloads, each with a new scale factor so that every one builds a new pipeline. Returns
   // the process's resident anonymous memory (KiB) after each.
   std::vector<long> reloads(int count);
@@ -95,26 +118,18 @@ TEST_F(WatchTest, ValidShaderEditChangesTheImage) {
 
 TEST_F(WatchTest, ErrorInAnIncludedFileKeepsTheImageAndRecovers) {
   start();
-  const std::string good_image = read_text(dir_ / "out.pfm");
   const std::string original = read_text(dir_ / "shaders/shade.glsl");
   const int bad_line = 1 + int(std::count(original.begin(), original.end(), '\n'));
-  save_in_place("shaders/shade.glsl", original + "this is not glsl;\n");
+  expect_shader_error_survived("shaders/shade.glsl", original + "this is not glsl;\n",
+                               "shaders/shade.glsl:" + std::to_string(bad_line) + ": error:");
+}
 
-  const auto error = expect_line(": error:");
-  ASSERT_TRUE(error);
-  EXPECT_NE(error->find("shaders/shade.glsl:" + std::to_string(bad_line) + ": error:"), std::string::npos) << *error;
-  const auto line = expect_line("reload 1");
-  ASSERT_TRUE(line);
-  EXPECT_NE(line->find("shader has errors"), std::string::npos) << *line;
-  EXPECT_NE(line->find("not rendered"), std::string::npos) << *line;
-  EXPECT_TRUE(child_->running());
-  EXPECT_EQ(read_text(dir_ / "out.pfm"), good_image) << "the last good image must stay";
-
-  save_in_place("shaders/shade.glsl", original);
-  const auto fixed = expect_line("reload 2");
-  ASSERT_TRUE(fixed);
-  EXPECT_NE(fixed->find("render"), std::string::npos) << *fixed;
-  EXPECT_EQ(read_text(dir_ / "out.pfm"), good_image) << "the same shader must give the same image";
+TEST_F(WatchTest, AnIncludeCycleIsAnErrorOfItsReloadAndWatchingGoesOn) {
+  // Compiling a cycle used to never end, so watch hung on the save that made one.
+  save_in_place("shaders/loop.glsl", "// includes itself, with no include guard\n#include \"loop.glsl\"\n");
+  start();
+  expect_shader_error_survived("shaders/shade.glsl", read_text(dir_ / "shaders/shade.glsl") + "#include \"loop.glsl\"\n",
+                               "shaders/loop.glsl:2: error: #include cycle: trace.comp -> shade.glsl -> loop.glsl -> loop.glsl");
 }
 
 TEST_F(WatchTest, SceneEditsRerenderAndABrokenSceneIsSurvived) {

@@ -1,8 +1,6 @@
 #include "gpu/shader_compiler.h"
 
 #include <algorithm>
-#include <fstream>
-#include <memory>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -23,74 +21,19 @@ struct GlslangProcess {
   ~GlslangProcess() { glslang::FinalizeProcess(); }
 };
 
-bool read_file(const std::filesystem::path& file, std::string& text) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) return false;
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return false;
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  text = buffer.str();
-  return true;
-}
-
-class Includer : public glslang::TShader::Includer {
- public:
-  Includer(std::vector<std::filesystem::path> dirs, const std::vector<GeneratedInclude>& generated,
-           std::vector<std::filesystem::path>& sources)
-      : dirs_(std::move(dirs)), generated_(generated), sources_(sources) {}
-
-  IncludeResult* includeLocal(const char* header, const char* includer, size_t) override {
-    return find(header, std::filesystem::path(includer).parent_path());
-  }
-  IncludeResult* includeSystem(const char* header, const char*, size_t) override { return find(header, {}); }
-  void releaseInclude(IncludeResult* result) override {
-    if (result) {
-      delete static_cast<std::string*>(result->userData);
-      delete result;
-    }
-  }
-
- private:
-  IncludeResult* find(const char* header, const std::filesystem::path& local_dir) {
-    for (const auto& g : generated_)
-      if (g.name == header) {
-        auto text = std::make_unique<std::string>(g.text);
-        auto* result = new IncludeResult(g.name + " (generated)", text->data(), text->size(), text.get());
-        text.release();
-        return result;
-      }
-    std::vector<std::filesystem::path> candidates;
-    if (!local_dir.empty()) candidates.push_back(local_dir / header);
-    for (const auto& dir : dirs_) candidates.push_back(dir / header);
-    for (const auto& candidate : candidates) {
-      auto text = std::make_unique<std::string>();
-      if (!read_file(candidate, *text)) continue;
-      const std::filesystem::path resolved = candidate.lexically_normal();
-      if (std::find(sources_.begin(), sources_.end(), resolved) == sources_.end()) sources_.push_back(resolved);
-      // headerName becomes the file name in glslang's messages for code in this file.
-      auto* result = new IncludeResult(resolved.string(), text->data(), text->size(), text.get());
-      text.release();
-      return result;
-    }
-    return nullptr;  // glslang reports "Could not process include directive" at the #include line
-  }
-
-  std::vector<std::filesystem::path> dirs_;
-  const std::vector<GeneratedInclude>& generated_;
-  std::vector<std::filesystem::path>& sources_;
-};
-
 // glslang writes "ERROR: file:line: 'token' : message"; we write "file:line: error: 'token' : message"
 // and drop its summary lines ("ERROR: 1 compilation errors.  No code generated.").
 std::string format_log(const std::string& log) {
   static const std::regex located(R"(^(ERROR|WARNING): (.+):(\d+): (.*)$)");
+  // The include resolver's errors name the #include already (gpu/shader_includes.h); glslang wraps them.
+  static const std::regex include_error(R"(^'#include' : (#include .*) for header name: .*$)");
   std::istringstream in(log);
   std::string line, out;
   std::smatch m;
   while (std::getline(in, line)) {
     if (std::regex_match(line, m, located)) {
       std::string message = m[4].str();
+      if (std::smatch inner; std::regex_match(message, inner, include_error)) message = inner[1].str();
       if (message.rfind("'' : ", 0) == 0) message = message.substr(5);  // no token to quote
       while (!message.empty() && message.front() == ' ') message.erase(0, 1);
       out += m[2].str() + ":" + m[3].str() + ": " + (m[1] == "ERROR" ? "error" : "warning") + ": " + message + "\n";
@@ -156,11 +99,11 @@ CompiledShader compile_compute_shader(const std::filesystem::path& entry,
   static GlslangProcess process;
 
   const std::filesystem::path entry_path = entry.lexically_normal();
-  std::string text;
-  if (!read_file(entry_path, text)) throw ShaderError(entry_path.string() + ": cannot read shader file");
+  const InputFile input = read_shader_file(entry_path);
+  if (!input.error.empty()) throw ShaderError(entry_path.string() + ": " + input.error);
+  const std::string& text = input.text;
 
   CompiledShader result;
-  result.sources.push_back(entry_path);
 
   glslang::TShader shader(EShLangCompute);
   const char* strings[] = {text.c_str()};
@@ -172,10 +115,12 @@ CompiledShader compile_compute_shader(const std::filesystem::path& entry,
   shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
   shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
 
-  Includer includer(include_dirs, generated, result.sources);
+  ShaderIncludes includes(entry_path, include_dirs, generated);
   const auto messages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
-  if (!shader.parse(GetDefaultResources(), 460, false, messages, includer))
+  if (!shader.parse(GetDefaultResources(), 460, false, messages, includes))
     throw ShaderError(format_log(shader.getInfoLog()));
+
+  result.sources = includes.sources();
 
   glslang::TProgram program;
   program.addShader(&shader);

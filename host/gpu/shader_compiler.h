@@ -9,6 +9,8 @@
 
 #include <vulkan/vulkan_raii.hpp>
 
+#include "gpu/shader_includes.h"
+
 namespace vkray::gpu {
 
 // A resource the shader declares in a descriptor set (not its push constants), from glslang's
@@ -28,14 +30,7 @@ struct CompiledShader {
   std::vector<ShaderBinding> bindings;
 };
 
-// Text served for an #include of `name` in place of any file of that name (code the host generates).
-struct GeneratedInclude {
-  std::string name;  // as written in the #include
-  std::string text;
-};
-
-// Compiles `entry` for Vulkan 1.2. `#include "x"` is looked up in `generated`, then next to the
-// including file, then in `include_dirs` in order; `#include <x>` skips the including file's folder.
+// Compiles `entry` for Vulkan 1.2, its #include directives resolved as gpu/shader_includes.h says.
 // Throws ShaderError whose message has one line per problem, "file:line: error: message", where
 // file is the file that has the error (an included file too; "x (generated)" for generated code).
 CompiledShader compile_compute_shader(const std::filesystem::path& entry,
