@@ -17,6 +17,13 @@
 namespace vkray::test {
 namespace {
 
+// "f7.glsl"
+std::string numbered(int i) {
+  std::string name = "f";
+  name += std::to_string(i);
+  return name + ".glsl";
+}
+
 const std::string kMain = "#version 460\n#extension GL_GOOGLE_include_directive : require\nlayout(local_size_x = 1) in;\n";
 
 class ShaderIncludesTest : public ::testing::Test {
@@ -74,23 +81,28 @@ TEST_F(ShaderIncludesTest, GuardedHeadersMayBeIncludedAgainAndInACycle) {
 
 TEST_F(ShaderIncludesTest, AChainDeeperThan32IsAnError) {
   // main -> f1 -> ... -> fN: 32 levels compile, 33 do not.
-  const auto name = [](int i) {
-    std::string text = "f";
-    text += std::to_string(i);
-    return text + ".glsl";
-  };
   const auto chain = [&](int depth) {
     std::filesystem::remove_all(dir_.path());
     std::filesystem::create_directories(dir_.path());
     write({{"main.comp", kMain + "#include \"f1.glsl\"\nvoid main() {}\n"}});
     for (int i = 1; i <= depth; ++i)
-      write({{name(i), i == depth ? "\n" : "#include \"" + name(i + 1) + "\"\n"}});
+      write({{numbered(i), i == depth ? "\n" : "#include \"" + numbered(i + 1) + "\"\n"}});
   };
   chain(32);
   EXPECT_EQ(gpu::compile_compute_shader(dir_ / "main.comp", {dir_.path()}).sources.size(), 33u);
   chain(33);
   EXPECT_NE(error(file("f32.glsl") + ":1").find("#include nested more than 32 deep: main.comp -> f1.glsl -> f2.glsl"),
             std::string::npos);
+}
+
+TEST_F(ShaderIncludesTest, IncludesThatMultiplyAreCutOff) {
+  // Each of 24 files includes the next twice: 2^24 includes, not a cycle and not too deep.
+  write({{"main.comp", kMain + "#include \"f1.glsl\"\nvoid main() {}\n"}, {"f24.glsl", "\n"}});
+  for (int i = 1; i < 24; ++i) {
+    const std::string next = "#include \"" + numbered(i + 1) + "\"\n";
+    write({{numbered(i), next + next}});
+  }
+  EXPECT_NE(error(file("f23.glsl") + ":2").find("the shader includes more than 4096 files"), std::string::npos);
 }
 
 TEST_F(ShaderIncludesTest, AnIncludeThatIsNotARegularFileIsAnErrorNotAHang) {

@@ -106,6 +106,9 @@ glslang::TShader::Includer::IncludeResult* ShaderIncludes::include(const std::st
   };
   if (depth > kMaxIncludeDepth)
     return error("#include nested more than " + std::to_string(kMaxIncludeDepth) + " deep: " + chain_text(header));
+  if (++includes_ > kMaxIncludes)
+    return error("#include \"" + header + "\": the shader includes more than " + std::to_string(kMaxIncludes) +
+                 " files (counting a file each time it is included)");
 
   std::string key, text;
   bool generated = false;
@@ -130,6 +133,10 @@ glslang::TShader::Includer::IncludeResult* ShaderIncludes::include(const std::st
     if (key.empty()) return nullptr;  // glslang reports "Could not process include directive"
   }
 
+  included_bytes_ += text.size();
+  if (included_bytes_ > kMaxIncludedBytes)
+    return error("#include \"" + header + "\": the shader's includes pass " + std::to_string(kMaxIncludedBytes >> 20) +
+                 " MiB (counting a file each time it is included)");
   const bool open = std::any_of(chain_.begin(), chain_.end(), [&](const Open& o) { return o.key == key; });
   if (open && !has_include_guard(text)) return error("#include cycle: " + chain_text(header));
   if (!generated && std::find(sources_.begin(), sources_.end(), key) == sources_.end())

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -16,8 +17,12 @@
 
 namespace vkray::gpu {
 
-// How many files deep #include may nest below the entry file; README, "Limits".
+// How many files deep #include may nest below the entry file, and how much one compile may include
+// in all, counting a file each time it is included (files that include each other twice at each of
+// 32 levels would otherwise be read 2^32 times); README, "Limits".
 constexpr size_t kMaxIncludeDepth = 32;
+constexpr size_t kMaxIncludes = 4096;
+constexpr uint64_t kMaxIncludedBytes = uint64_t(64) << 20;
 
 // Text served for an #include of `name` in place of any file of that name (code the host generates).
 struct GeneratedInclude {
@@ -66,6 +71,8 @@ class ShaderIncludes : public glslang::TShader::Includer {
   std::vector<Open> chain_;
   // glslang asks includeSystem after includeLocal fails; that search is already done, so it gets
   // includeLocal's answer again.
+  size_t includes_ = 0;
+  uint64_t included_bytes_ = 0;
   bool local_failed_ = false;
   std::string local_error_;
 };
