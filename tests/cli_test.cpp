@@ -1,5 +1,4 @@
 // The vkray command as a user runs it: outputs, messages and exit codes.
-#include <signal.h>
 
 #include <chrono>
 #include <filesystem>
@@ -13,7 +12,6 @@
 #include <nlohmann/json.hpp>
 
 #include "image/image.h"
-#include "support/child_process.h"
 #include "support/run_vkray.h"
 #include "support/temp_dir.h"
 
@@ -261,29 +259,6 @@ TEST(CliTest, ImageTooLargeForTheDeviceExitsThreeNamingTheLimit) {
   EXPECT_NE(run.err.find("image too large"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("maxStorageBufferRange"), std::string::npos) << run.err;
   EXPECT_FALSE(has_image_files(dir.path()));
-}
-
-// Renders the teapot large with `renderer`, sends SIGINT once a progress line with `progress`
-// shows it rendering, and expects exit 130 with nothing written.
-void expect_sigint_stops_the_render(const std::string& renderer, const std::string& progress) {
-  TempDir dir;
-  ChildProcess child({VKRAY_EXECUTABLE, "render", kScenes + "/teapot.json", "--renderer", renderer, "--width", "2048",
-                      "--height", "2048", "--spp", "16", "-o", "out.png"},
-                     dir.path().string());
-  ASSERT_TRUE(child.wait_for_line(progress, std::chrono::seconds(60))) << child.all_output();
-  child.signal(SIGINT);
-  const auto code = child.wait_exit(std::chrono::seconds(60));
-  ASSERT_TRUE(code.has_value());
-  EXPECT_EQ(*code, 130) << child.all_output();
-  EXPECT_NE(child.all_output().find("interrupted; no image written"), std::string::npos) << child.all_output();
-  EXPECT_FALSE(has_image_files(dir.path()));
-}
-
-TEST(CliTest, SigintDuringARenderExitsCleanlyAndWritesNothing) { expect_sigint_stops_the_render("gpu", "tracing"); }
-
-TEST(CliTest, SigintDuringACpuRenderExitsCleanlyAndWritesNothing) {
-  // The CPU reference stops between rows as the GPU path stops between tiles.
-  expect_sigint_stops_the_render("cpu", "rows)");
 }
 
 TEST(CliTest, VersionNamesTheCommitItWasBuiltFrom) {

@@ -1,6 +1,9 @@
 #include "base/interrupt.h"
 
+#include <sys/eventfd.h>
 #include <unistd.h>
+
+#include <cstdint>
 
 #include <algorithm>
 #include <atomic>
@@ -14,6 +17,8 @@ namespace {
 
 std::atomic<bool> requested{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "request_interrupt() must be async-signal-safe");
+// Created before main(), so that request_interrupt() never has to create it.
+const int event_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
 
 struct TemporaryFiles {
   std::mutex mutex;
@@ -27,9 +32,18 @@ TemporaryFiles& temporary_files() {
 
 }  // namespace
 
-void request_interrupt() noexcept { requested.store(true, std::memory_order_relaxed); }
+void request_interrupt() noexcept {
+  requested.store(true, std::memory_order_relaxed);
+  const uint64_t one = 1;
+  [[maybe_unused]] const ssize_t written = ::write(event_fd, &one, sizeof one);  // write(2) is async-signal-safe
+}
 bool interrupt_requested() noexcept { return requested.load(std::memory_order_relaxed); }
-void clear_interrupt() noexcept { requested.store(false, std::memory_order_relaxed); }
+void clear_interrupt() noexcept {
+  requested.store(false, std::memory_order_relaxed);
+  uint64_t count = 0;
+  [[maybe_unused]] const ssize_t read = ::read(event_fd, &count, sizeof count);  // resets the counter
+}
+int interrupt_fd() noexcept { return event_fd; }
 void throw_if_interrupted() {
   if (interrupt_requested()) throw Cancelled();
 }

@@ -13,8 +13,11 @@ namespace vkray {
 // Async-signal-safe: a lock-free atomic store.
 void request_interrupt() noexcept;
 bool interrupt_requested() noexcept;
-// Forgets a request (a face that goes on after one, e.g. `vkray watch` ending a render).
+// Forgets a request (a face or a test that goes on after one).
 void clear_interrupt() noexcept;
+// A descriptor that polls readable while a request stands, for a face that waits in poll() (the
+// file watcher of `vkray watch`).
+int interrupt_fd() noexcept;
 // Throws Cancelled when a stop was requested.
 void throw_if_interrupted();
 

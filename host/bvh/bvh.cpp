@@ -9,6 +9,7 @@
 
 #include "base/check.h"
 #include "base/errors.h"
+#include "base/interrupt.h"
 
 namespace vkray {
 namespace {
@@ -60,6 +61,7 @@ class Builder {
   // Builds the subtree over order[begin, end) and returns its link. The root (depth 1) is written
   // into nodes[0]; other inner nodes are appended.
   uint32_t subtree(uint32_t begin, uint32_t end, const Aabb& box, uint32_t depth) {
+    throw_if_interrupted();  // one relaxed load a node: a large build stops within milliseconds
     const uint32_t count = end - begin;
     // The GPU's traversal stack is sized for kMaxDepth levels (VKRAY_TRAVERSAL_STACK): deeper would
     // lose nodes silently there.

@@ -15,7 +15,6 @@
 #include "bvh/bvh.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
-#include "cli/stop_signals.h"
 #include "scene/scene.h"
 #include "session/cpu_render.h"
 #include "session/paths.h"
@@ -74,13 +73,11 @@ std::string fixed(double value, int decimals) {
 }
 
 int run_bench(const BenchArgs& args) {
-  const StopSignals stop;
   const std::filesystem::path scene_dir = default_scene().parent_path();
   RenderOptions measured = render_options(nullptr, &args.gpu, &args.cpu);
   measured.width = args.width;
   measured.height = args.height;
   measured.samples_per_pixel = 1;
-  measured.cancel = [&stop] { return stop.pending(); };
   const unsigned threads = cpu_threads(measured);
 #ifdef VKRAY_HAVE_EMBREE
   const bool with_embree = args.embree;

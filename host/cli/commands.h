@@ -12,6 +12,10 @@ namespace vkray::cli {
 struct Command {
   CLI::App* app;
   std::function<int()> run;
+  // Ctrl-C and SIGTERM (cli/stop_signals.h): the exit code and message of a command that is stopped
+  // by force. A command that unwinds by itself reports Cancelled as main() reports any error.
+  int signal_exit_code = 130;
+  const char* signal_message = "interrupted; no image written";
 };
 
 Command add_render_command(CLI::App& app);

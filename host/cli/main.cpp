@@ -9,6 +9,7 @@
 #include "base/errors.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
+#include "cli/stop_signals.h"
 #include "session/failure.h"
 #include "session/session.h"
 #include "session/version.h"
@@ -17,6 +18,8 @@ namespace {
 
 int run(int argc, char** argv) {
   using namespace vkray;
+  // Ctrl-C and SIGTERM, for every command alike, from the first moment (before any thread exists).
+  cli::StopSignals stop;
   CLI::App app("vkray: a raytracer on Vulkan compute shaders, with a headless renderer for any Vulkan device "
                "(lavapipe included).");
   app.footer(cli::kExitCodes);
@@ -34,7 +37,10 @@ int run(int argc, char** argv) {
   }
   try {
     for (const cli::Command& command : commands)
-      if (*command.app) return command.run();
+      if (*command.app) {
+        stop.set_forced_exit(command.signal_exit_code, command.signal_message);
+        return command.run();
+      }
   } catch (...) {
     const Failure failure = describe_failure(std::current_exception());
     std::cerr << "vkray: " << failure.headline;

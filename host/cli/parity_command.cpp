@@ -13,7 +13,6 @@
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "cli/report.h"
-#include "cli/stop_signals.h"
 #include "image/image.h"
 #include "session/parity.h"
 #include "session/session.h"
@@ -93,14 +92,12 @@ void print_text(const ParityResult& r, const std::string& device, const std::fil
 }
 
 int run_parity(const ParityArgs& args) {
-  const StopSignals stop;
   auto log = [&](const std::string& line) {
     if (!args.json) std::cerr << "vkray: " << line << "\n";
   };
   const LoadedScene loaded = load_scene_file(scene_file(args.scene));
   if (!args.diff.empty()) check_output_path(args.diff);
   RenderOptions options = render_options(&args.scene, &args.gpu, &args.cpu);
-  options.cancel = [&stop] { return stop.pending(); };
   log(describe(*loaded.scene, image_settings(*loaded.scene, options)));
 
   Session session(session_options(args.device));

@@ -8,7 +8,6 @@
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "cli/report.h"
-#include "cli/stop_signals.h"
 #include "image/image.h"
 #include "session/cpu_render.h"
 #include "session/session.h"
@@ -27,7 +26,6 @@ struct RenderArgs {
 };
 
 int run_render(const RenderArgs& args) {
-  const StopSignals stop;  // Ctrl-C stops the render between tiles, not in the middle of a Vulkan call
   const auto total_start = Clock::now();
   auto log = [&](const std::string& line) {
     if (!args.quiet) std::cerr << "vkray: " << line << "\n";
@@ -37,7 +35,6 @@ int run_render(const RenderArgs& args) {
       args.output.empty() ? std::filesystem::path(loaded.scene->name + ".png") : args.output;
   check_output_path(output);
   RenderOptions options = render_options(&args.scene, &args.gpu, &args.cpu);
-  options.cancel = [&stop] { return stop.pending(); };
   const ImageSettings image = image_settings(*loaded.scene, options);
 
   RenderResult result;

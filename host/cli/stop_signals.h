@@ -1,42 +1,40 @@
-// SIGINT and SIGTERM delivered through a file descriptor instead of killing the process, so a
-// command can stop between units of work, release the device and exit cleanly.
+// SIGINT and SIGTERM, the same for every command. main() creates one StopSignals before any other
+// thread exists: the signals are blocked in every thread, and a thread of its own reads them and
+// turns them into the library's interrupt request (base/interrupt.h), at which the command unwinds
+// at its next check (a row, a tile, a chunk of a file, a node of the BVH) and exits 130, having
+// written nothing. A stage that cannot be interrupted (a driver compiling a pipeline, say) is not
+// waited for past kGrace: the thread then removes the temporary outputs and ends the process itself,
+// with the same exit code and message.
 #pragma once
 
-#include <poll.h>
-#include <signal.h>
-#include <sys/signalfd.h>
-#include <unistd.h>
+#include <atomic>
+#include <chrono>
+#include <string>
+#include <thread>
 
-namespace vkray {
+namespace vkray::cli {
 
-// Blocks SIGINT and SIGTERM while it exists; restores the signal mask when destroyed.
 class StopSignals {
  public:
-  StopSignals() {
-    sigemptyset(&set_);
-    sigaddset(&set_, SIGINT);
-    sigaddset(&set_, SIGTERM);
-    sigprocmask(SIG_BLOCK, &set_, &previous_);
-    fd_ = signalfd(-1, &set_, SFD_CLOEXEC | SFD_NONBLOCK);
-  }
-  ~StopSignals() {
-    // Consume the signals that stopped us: left pending, they would be delivered (and kill the
-    // process) the moment the mask is restored.
-    signalfd_siginfo info;
-    while (::read(fd_, &info, sizeof info) == sizeof info) {
-    }
-    ::close(fd_);
-    sigprocmask(SIG_SETMASK, &previous_, nullptr);
-  }
-  int fd() const { return fd_; }
-  bool pending() const {
-    pollfd p{fd_, POLLIN, 0};
-    return ::poll(&p, 1, 0) > 0;
-  }
+  static constexpr std::chrono::milliseconds kGrace{700};
+
+  StopSignals();
+  ~StopSignals();  // stops the thread; the signals stay blocked until the process ends
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+  // What a forced exit reports: by default exit 130, "interrupted; no image written". `vkray watch`,
+  // which Ctrl-C ends normally, exits 0.
+  void set_forced_exit(int exit_code, std::string message);
 
  private:
-  sigset_t set_{}, previous_{};
-  int fd_ = -1;
+  void run();
+
+  int signal_fd_ = -1;
+  int done_fd_ = -1;  // readable once the command has ended
+  std::atomic<int> exit_code_;
+  std::string message_;  // written before the thread can read it (set_forced_exit runs before any signal matters)
+  std::thread thread_;
 };
 
-}  // namespace vkray
+}  // namespace vkray::cli

@@ -9,12 +9,12 @@
 #include <vector>
 
 #include "base/errors.h"
+#include "base/interrupt.h"
 #include "base/timing.h"
 #include "cli/commands.h"
 #include "cli/file_watcher.h"
 #include "cli/flags.h"
 #include "cli/report.h"
-#include "cli/stop_signals.h"
 #include "image/image.h"
 #include "session/failure.h"
 #include "session/paths.h"
@@ -69,7 +69,6 @@ class Watch {
   void watch_current_files();
 
   const WatchArgs& args_;
-  const StopSignals stop_;
   const std::filesystem::path scene_file_;
   const std::filesystem::path output_;
   SessionOptions session_options_;
@@ -91,7 +90,6 @@ Watch::Watch(const WatchArgs& args)
   check_output_path(output_);  // before the device: a typo costs nothing
   session_options_.shader_dir = absolute_normal(session_options_.shader_dir.empty() ? default_shader_dir()
                                                                                    : session_options_.shader_dir);
-  options_.cancel = [this] { return stop_.pending(); };
   session_ = std::make_unique<Session>(session_options_);
   std::cerr << "vkray: device " << session_->device_description() << (args.device.validate ? ", validation on" : "")
             << "\n";
@@ -106,6 +104,8 @@ std::string Watch::reload_scene() {
     scene_ = std::move(loaded);
     on_device_ = std::move(uploaded);  // the old one goes whenever no render holds it any more
     scene_broken_ = false;
+  } catch (const Cancelled&) {  // Ctrl-C: watching ends
+    throw;
   } catch (const DeviceLostError&) {
     throw;
   } catch (const TimeoutError&) {  // a timed-out tile still runs: not the scene's fault
@@ -118,6 +118,8 @@ std::string Watch::reload_scene() {
   }
   try {
     if (session_->has_shaders()) prepare_pipeline();
+  } catch (const Cancelled&) {  // Ctrl-C: watching ends
+    throw;
   } catch (const DeviceLostError&) {
     throw;
   } catch (...) {  // the shaders do not compile with the scene's generated code
@@ -136,6 +138,8 @@ std::string Watch::compile_shaders() {
     const double prepare_seconds = on_device_ ? prepare_pipeline() : 0.0;
     return "compile " + format_ms((compiled.seconds + prepare_seconds) * 1e3) +
            (compiled.spirv_changed ? "" : " (SPIR-V unchanged)");
+  } catch (const Cancelled&) {  // Ctrl-C: watching ends
+    throw;
   } catch (const DeviceLostError&) {
     throw;
   } catch (...) {  // a compile error, a binding declared otherwise, a validation message
@@ -205,7 +209,7 @@ int Watch::run() {
               << " folders; Ctrl-C to stop\n";
 
     for (uint32_t reload = 1; !args_.exit_after || reload <= *args_.exit_after; ++reload) {
-      const std::vector<std::filesystem::path> changed = watcher_.wait(std::chrono::milliseconds(50), stop_.fd());
+      const std::vector<std::filesystem::path> changed = watcher_.wait(std::chrono::milliseconds(50), interrupt_fd());
       if (changed.empty()) break;  // SIGINT or SIGTERM
       const bool scene_changed = std::any_of(changed.begin(), changed.end(), [&](const auto& f) { return is_scene_file(f); });
       const bool shader_changed = std::any_of(changed.begin(), changed.end(), [&](const auto& f) { return !is_scene_file(f); });
@@ -258,7 +262,7 @@ Command add_watch_command(CLI::App& app) {
                    "Stop after N reloads (each change that was acted on counts, failed or not); for tests and scripts")
       ->check(CLI::Range(1, 1000000));
   command->footer(kExitCodes);
-  return {command, [args] { return Watch(*args).run(); }};
+  return {command, [args] { return Watch(*args).run(); }, kExitOk, "stopped"};
 }
 
 }  // namespace vkray::cli

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "base/errors.h"
+#include "base/interrupt.h"
 #include "bvh/bvh.h"
 #include "scene/camera.h"
 #include "shared/types.h"
@@ -227,6 +228,10 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
     uint64_t rays = 0;
     for (uint32_t j; !cancelled && (j = next_row++) < settings.height;) {
       for (uint32_t i = 0; i < settings.width; ++i) {
+        if (interrupt_requested()) {  // per pixel: a row of many samples can take seconds
+          cancelled = true;
+          break;
+        }
         const uint32_t index = j * settings.width + i;
         uint64_t signature = 0xcbf29ce484222325ull;
         dvec3 sum(0.0);
@@ -240,10 +245,9 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
         result.image.pixels[index] = glm::vec3(sum / double(settings.samples_per_pixel));
         result.signatures[index] = signature;
       }
-      if (options.progress || options.cancel) {
+      if (options.progress && !cancelled) {
         std::lock_guard lock(progress_mutex);
-        if (options.progress) options.progress(++rows_done, settings.height);
-        if (options.cancel && options.cancel()) cancelled = true;
+        options.progress(++rows_done, settings.height);
       }
     }
     total_rays += rays;

@@ -23,9 +23,8 @@ struct ReferenceOptions {
   const Bvh* bvh = nullptr;  // a BVH already built for this scene; null: build one
   bool shadows = true;   // false: no shadow rays, every light counts as visible (benchmarks)
   std::function<void(uint32_t rows_done, uint32_t rows)> progress;  // called under a lock
-  // Asked after each row, under the same lock; when it returns true the threads stop and
-  // render_reference throws Cancelled.
-  std::function<bool()> cancel;
+  // On an interrupt request (base/interrupt.h) the threads stop and render_reference throws
+  // Cancelled.
 };
 
 struct ReferenceResult {

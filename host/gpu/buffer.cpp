@@ -53,7 +53,7 @@ Buffer upload_buffer(const Context& ctx, const void* data, vk::DeviceSize size, 
   ctx.queue().submit(vk::SubmitInfo({}, {}, raw), *fence);
   try {
     ctx.wait(fence, std::chrono::seconds(60), "a buffer upload");
-  } catch (const TimeoutError&) {
+  } catch (...) {  // timed out or interrupted
     // The copy may still run: leave everything it uses to the process (Context::abandon_work()).
     for (auto* buffer : {&staging, &target}) {
       static_cast<void>(buffer->buffer.release());

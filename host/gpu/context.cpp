@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "base/errors.h"
+#include "base/interrupt.h"
 
 namespace vkray::gpu {
 namespace {
@@ -208,10 +209,17 @@ uint32_t Context::memory_type(uint32_t type_bits, vk::MemoryPropertyFlags requir
 }
 
 void Context::wait(const vk::raii::Fence& fence, std::chrono::milliseconds timeout, const char* what) const {
-  const auto ns = static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count());
-  const vk::Result result = device_.waitForFences({*fence}, VK_TRUE, ns);
-  if (result == vk::Result::eTimeout)
-    throw TimeoutError(std::string("vkWaitForFences: ") + what + " did not finish within " +
+  // In slices, so that a Ctrl-C is seen within one even while a long tile runs.
+  constexpr auto kSlice = std::chrono::milliseconds(50);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    throw_if_interrupted();
+    const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - std::chrono::steady_clock::now());
+    const auto slice = std::clamp(left, std::chrono::nanoseconds(0), std::chrono::nanoseconds(kSlice));
+    if (device_.waitForFences({*fence}, VK_TRUE, uint64_t(slice.count())) != vk::Result::eTimeout) return;
+    if (slice < kSlice) break;
+  }
+  throw TimeoutError(std::string("vkWaitForFences: ") + what + " did not finish within " +
                        std::to_string(timeout.count()) + " ms (VK_TIMEOUT)");
 }
 

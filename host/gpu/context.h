@@ -52,7 +52,8 @@ class Context {
   uint32_t memory_type(uint32_t type_bits, vk::MemoryPropertyFlags required,
                        vk::MemoryPropertyFlags preferred = {}) const;
 
-  // Waits for a fence with a finite timeout; throws TimeoutError naming `what` on timeout.
+  // Waits for a fence with a finite timeout; throws TimeoutError naming `what` on timeout, and
+  // Cancelled on an interrupt request (base/interrupt.h). Either way the work may still run.
   void wait(const vk::raii::Fence& fence, std::chrono::milliseconds timeout, const char* what) const;
 
   // Says that work submitted to this device may still be running and will never be waited for

@@ -6,6 +6,7 @@
 
 #include "base/checked.h"
 #include "base/errors.h"
+#include "base/interrupt.h"
 #include "base/timing.h"
 #include "gpu/buffer.h"
 #include "packing/scene_packing.h"
@@ -126,13 +127,13 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     ctx_->queue().submit(vk::SubmitInfo({}, {}, raw), *frame->fence);
     try {
       ctx_->wait(frame->fence, request.tile_timeout, "a render tile");
-    } catch (const TimeoutError&) {
+    } catch (...) {  // timed out or interrupted: the tile may still run
       abandoned_.push_back(std::move(frame));  // kept until the device is done with it
       throw;
     }
     device.resetFences(*frame->fence);
     if (request.progress) request.progress(tile_index + 1, tile_count);
-    if (request.cancel && tile_index + 1 < tile_count && request.cancel()) throw Cancelled();
+    if (tile_index + 1 < tile_count) throw_if_interrupted();
   }
   stats.trace_seconds = seconds_since(start);
   stats.tiles = tile_count;

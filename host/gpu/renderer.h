@@ -27,8 +27,6 @@ struct TraceRequest {
   uint32_t tile_side = 0;
   // Called after each tile with (tiles done, tiles in all).
   std::function<void(uint32_t, uint32_t)> progress;
-  // Asked between tiles; when it returns true the render stops and throws Cancelled.
-  std::function<bool()> cancel;
 };
 
 struct TraceStats {
@@ -48,10 +46,11 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Renders `scene` with `pipeline`'s variant for the request. Throws Cancelled (nothing left in
-  // flight), TimeoutError when a tile outlives request.tile_timeout (its work may go on: what it
-  // uses is kept until it finishes, and the next render first waits up to its own tile timeout for
-  // it), and DeviceError or vk::SystemError for failed calls.
+  // Renders `scene` with `pipeline`'s variant for the request. Throws TimeoutError when a tile
+  // outlives request.tile_timeout (its work may go on: what it uses is kept until it finishes, and
+  // the next render first waits up to its own tile timeout for it), Cancelled on an interrupt
+  // request (a tile still running is kept the same way), and DeviceError or vk::SystemError for
+  // failed calls.
   Image render(std::shared_ptr<const TracePipeline> pipeline, std::shared_ptr<const GpuScene> scene,
                const TraceRequest& request, TraceStats* stats = nullptr);
 

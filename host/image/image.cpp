@@ -16,6 +16,7 @@
 #include <png.h>
 
 #include "base/errors.h"
+#include "base/interrupt.h"
 
 namespace vkray {
 namespace {
@@ -35,6 +36,7 @@ class AtomicFile {
     const int fd = mkstemp(pattern.data());
     if (fd < 0) throw OutputError(target_.string() + ": cannot create file: " + std::strerror(errno));
     temp_ = pattern;
+    register_temporary_file(temp_);  // removed even by a forced exit after Ctrl-C
     file_ = fdopen(fd, "wb");
     if (!file_) {
       ::close(fd);
@@ -49,6 +51,7 @@ class AtomicFile {
     if (!committed_) {
       std::error_code ec;
       std::filesystem::remove(temp_, ec);
+      unregister_temporary_file(temp_);
     }
   }
   FILE* get() { return file_; }
@@ -62,9 +65,12 @@ class AtomicFile {
     if (::chmod(temp_.c_str(), 0666 & ~mask) != 0 && !write_failed && !close_failed)
       throw OutputError(target_.string() + ": cannot set file mode: " + std::strerror(errno));
     if (write_failed || close_failed) throw OutputError(target_.string() + ": write failed: " + std::strerror(errno));
-    std::error_code ec;
-    std::filesystem::rename(temp_, target_, ec);
-    if (ec) throw OutputError(target_.string() + ": cannot rename into place: " + ec.message());
+    // Not after an interrupt request: a command stopped by Ctrl-C writes nothing.
+    commit_unless_interrupted(temp_, [this] {
+      std::error_code ec;
+      std::filesystem::rename(temp_, target_, ec);
+      if (ec) throw OutputError(target_.string() + ": cannot rename into place: " + ec.message());
+    });
     committed_ = true;
   }
 
@@ -74,19 +80,49 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-void write_png(const Image& image, const std::filesystem::path& file) {
-  std::vector<uint8_t> bytes(size_t(image.width) * image.height * 3);
-  for (size_t i = 0; i < image.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) bytes[i * 3 + size_t(c)] = encode_srgb8(image.pixels[i][c]);
+// libpng reports errors through longjmp; this handler turns them into a message instead.
+[[noreturn]] void png_failed(png_structp png, png_const_charp message) {
+  auto* error = static_cast<std::string*>(png_get_error_ptr(png));
+  *error = message;
+  png_longjmp(png, 1);
+}
 
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  png.width = image.width;
-  png.height = image.height;
-  png.format = PNG_FORMAT_RGB;  // 8-bit sRGB: libpng writes the sRGB chunk
+// Row by row, so that a Ctrl-C stops even a 16384x16384 image within a row (the whole image takes
+// seconds to compress). `row` is made before the setjmp and outlives any jump back to it.
+bool encode_png(const Image& image, FILE* out, std::string& error) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_failed, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!info) {
+    png_destroy_write_struct(&png, nullptr);
+    error = "out of memory";
+    return false;
+  }
+  std::vector<png_byte> row(size_t(image.width) * 3);
+  bool interrupted = false;
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_init_io(png, out);
+  png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);  // the chunk libpng's simplified writer wrote
+  png_write_info(png, info);
+  for (uint32_t y = 0; y < image.height && !(interrupted = interrupt_requested()); ++y) {
+    for (uint32_t x = 0; x < image.width; ++x)
+      for (int c = 0; c < 3; ++c) row[size_t(x) * 3 + size_t(c)] = encode_srgb8(image.at(x, y)[c]);
+    png_write_row(png, row.data());
+  }
+  if (!interrupted) png_write_end(png, info);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+void write_png(const Image& image, const std::filesystem::path& file) {
   AtomicFile out(file);
-  if (!png_image_write_to_stdio(&png, out.get(), 0, bytes.data(), 0, nullptr))
-    throw OutputError(file.string() + ": PNG write failed: " + png.message);
+  std::string error;
+  if (!encode_png(image, out.get(), error)) throw OutputError(file.string() + ": PNG write failed: " + error);
+  throw_if_interrupted();
   out.commit();
 }
 
@@ -94,8 +130,10 @@ void write_pfm(const Image& image, const std::filesystem::path& file) {
   static_assert(std::endian::native == std::endian::little, "PFM writer assumes a little-endian host");
   AtomicFile out(file);
   std::fprintf(out.get(), "PF\n%u %u\n-1.0\n", image.width, image.height);
-  for (uint32_t row = image.height; row-- > 0;)  // PFM stores the bottom row first
+  for (uint32_t row = image.height; row-- > 0;) {  // PFM stores the bottom row first
+    throw_if_interrupted();
     std::fwrite(&image.at(0, row), sizeof(glm::vec3), image.width, out.get());
+  }
   out.commit();
 }
 

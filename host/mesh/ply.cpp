@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "base/errors.h"
+#include "base/interrupt.h"
 
 namespace vkray {
 namespace {
@@ -368,6 +369,7 @@ Mesh parse_ply(std::string_view bytes, const std::filesystem::path& file) {
   for (const Element& element : header.elements) {
     values.assign(element.properties.size(), 0.0);
     for (uint64_t index = 0; index < element.count; ++index) {
+      if (index % 4096 == 0) throw_if_interrupted();
       in.begin(element, index);
       polygon.clear();
       for (size_t p = 0; p < element.properties.size(); ++p) {

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "base/check.h"
+#include "base/interrupt.h"
 #include "scene/camera.h"
 
 namespace vkray::gpu {
@@ -153,6 +154,7 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
   packed.primitives.reserve(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);
   if (any_smooth) packed.normals.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
   for (size_t slot = 0; slot < bvh.order.size(); ++slot) {
+    if (slot % 4096 == 0) throw_if_interrupted();
     const uint32_t p = bvh.order[slot];
     PrimitiveTexels texels;
     if (p < triangle_count) {

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "base/errors.h"
+#include "base/interrupt.h"
 
 namespace vkray {
 namespace {
@@ -18,6 +19,7 @@ class Structure {
   explicit Structure(const std::filesystem::path& file) : file_(file) {}
 
   bool on_event(json::parse_event_t event, const json& parsed) {
+    if (++events_ % 65536 == 0) throw_if_interrupted();  // a 64 MiB file takes a second or two
     switch (event) {
       case json::parse_event_t::object_start:
       case json::parse_event_t::array_start:
@@ -64,6 +66,7 @@ class Structure {
 
   const std::filesystem::path& file_;
   std::vector<Frame> frames_;
+  size_t events_ = 0;
 };
 
 // "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error ..." -> "syntax error ..."

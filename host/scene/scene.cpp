@@ -13,6 +13,7 @@
 
 #include "base/errors.h"
 #include "base/input_file.h"
+#include "base/interrupt.h"
 #include "mesh/load.h"
 #include "mesh/normals.h"
 #include "scene/json_document.h"
@@ -269,6 +270,7 @@ glm::mat4 SceneParser::parse_transform(const Value& v) {
 }
 
 void SceneParser::parse_object(const Value& v) {
+  throw_if_interrupted();
   expect_object(v);
   const Value type_value = require(v, "type");
   const std::string type = string(type_value);
@@ -344,9 +346,11 @@ void SceneParser::check_primitive_count(const Value& where, size_t adding) const
 }
 
 void SceneParser::add_triangles(const Value& where, std::vector<Triangle>& triangles) {
-  for (size_t i = 0; i < triangles.size(); ++i)
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    if (i % 4096 == 0) throw_if_interrupted();  // a mesh of millions takes a while to place
     for (const glm::vec3& p : triangles[i].v)
       check_coordinates(where, p, ("triangle " + std::to_string(i) + " (after the transform)").c_str());
+  }
   const auto degenerate = [](const Triangle& t) { return glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f; };
   const size_t left_out = size_t(std::count_if(triangles.begin(), triangles.end(), degenerate));
   check_primitive_count(where, triangles.size() - left_out);

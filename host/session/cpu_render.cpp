@@ -19,7 +19,6 @@ RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, con
   reference_options.shadows = options.shadows;
   if (options.progress)
     reference_options.progress = [&options](uint32_t done, uint32_t total) { options.progress("rows", done, total); };
-  reference_options.cancel = options.cancel;
   cpu::ReferenceResult reference = cpu::render_reference(scene, image_settings(scene, options), reference_options);
   RenderResult result;
   result.image = std::move(reference.image);

@@ -11,7 +11,7 @@
 namespace vkray {
 struct Bvh;
 
-// Throws Cancelled when options.cancel asks (between rows), UsageError for an override out of range.
+// Throws Cancelled on an interrupt request (base/interrupt.h), UsageError for an override out of range.
 // `bvh`: one already built for the scene; null builds one (its time is part of the trace).
 // `signatures`: where to put each pixel's record of what its samples saw (cpu/reference.h), for
 // parity's edge detection.

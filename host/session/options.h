@@ -43,9 +43,7 @@ struct RenderOptions {
   // Called as the render proceeds with the unit ("tiles" on the GPU, "rows" on the CPU), the units
   // done and the units in all.
   std::function<void(const char* unit, uint32_t done, uint32_t total)> progress;
-  // Asked between units; when it returns true the render stops with Cancelled, and nothing is left
-  // running.
-  std::function<bool()> cancel;
+  // A render stops on an interrupt request (base/interrupt.h) and throws Cancelled.
 };
 
 // The scene's image settings with the options' overrides. Throws UsageError for an override out of

@@ -150,7 +150,6 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
   request.tile_side = options.tile_side;
   if (options.progress)
     request.progress = [&options](uint32_t done, uint32_t total) { options.progress("tiles", done, total); };
-  request.cancel = options.cancel;
   prepare(scene, options);  // nothing to do when prepared before
   gpu::TraceStats trace;
   RenderResult result;

@@ -1,0 +1,61 @@
+#include "cli/stop_signals.h"
+
+#include <poll.h>
+#include <signal.h>
+#include <sys/eventfd.h>
+#include <sys/signalfd.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdlib>
+
+#include "base/errors.h"
+#include "base/interrupt.h"
+
+namespace vkray::cli {
+
+StopSignals::StopSignals() : exit_code_(kExitInterrupted), message_("vkray: interrupted; no image written\n") {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  // Every thread created after this (the driver's, the CPU reference's) inherits the mask.
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  signal_fd_ = signalfd(-1, &set, SFD_CLOEXEC);
+  done_fd_ = eventfd(0, EFD_CLOEXEC);
+  thread_ = std::thread([this] { run(); });
+}
+
+StopSignals::~StopSignals() {
+  const uint64_t one = 1;
+  [[maybe_unused]] const ssize_t written = ::write(done_fd_, &one, sizeof one);
+  thread_.join();
+  ::close(signal_fd_);
+  ::close(done_fd_);
+}
+
+void StopSignals::set_forced_exit(int exit_code, std::string message) {
+  exit_code_ = exit_code;
+  message_ = "vkray: " + message + "\n";
+}
+
+void StopSignals::run() {
+  pollfd fds[] = {{signal_fd_, POLLIN, 0}, {done_fd_, POLLIN, 0}};
+  while (::poll(fds, 2, -1) < 0) {
+  }
+  if (fds[1].revents != 0) return;  // the command ended without a signal
+  signalfd_siginfo info;
+  [[maybe_unused]] const ssize_t got = ::read(signal_fd_, &info, sizeof info);
+  request_interrupt();
+  // The command now unwinds; give it kGrace to do so.
+  pollfd done{done_fd_, POLLIN, 0};
+  int ready;
+  while ((ready = ::poll(&done, 1, int(kGrace.count()))) < 0) {
+  }
+  if (ready > 0) return;
+  remove_temporary_files();
+  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, message_.data(), message_.size());
+  std::_Exit(exit_code_);
+}
+
+}  // namespace vkray::cli

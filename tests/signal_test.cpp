@@ -1,0 +1,122 @@
+// Ctrl-C and SIGTERM (README, "Robustness"): every command stops within a second, whatever stage the
+// signal finds it in (reading the scene and its meshes, compiling, building the BVH, tracing on the
+// GPU or the CPU, writing), exits 130, and leaves the output folder as it was: no new file, no
+// temporary file, an existing output untouched. `vkray watch` is the exception: Ctrl-C is how it
+// ends, with exit 0 (watch_test.cpp).
+#include <signal.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <thread>
+#include <tuple>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "support/child_process.h"
+#include "support/temp_dir.h"
+
+namespace vkray::test {
+namespace {
+
+const std::string kScenes = VKRAY_SCENE_DIR;
+constexpr const char* kOldOutput = "an image from before";
+
+std::string read_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+// The folder holds only out.png, as it was before the command ran.
+void expect_untouched(const TempDir& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) names.push_back(entry.path().filename().string());
+  EXPECT_EQ(names, std::vector<std::string>{"out.png"});
+  EXPECT_EQ(read_file(dir / "out.png"), kOldOutput) << "the existing output was overwritten";
+}
+
+// Runs `argv` in a folder that already has an out.png, sends `sig` after `delay`, and expects the
+// command to stop within a second of it with exit 130, leaving the folder as it was; or, if the
+// command had finished before the signal, exit 0.
+void expect_stops(const std::vector<std::string>& argv, std::chrono::milliseconds delay, int sig) {
+  TempDir dir;
+  std::ofstream(dir / "out.png") << kOldOutput;
+  ChildProcess child(argv, dir.path().string());
+  std::this_thread::sleep_for(delay);
+  child.signal(sig);
+  const auto sent = std::chrono::steady_clock::now();
+  const auto code = child.wait_exit(std::chrono::seconds(30));
+  const auto took = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - sent);
+  ASSERT_TRUE(code.has_value()) << "still running 30 s after the signal:\n" << child.all_output();
+  if (*code == 0) return;  // done before the signal arrived: a complete output is right
+  EXPECT_EQ(*code, 130) << child.all_output();
+  EXPECT_LT(took.count(), 1000) << "stopped " << took.count() << " ms after the signal:\n" << child.all_output();
+  EXPECT_NE(child.all_output().find("interrupted; no image written"), std::string::npos) << child.all_output();
+  expect_untouched(dir);
+}
+
+// dragon-field.json (2 million triangles) spends about 0.5 s loading, 0.2 s compiling, 3 s building
+// its BVH and 0.3 s tracing on lavapipe, so these delays find each command in every stage.
+const std::vector<int> kDelaysMs = {30, 150, 400, 800, 1500, 3000};
+
+using Case = std::tuple<std::string, int>;  // command, delay in ms
+
+class SignalTest : public ::testing::TestWithParam<Case> {};
+
+std::vector<std::string> command(const std::string& name) {
+  const std::string scene = kScenes + "/dragon-field.json";
+  if (name == "render_gpu") return {VKRAY_EXECUTABLE, "render", scene, "-o", "out.png"};
+  if (name == "render_cpu") return {VKRAY_EXECUTABLE, "render", scene, "--renderer", "cpu", "-o", "out.png"};
+  return {VKRAY_EXECUTABLE, "parity", scene, "--diff", "out.png"};
+}
+
+TEST_P(SignalTest, StopsWithinASecondWritingNothing) {
+  const auto& [name, delay] = GetParam();
+  // SIGINT and SIGTERM take one path: alternate them.
+  expect_stops(command(name), std::chrono::milliseconds(delay), delay % 2 ? SIGTERM : SIGINT);
+}
+
+std::vector<Case> cases() {
+  std::vector<Case> result;
+  for (const char* name : {"render_gpu", "render_cpu", "parity"})
+    for (const int delay : kDelaysMs) result.emplace_back(name, delay + (result.size() % 2));
+  return result;
+}
+
+INSTANTIATE_TEST_SUITE_P(Commands, SignalTest, ::testing::ValuesIn(cases()), [](const auto& param) {
+  return std::get<0>(param.param) + "_after_" + std::to_string(std::get<1>(param.param)) + "ms";
+});
+
+TEST(SignalTest, BenchStopsWithinASecond) {
+  for (const int delay : {100, 1000}) expect_stops({VKRAY_EXECUTABLE, "bench", "--repeat", "1"}, std::chrono::milliseconds(delay), SIGINT);
+}
+
+// Renders the teapot large with `renderer`, sends SIGINT once a progress line with `progress`
+// shows it rendering, and expects exit 130 with nothing written.
+void expect_sigint_stops_the_render(const std::string& renderer, const std::string& progress) {
+  TempDir dir;
+  std::ofstream(dir / "out.png") << kOldOutput;
+  ChildProcess child({VKRAY_EXECUTABLE, "render", kScenes + "/teapot.json", "--renderer", renderer, "--width", "2048",
+                      "--height", "2048", "--spp", "16", "-o", "out.png"},
+                     dir.path().string());
+  ASSERT_TRUE(child.wait_for_line(progress, std::chrono::seconds(60))) << child.all_output();
+  child.signal(SIGINT);
+  const auto code = child.wait_exit(std::chrono::seconds(60));
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 130) << child.all_output();
+  EXPECT_NE(child.all_output().find("interrupted; no image written"), std::string::npos) << child.all_output();
+  expect_untouched(dir);
+}
+
+TEST(SignalTest, SigintDuringAGpuRenderExitsCleanlyAndWritesNothing) { expect_sigint_stops_the_render("gpu", "tracing"); }
+
+TEST(SignalTest, SigintDuringACpuRenderExitsCleanlyAndWritesNothing) {
+  // The CPU reference stops within a pixel as the GPU path stops within a tile.
+  expect_sigint_stops_the_render("cpu", "rows)");
+}
+
+}  // namespace
+}  // namespace vkray::test
