@@ -27,13 +27,17 @@ bool has_image_files(const std::filesystem::path& dir) { return !std::filesystem
 
 const std::string kScenes = VKRAY_SCENE_DIR;
 
+void expect_png_size(const std::filesystem::path& file, uint32_t width, uint32_t height) {
+  const Image image = read_png(file);
+  EXPECT_EQ(image.width, width);
+  EXPECT_EQ(image.height, height);
+}
+
 TEST(CliTest, RendersTheDefaultSceneToSceneNamePng) {
   TempDir dir;
   const Result run = vkray("render --validate --width 64 --height 48", dir.path());
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  const Image image = read_png(dir / "cornell.png");
-  EXPECT_EQ(image.width, 64u);
-  EXPECT_EQ(image.height, 48u);
+  expect_png_size(dir / "cornell.png", 64, 48);
   // stderr reports the device, every phase and the ray rate.
   for (const char* word : {"device ", "load ", "compile ", "upload ", "trace ", "read back ", "write ", "Mrays/s", "wrote cornell.png"})
     EXPECT_NE(run.err.find(word), std::string::npos) << word << " missing from:\n" << run.err;
@@ -259,6 +263,63 @@ TEST(CliTest, ImageTooLargeForTheDeviceExitsThreeNamingTheLimit) {
   EXPECT_NE(run.err.find("image too large"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("maxStorageBufferRange"), std::string::npos) << run.err;
   EXPECT_FALSE(has_image_files(dir.path()));
+}
+
+// Option values follow one rule per type (cli/flags.h): integers are decimal ("0100" is 100, never
+// octal 64; "0x40" is refused), and no text value may be empty (`render ""` was the default scene).
+TEST(CliTest, IntegersAreDecimal) {
+  TempDir dir;
+  const Result run = vkray("render --width 0100 --height 00064 --spp 010 -q -o out.png", dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  expect_png_size(dir / "out.png", 100, 64);
+  for (const char* value : {"0x40", "+5", "-5", "1e2", "64px", "' 64'"}) {
+    const Result bad = vkray(std::string("render --width ") + value + " -o bad.png", dir.path());
+    EXPECT_EQ(bad.exit_code, 2) << value;
+    EXPECT_NE(bad.err.find("--width: expected a decimal integer"), std::string::npos) << bad.err;
+  }
+  EXPECT_EQ(vkray("bench --repeat 0x2", dir.path()).exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.png"));
+}
+
+TEST(CliTest, EmptyValuesAreRefused) {
+  TempDir dir;
+  for (const char* args : {"render ''", "render -o ''", "render --shader-dir '' -o x.png", "render --device '' -o x.png",
+                           "parity --diff ''", "watch ''", "bench --scenes ''"}) {
+    const Result run = vkray(args, dir.path());
+    EXPECT_EQ(run.exit_code, 2) << args << ": " << run.err;
+    EXPECT_NE(run.err.find("the value is empty"), std::string::npos) << args << ": " << run.err;
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
+TEST(CliTest, AnUnknownCommandIsNamed) {
+  TempDir dir;
+  const Result run = vkray("rendr scene.json", dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("unknown command \"rendr\" (commands: render, parity, watch, bench, devices)"), std::string::npos)
+      << run.err;
+}
+
+TEST(CliTest, MessagesQuoteArgumentsPrintably) {
+  TempDir dir;
+  for (const char* args : {"$(printf 'x\\033[2Jy')", "render --width $(printf '\\033]0;x\\007')",
+                           "render $(printf 'a\\033[31m.json')"}) {
+    const Result run = vkray(args, dir.path());
+    EXPECT_NE(run.exit_code, 0) << args;
+    EXPECT_EQ(run.err.find('\x1b'), std::string::npos) << args << ": " << run.err;
+    EXPECT_EQ(run.err.find('\x07'), std::string::npos) << args << ": " << run.err;
+    EXPECT_NE(run.err.find('?'), std::string::npos) << args << ": " << run.err;
+  }
+}
+
+// A reader that closes stderr early (`| head -1`) killed the render with SIGPIPE halfway.
+TEST(CliTest, AClosedStderrDoesNotStopARender) {
+  TempDir dir;
+  // The shell waits for both ends of the pipe; its status is head's, so the image tells.
+  const std::string command = "cd '" + dir.path().string() + "' && '" VKRAY_EXECUTABLE
+                              "' render --width 64 --height 64 -o out.png 2>&1 | head -c 1 >/dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  expect_png_size(dir / "out.png", 64, 64);
 }
 
 TEST(CliTest, VersionNamesTheCommitItWasBuiltFrom) {

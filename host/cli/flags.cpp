@@ -1,6 +1,9 @@
 #include "cli/flags.h"
 
+#include <algorithm>
 #include <map>
+
+#include "base/errors.h"
 
 #include "session/paths.h"
 
@@ -50,6 +53,28 @@ void add_gpu_flags(CLI::App& command, GpuFlags& flags) {
 
 void add_cpu_flags(CLI::App& command, CpuFlags& flags, const std::string& description) {
   command.add_option("--threads", flags.threads, description)->check(CLI::Range(1, 256));
+}
+
+void apply_value_rules(CLI::App& app) {
+  const CLI::Validator decimal(
+      [](std::string& value) -> std::string {
+        if (value.empty() || value.find_first_not_of("0123456789") != std::string::npos)
+          return "expected a decimal integer, got \"" + printable(value) + "\"";
+        value.erase(0, std::min(value.find_first_not_of('0'), value.size() - 1));
+        return "";
+      },
+      "");
+  const CLI::Validator not_empty([](std::string& value) { return value.empty() ? "the value is empty" : ""; }, "");
+  for (CLI::App* command : app.get_subcommands({})) {
+    apply_value_rules(*command);
+    for (CLI::Option* option : command->get_options()) {
+      if (option->get_expected_min() == 0) continue;  // a flag
+      // "UINT", or "UINT:INT in [1 - 16384]" with a range check.
+      const std::string type = option->get_type_name().substr(0, option->get_type_name().find(':'));
+      if (type == "INT" || type == "UINT") option->transform(decimal);
+      else if (type == "TEXT") option->check(not_empty);
+    }
+  }
 }
 
 std::filesystem::path scene_file(const SceneFlags& flags) { return flags.scene.empty() ? default_scene() : flags.scene; }

@@ -40,6 +40,12 @@ void add_device_flags(CLI::App& command, DeviceFlags& flags, bool validate = tru
 void add_gpu_flags(CLI::App& command, GpuFlags& flags);
 void add_cpu_flags(CLI::App& command, CpuFlags& flags, const std::string& description);
 
+// Rules every option value follows, set once for all commands by the option's type, so that no
+// option can miss them: an integer is decimal digits (CLI11 alone reads "0100" as octal 64 and
+// "0x40" as hex; leading zeros are dropped, so "0100" is 100), and a text or path value is not
+// empty (`-o ""` is a mistake, not "the default").
+void apply_value_rules(CLI::App& app);
+
 // The scene file the flags name, or the default scene.
 std::filesystem::path scene_file(const SceneFlags& flags);
 SessionOptions session_options(const DeviceFlags& flags);

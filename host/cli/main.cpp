@@ -2,17 +2,13 @@
 // stderr and the documented exit code (session/failure.h).
 #include <cstdlib>
 #include <iostream>
-#include <vector>
-
-#include <CLI/CLI.hpp>
+#include <variant>
 
 #include "base/errors.h"
-#include "cli/commands.h"
-#include "cli/flags.h"
+#include "cli/command_line.h"
 #include "cli/stop_signals.h"
 #include "session/failure.h"
 #include "session/session.h"
-#include "session/version.h"
 
 namespace {
 
@@ -20,27 +16,13 @@ int run(int argc, char** argv) {
   using namespace vkray;
   // Ctrl-C and SIGTERM, for every command alike, from the first moment (before any thread exists).
   cli::StopSignals stop;
-  CLI::App app("vkray: a raytracer on Vulkan compute shaders, with a headless renderer for any Vulkan device "
-               "(lavapipe included).");
-  app.footer(cli::kExitCodes);
-  app.set_version_flag("--version", std::string("vkray ") + version_string());
-  app.require_subcommand(1);
-  const std::vector<cli::Command> commands = {cli::add_render_command(app), cli::add_parity_command(app),
-                                              cli::add_watch_command(app), cli::add_bench_command(app),
-                                              cli::add_devices_command(app)};
+  const auto line = cli::make_command_line();
+  const auto parsed = cli::parse_command_line(*line, argc, argv, std::cout, std::cerr);
+  if (std::holds_alternative<int>(parsed)) return std::get<int>(parsed);
+  const cli::Command& command = *std::get<const cli::Command*>(parsed);
+  stop.set_forced_exit(command.signal_exit_code, command.signal_message);
   try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help and --version are "errors" whose exit code is 0; CLI11's own codes for usage errors
-    // become the one documented code.
-    return app.exit(e) == 0 ? kExitOk : kExitUsage;
-  }
-  try {
-    for (const cli::Command& command : commands)
-      if (*command.app) {
-        stop.set_forced_exit(command.signal_exit_code, command.signal_message);
-        return command.run();
-      }
+    return command.run();
   } catch (...) {
     const Failure failure = describe_failure(std::current_exception());
     std::cerr << "vkray: " << failure.headline;
@@ -48,7 +30,6 @@ int run(int argc, char** argv) {
     std::cerr << "\n";
     return failure.exit_code;
   }
-  return kExitUsage;
 }
 
 }  // namespace
