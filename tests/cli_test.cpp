@@ -7,6 +7,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -320,6 +321,30 @@ TEST(CliTest, AClosedStderrDoesNotStopARender) {
                               "' render --width 64 --height 64 -o out.png 2>&1 | head -c 1 >/dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0);
   expect_png_size(dir / "out.png", 64, 64);
+}
+
+// Running out of resources (DECISIONS.md, issue 14): a clear message, exit 1, and never a partial
+// output file. `ulimit -f` makes the disk "full" partway through the PNG; `ulimit -v` makes host
+// memory run out for a large CPU render.
+TEST(CliTest, AFullDiskFailsTheWriteAndLeavesNoFile) {
+  TempDir dir;
+  ASSERT_EQ(vkray("render --renderer cpu --width 512 --height 512 -q -o out.png", dir.path()).exit_code, 0);
+  const Result run = run_vkray("render --renderer cpu --width 512 --height 512 -q -o out.png", dir.path(), "ulimit -f 4");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("out.png: PNG write failed: Write Error: File too large"), std::string::npos) << run.err;
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) names.push_back(entry.path().filename().string());
+  EXPECT_EQ(names, std::vector<std::string>{"out.png"}) << "a temporary file was left behind";
+  EXPECT_EQ(read_png(dir / "out.png").width, 512u);  // the first, complete render; not half of the second
+}
+
+TEST(CliTest, RunningOutOfHostMemoryExitsOne) {
+  TempDir dir;
+  const Result run =
+      run_vkray("render --renderer cpu --width 16384 --height 16384 -q -o big.png", dir.path(), "ulimit -v 2000000");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("out of host memory"), std::string::npos) << run.err;
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
 TEST(CliTest, VersionNamesTheCommitItWasBuiltFrom) {

@@ -21,9 +21,11 @@ StopSignals::StopSignals() : exit_code_(kExitInterrupted), message_("vkray: inte
   sigaddset(&set, SIGTERM);
   // Every thread created after this (the driver's, the CPU reference's) inherits the mask.
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
-  // A reader that closes its end of stderr (`vkray render ... 2>&1 | head -1`) must not kill a
-  // render halfway through writing its image: the write fails with EPIPE instead.
+  // Two signals would end the process halfway through writing its image, leaving the temporary
+  // file: a reader that closes its end of stderr (`vkray render ... 2>&1 | head -1`; the write
+  // fails with EPIPE instead) and a file past the size limit (`ulimit -f`; EFBIG, an OutputError).
   ::signal(SIGPIPE, SIG_IGN);
+  ::signal(SIGXFSZ, SIG_IGN);
   signal_fd_ = signalfd(-1, &set, SFD_CLOEXEC);
   done_fd_ = eventfd(0, EFD_CLOEXEC);
   thread_ = std::thread([this] { run(); });

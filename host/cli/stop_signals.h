@@ -4,7 +4,8 @@
 // at its next check (a row, a tile, a chunk of a file, a node of the BVH) and exits 130, having
 // written nothing. A stage that cannot be interrupted (a driver compiling a pipeline, say) is not
 // waited for past kGrace: the thread then removes the temporary outputs and ends the process itself,
-// with the same exit code and message. SIGPIPE is ignored, so a closed stderr never ends a command.
+// with the same exit code and message. SIGPIPE and SIGXFSZ are ignored: a closed stderr or a file
+// size limit fails a write, which is reported, instead of killing the process halfway.
 #pragma once
 
 #include <atomic>

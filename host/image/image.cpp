@@ -84,6 +84,8 @@ class AtomicFile {
 [[noreturn]] void png_failed(png_structp png, png_const_charp message) {
   auto* error = static_cast<std::string*>(png_get_error_ptr(png));
   *error = message;
+  // libpng's "Write Error" comes from a failed fwrite(): say why (a full disk, a size limit).
+  if (errno != 0) *error += std::string(": ") + std::strerror(errno);
   png_longjmp(png, 1);
 }
 
@@ -99,6 +101,7 @@ bool encode_png(const Image& image, FILE* out, std::string& error) {
   }
   std::vector<png_byte> row(size_t(image.width) * 3);
   bool interrupted = false;
+  errno = 0;
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
     return false;

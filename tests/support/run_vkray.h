@@ -12,6 +12,7 @@ struct CommandResult {
 };
 
 // `vkray ARGS` in `cwd`, with no standard input.
-CommandResult run_vkray(const std::string& args, const std::filesystem::path& cwd);
+// `limits`: shell commands run first in the same shell, e.g. "ulimit -f 4" (a full disk).
+CommandResult run_vkray(const std::string& args, const std::filesystem::path& cwd, const std::string& limits = "");
 
 }  // namespace vkray::test
