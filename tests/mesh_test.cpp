@@ -222,6 +222,33 @@ TEST_F(MeshFileTest, SceneMeshObjects) {
   EXPECT_EQ(scene.referenced_files[0], (dir_ / "tri.obj").lexically_normal());
 }
 
+// Policy (README, "Limits and robustness"): a mesh path may leave the scene's folder, by ".." or as
+// an absolute path, as a shared mesh library needs; vkray only reads what it names, and only a
+// regular file of bounded size.
+TEST_F(MeshFileTest, MeshPathsMayLeaveTheSceneFolder) {
+  std::filesystem::create_directory(dir_ / "library");
+  write("library/tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  std::filesystem::create_directory(dir_ / "scenes");
+  write("scenes/s.json", R"({"camera": {"position": [0, 0, -5], "direction": [0, 0, 1], "focal_length": 1},
+    "materials": {"m": {"albedo": [1, 1, 1]}},
+    "objects": [{"type": "mesh", "file": ")" + (dir_ / "library/tri.obj").string() + R"(", "material": "m"},
+                {"type": "mesh", "file": "../library/tri.obj", "material": "m"},
+                {"type": "mesh", "file": "/dev/zero", "material": "m"}]})");
+  try {
+    load_scene(dir_ / "scenes/s.json");
+    ADD_FAILURE() << "/dev/zero was read as a mesh";
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("/objects/2/file: /dev/zero: is a character device"), std::string::npos) << e.what();
+  }
+  write("scenes/s.json", R"({"camera": {"position": [0, 0, -5], "direction": [0, 0, 1], "focal_length": 1},
+    "materials": {"m": {"albedo": [1, 1, 1]}},
+    "objects": [{"type": "mesh", "file": ")" + (dir_ / "library/tri.obj").string() + R"(", "material": "m"},
+                {"type": "mesh", "file": "../library/tri.obj", "material": "m"}]})");
+  const Scene scene = load_scene(dir_ / "scenes/s.json");
+  EXPECT_EQ(scene.triangles.size(), 2u);
+  ASSERT_EQ(scene.referenced_files.size(), 1u);  // the same file by either path
+}
+
 TEST_F(MeshFileTest, SceneMeshErrorsNameTheKeyAndTheMeshProblem) {
   write("bad.obj", "v 0 0 0\nf 1 2 3\n");
   write("s.json", R"({"camera": {"position": [0, 0, -5], "direction": [0, 0, 1], "focal_length": 1},
