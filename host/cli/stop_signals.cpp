@@ -8,13 +8,14 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <string>
 
 #include "base/errors.h"
 #include "base/interrupt.h"
 
 namespace vkray::cli {
 
-StopSignals::StopSignals() : exit_code_(kExitInterrupted), message_("vkray: interrupted; no image written\n") {
+StopSignals::StopSignals() : exit_code_(kExitInterrupted), message_("interrupted; no image written") {
   sigset_t set;
   sigemptyset(&set);
   sigaddset(&set, SIGINT);
@@ -39,9 +40,9 @@ StopSignals::~StopSignals() {
   ::close(done_fd_);
 }
 
-void StopSignals::set_forced_exit(int exit_code, std::string message) {
+void StopSignals::set_forced_exit(int exit_code, const char* message) {
   exit_code_ = exit_code;
-  message_ = "vkray: " + message + "\n";
+  message_ = message;
 }
 
 void StopSignals::run() {
@@ -59,7 +60,8 @@ void StopSignals::run() {
   }
   if (ready > 0) return;
   remove_temporary_files();
-  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, message_.data(), message_.size());
+  const std::string line = std::string("vkray: ") + message_.load() + "\n";
+  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, line.data(), line.size());
   std::_Exit(exit_code_);
 }
 

@@ -10,14 +10,13 @@
 
 #include <atomic>
 #include <chrono>
-#include <string>
 #include <thread>
 
 namespace vkray::cli {
 
 class StopSignals {
  public:
-  static constexpr std::chrono::milliseconds kGrace{700};
+  static constexpr std::chrono::milliseconds kGrace{500};
 
   StopSignals();
   ~StopSignals();  // stops the thread; the signals stay blocked until the process ends
@@ -26,7 +25,8 @@ class StopSignals {
 
   // What a forced exit reports: by default exit 130, "interrupted; no image written". `vkray watch`,
   // which Ctrl-C ends normally, exits 0.
-  void set_forced_exit(int exit_code, std::string message);
+  // `message` is a string literal (it is read by the signal thread at any time).
+  void set_forced_exit(int exit_code, const char* message);
 
  private:
   void run();
@@ -34,7 +34,7 @@ class StopSignals {
   int signal_fd_ = -1;
   int done_fd_ = -1;  // readable once the command has ended
   std::atomic<int> exit_code_;
-  std::string message_;  // written before the thread can read it (set_forced_exit runs before any signal matters)
+  std::atomic<const char*> message_;
   std::thread thread_;
 };
 
