@@ -151,6 +151,20 @@ TEST_P(AdversarialParityTest, SmallSceneScale) { check(scaled(cornell(), 1e-3f),
 
 TEST_P(AdversarialParityTest, LargeSceneScale) { check(scaled(cornell(), 1e4f), "scale-1e4"); }
 
+// The largest scenes vkray accepts (scene.h, kMaxCoordinate) render alike: the GPU's float math on
+// edge vectors (a normal from a cross product, barycentrics for smooth shading) must not overflow
+// where the CPU's double math does not. At 1e12 it did: the GPU lit these surfaces with ambient only.
+Scene at_the_coordinate_limit(const std::string& file) {
+  const Scene s = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / file);
+  return scaled(s, std::nextafter(kMaxCoordinate / s.extent(), 0.0f));
+}
+TEST_P(AdversarialParityTest, SpheresAndTrianglesAtTheCoordinateLimit) {
+  check(at_the_coordinate_limit("cornell-spheres.json"), "cornell-spheres-at-limit");
+}
+TEST_F(ParityTest, SmoothMeshAtTheCoordinateLimit) {  // too large to compile in: the BVH path only
+  expect_parity(run(at_the_coordinate_limit("teapot.json"), {128, 128, 1}, InlineScene::never), "teapot-at-limit");
+}
+
 TEST_P(AdversarialParityTest, LightBehindASurface) {
   Scene s = cornell();
   s.lights[0].position = {0.0f, -0.5f, 1.5f};  // behind the back wall: only ambient reaches the room

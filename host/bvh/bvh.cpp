@@ -173,7 +173,7 @@ Bvh build_bvh(const std::vector<Aabb>& boxes) {
     for (int axis = 0; axis < 3; ++axis)
       if (!(boxes[i].min[axis] <= boxes[i].max[axis] && std::abs(boxes[i].min[axis]) <= kMaxCoordinate &&
             std::abs(boxes[i].max[axis]) <= kMaxCoordinate))
-        throw LimitError("primitive " + std::to_string(i) + "'s bounds lie outside the coordinates vkray renders (+-1e12)");
+        throw LimitError("primitive " + std::to_string(i) + "'s bounds lie outside the coordinates vkray renders (+-1e9)");
   const auto start = std::chrono::steady_clock::now();
   Bvh bvh = Builder(boxes).build();
   bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -171,21 +171,29 @@ void SceneParser::parse_camera(const Value& v) {
   cam.position = vec3(require(v, "position"));
   check_coordinates(v["position"], cam.position, "the camera");
 
+  // A direction is judged in double, where any finite float vector has a finite, non-zero length
+  // unless it is zero (in float, the square of 1e20 overflows and that of 1e-30 vanishes). Its
+  // value stays the float computation wherever that is finite, as it always was.
+  const auto unit = [](glm::vec3 d) {
+    const float length = glm::length(d);
+    return length > 0.0f && std::isfinite(length) ? d / length : glm::vec3(glm::normalize(glm::dvec3(d)));
+  };
   const bool by_target = one_of(v, "look_at", "direction");
   const Value aim = by_target ? v["look_at"] : v["direction"];
+  if (by_target) check_coordinates(aim, vec3(aim), "look_at");
   const glm::vec3 forward = by_target ? vec3(aim) - cam.position : vec3(aim);
-  const float length = glm::length(forward);
-  if (!(length > 0.0f) || !std::isfinite(length))
+  if (!(glm::length(glm::dvec3(forward)) > 0.0))
     fail(aim, by_target ? "look_at equals the camera position: no view direction" : "direction has zero length");
-  cam.forward = forward / length;
+  cam.forward = unit(forward);
 
   if (v.has("up")) {
-    cam.up = vec3(v["up"]);
-    const float up_length = glm::length(cam.up);
-    if (!(up_length > 0.0f)) fail(v["up"], "up has zero length");
+    const glm::vec3 up = vec3(v["up"]);
+    if (!(glm::length(glm::dvec3(up)) > 0.0)) fail(v["up"], "up has zero length");
+    // A float length that overflows or vanishes is normalized away; the renderers only need the
+    // direction (scene/camera.h).
+    cam.up = std::isfinite(glm::length(up)) && glm::length(up) > 0.0f ? up : unit(up);
     // Relative test: |f x up/|up|| = sin of the angle between them.
-    if (glm::length(glm::cross(cam.forward, cam.up / up_length)) < 1e-6f)
-      fail(v["up"], "up is parallel to the view direction");
+    if (glm::length(glm::cross(cam.forward, unit(cam.up))) < 1e-6f) fail(v["up"], "up is parallel to the view direction");
   } else if (glm::length(glm::cross(cam.forward, cam.up)) < 1e-6f) {
     fail(v, "the default up [0,1,0] is parallel to the view direction; give \"up\"");
   }
@@ -334,7 +342,7 @@ void SceneParser::check_coordinates(const Value& where, const glm::vec3& p, cons
       char value[32];
       std::snprintf(value, sizeof value, "%g", double(p[c]));
       fail(where, std::string(what) + " has a coordinate of " + value +
-                      "; vkray renders world-space coordinates within +-1e12 (README, \"Limits\")");
+                      "; vkray renders world-space coordinates within +-1e9 (README, \"Limits\")");
     }
 }
 

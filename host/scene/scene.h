@@ -21,11 +21,13 @@ constexpr uint32_t kMaxImageSide = 16384;
 constexpr uint32_t kMaxSamplesPerPixel = 65536;
 
 // Every world-space coordinate (after transforms) lies within +-kMaxCoordinate, and so do the
-// camera and the lights. The intersection math multiplies up to three coordinate differences (a
-// triangle's 3x3 determinant): (2e12)^3 = 8e36 stays below FLT_MAX (3.4e38), so no sum or product
-// in the BVH builder or either renderer can overflow. A scene past it is refused at load, the same
-// for both renderers.
-constexpr float kMaxCoordinate = 1e12f;
+// camera, its target and the lights. The GPU's float math raises coordinate differences d (at
+// most 2e9) to the fourth power at most: the squared length of a triangle's edge cross product,
+// 3 (2 d^2)^2 = 1.9e38, and the barycentric denominator |e1|^2 |e2|^2 = (3 d^2)^2 = 1.4e38, both
+// below FLT_MAX (3.4e38); the 3x3 determinant (d^3) and a sphere's |oc|^2 (d^2) stay far below. So
+// no sum or product in the BVH builder or either renderer can overflow, and the two renderers see
+// the same numbers. A scene past it is refused at load, the same for both renderers.
+constexpr float kMaxCoordinate = 1e9f;
 
 // A scene holds at most this many primitives (triangles and spheres together): a BVH leaf names its
 // first primitive in 27 bits (bvh/bvh.h checks that the two agree).
@@ -40,7 +42,7 @@ struct ImageSettings {
 struct Camera {
   glm::vec3 position{0.0f};
   glm::vec3 forward{0.0f, 0.0f, 1.0f};  // unit view direction
-  glm::vec3 up{0.0f, 1.0f, 0.0f};       // not necessarily unit, never parallel to forward
+  glm::vec3 up{0.0f, 1.0f, 0.0f};       // never parallel to forward; its squared length is finite
   float focal_length = 1.0f;            // in units of the image height
 };
 
