@@ -1,6 +1,7 @@
 #include "base/interrupt.h"
 
 #include <sys/eventfd.h>
+#include <stdlib.h>
 #include <unistd.h>
 
 #include <cstdint>
@@ -48,10 +49,13 @@ void throw_if_interrupted() {
   if (interrupt_requested()) throw Cancelled();
 }
 
-void register_temporary_file(const std::filesystem::path& file) {
+int create_temporary_file(std::string& pattern) {
   TemporaryFiles& t = temporary_files();
   const std::lock_guard lock(t.mutex);
-  t.files.push_back(file);
+  if (t.closed || interrupt_requested()) throw Cancelled();
+  const int fd = ::mkstemp(pattern.data());
+  if (fd >= 0) t.files.push_back(pattern);
+  return fd;
 }
 
 void unregister_temporary_file(const std::filesystem::path& file) {
@@ -70,12 +74,12 @@ void commit_unless_interrupted(const std::filesystem::path& file, const std::fun
 
 void remove_temporary_files() noexcept {
   TemporaryFiles& t = temporary_files();
-  // Held for good: no commit may start after this, and the process ends right after.
+  // Held for good: no file may be created or committed after this, and the process ends right
+  // after (a thread that asks for the lock waits for that end).
   t.mutex.lock();
   t.closed = true;
   for (const auto& file : t.files) ::unlink(file.c_str());
   t.files.clear();
-  t.mutex.unlock();
 }
 
 }  // namespace vkray

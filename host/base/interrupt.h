@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <string>
 
 namespace vkray {
 
@@ -22,10 +23,13 @@ int interrupt_fd() noexcept;
 void throw_if_interrupted();
 
 // ---- Files that must not outlive a forced exit -----------------------------------------------------
-// A temporary output registers itself while it exists. If a stage cannot stop in time and the face
-// ends the process without unwinding (cli/stop_signals.h), it first removes these files, so even
-// then nothing is left behind.
-void register_temporary_file(const std::filesystem::path& file);
+// A temporary output is created here and registered while it exists. If a stage cannot stop in time
+// and the face ends the process without unwinding (cli/stop_signals.h), it first removes these
+// files, so even then nothing is left behind.
+// Creates a file from a mkstemp() pattern (rewritten to the name made) and returns its descriptor,
+// or -1 with errno set; throws Cancelled after an interrupt request, under the same lock as the
+// removal, so no file can appear after it.
+int create_temporary_file(std::string& pattern);
 void unregister_temporary_file(const std::filesystem::path& file);
 // Runs `commit` (the rename of a temporary file into place) unless a stop was requested, and
 // unregisters `file`; atomic with respect to remove_temporary_files(). Throws Cancelled.

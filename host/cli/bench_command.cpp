@@ -164,7 +164,8 @@ int run_bench(const BenchArgs& args) {
       if (with_embree) j["embree_build_ms"] = r.embree_build_ms;
       out.push_back(j);
     }
-    std::cout << out.dump(2) << "\n";
+    // Paths that are not UTF-8 print with U+FFFD rather than failing the report.
+    std::cout << out.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     return kExitOk;
   }
 

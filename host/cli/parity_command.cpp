@@ -130,7 +130,8 @@ int run_parity(const ParityArgs& args) {
       j["diff_image"] = args.diff.string();
       if (!diff_is_pfm) j["diff_max_steps"] = max_steps;
     }
-    std::cout << j.dump() << "\n";
+    // Paths that are not UTF-8 print with U+FFFD rather than failing the report.
+    std::cout << j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   } else {
     print_text(result, device, args.diff, diff_is_pfm, max_steps);
   }

@@ -27,7 +27,7 @@ LoadedScene load_scene_file(const std::filesystem::path& file) {
 }
 
 std::string describe(const Scene& scene, const ImageSettings& image) {
-  return scene.file.string() + ": " + std::to_string(scene.triangles.size()) + " triangles, " +
+  return printable(scene.file.string(), 200) + ": " + std::to_string(scene.triangles.size()) + " triangles, " +
          std::to_string(scene.spheres.size()) + " spheres, " + std::to_string(scene.lights.size()) + " lights; " +
          std::to_string(image.width) + "x" + std::to_string(image.height) + ", " +
          std::to_string(image.samples_per_pixel) + " spp";

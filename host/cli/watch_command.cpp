@@ -35,7 +35,7 @@ std::filesystem::path absolute_normal(const std::filesystem::path& p) { return s
 
 std::string names(const std::vector<std::filesystem::path>& files) {
   std::string text;
-  for (const auto& f : files) text += (text.empty() ? "" : ", ") + f.filename().string();
+  for (const auto& f : files) text += (text.empty() ? "" : ", ") + printable(f.filename().string());
   return text;
 }
 

@@ -4,6 +4,8 @@
 #include <memory>
 #include <utility>
 
+#include "base/errors.h"
+
 namespace vkray::gpu {
 namespace {
 
@@ -99,15 +101,22 @@ glslang::TShader::Includer::IncludeResult* ShaderIncludes::error(const std::stri
 glslang::TShader::Includer::IncludeResult* ShaderIncludes::include(const std::string& header,
                                                                    const std::filesystem::path& local_dir, size_t depth) {
   // glslang counts the depth from 1 for a file the entry includes.
+  // Each name quoted printably and briefly, and a long chain shown by its two ends: the message
+  // stays one short line (a log line of many KB would also strain format_log's regular expressions).
   const auto chain_text = [&](const std::string& last) {
     std::string text;
-    for (const Open& open : chain_) text += open.name + " -> ";
-    return text + last;
+    for (size_t i = 0; i < chain_.size(); ++i) {
+      if (chain_.size() > 8 && i == 3) text += "... -> ";
+      if (chain_.size() > 8 && i >= 3 && i + 4 < chain_.size()) continue;
+      text += printable(chain_[i].name, 60) + " -> ";
+    }
+    return text + printable(last, 60);
   };
   if (depth > kMaxIncludeDepth)
     return error("#include nested more than " + std::to_string(kMaxIncludeDepth) + " deep: " + chain_text(header));
   if (++includes_ > kMaxIncludes)
-    return error("#include \"" + header + "\": the shader includes more than " + std::to_string(kMaxIncludes) +
+    return error("#include \"" + printable(header, 60) + "\": the shader includes more than " +
+                 std::to_string(kMaxIncludes) +
                  " files (counting a file each time it is included)");
 
   std::string key, text;
@@ -125,7 +134,8 @@ glslang::TShader::Includer::IncludeResult* ShaderIncludes::include(const std::st
       InputFile input = read_(candidate);
       if (input.error == "not found") continue;
       if (!input.error.empty())
-        return error("#include \"" + header + "\": " + candidate.lexically_normal().string() + ": " + input.error);
+        return error("#include \"" + printable(header, 60) + "\": " +
+                     printable(candidate.lexically_normal().string(), 200) + ": " + input.error);
       key = candidate.lexically_normal().string();
       text = std::move(input.text);
       break;
@@ -135,7 +145,7 @@ glslang::TShader::Includer::IncludeResult* ShaderIncludes::include(const std::st
 
   included_bytes_ += text.size();
   if (included_bytes_ > kMaxIncludedBytes)
-    return error("#include \"" + header + "\": the shader's includes pass " + std::to_string(kMaxIncludedBytes >> 20) +
+    return error("#include \"" + printable(header, 60) + "\": the shader's includes pass " + std::to_string(kMaxIncludedBytes >> 20) +
                  " MiB (counting a file each time it is included)");
   const bool open = std::any_of(chain_.begin(), chain_.end(), [&](const Open& o) { return o.key == key; });
   if (open && !has_include_guard(text)) return error("#include cycle: " + chain_text(header));

@@ -33,15 +33,18 @@ class AtomicFile {
   explicit AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
     std::string pattern = (target_.has_parent_path() ? target_.parent_path() / "" : std::filesystem::path())
                               .string() + "." + target_.filename().string() + ".tmp-XXXXXX";
-    const int fd = mkstemp(pattern.data());
+    // Registered, so that even a forced exit after Ctrl-C removes it.
+    const int fd = create_temporary_file(pattern);
     if (fd < 0) throw OutputError(target_.string() + ": cannot create file: " + std::strerror(errno));
     temp_ = pattern;
-    register_temporary_file(temp_);  // removed even by a forced exit after Ctrl-C
     file_ = fdopen(fd, "wb");
     if (!file_) {
+      const int error = errno;
       ::close(fd);
-      std::filesystem::remove(temp_);
-      throw OutputError(target_.string() + ": cannot open file: " + std::strerror(errno));
+      std::error_code ec;
+      std::filesystem::remove(temp_, ec);
+      unregister_temporary_file(temp_);
+      throw OutputError(target_.string() + ": cannot open file: " + std::strerror(error));
     }
   }
   AtomicFile(const AtomicFile&) = delete;

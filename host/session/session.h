@@ -75,8 +75,9 @@ class Session {
   // Compiles now the pipeline a render of `scene` with `options` needs, so that a caller can time
   // compiling apart from tracing; returns the seconds it took. Throws ShaderError.
   double prepare(const DeviceScene& scene, const RenderOptions& options);
-  // Throws Cancelled, TimeoutError (a tile outlived options.tile_timeout), DeviceLostError,
-  // DeviceError, ShaderError, UsageError.
+  // Throws Cancelled (on the process-wide interrupt request, base/interrupt.h: Ctrl-C stops every
+  // render in the process, and a face that goes on afterwards clears it), TimeoutError (a tile
+  // outlived options.tile_timeout), DeviceLostError, DeviceError, ShaderError, UsageError.
   RenderResult render(const DeviceScene& scene, const RenderOptions& options);
 
   // ---- Ending -----------------------------------------------------------------------------------
