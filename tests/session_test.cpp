@@ -2,11 +2,15 @@
 // and what a render that timed out leaves behind.
 #include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
 #include <memory>
 
 #include <gtest/gtest.h>
 
 #include "base/errors.h"
+#include "gpu/context.h"
 #include "session/session.h"
 #include "support/gpu_fixture.h"
 
@@ -61,6 +65,33 @@ TEST(SessionUseTest, ASceneFromAnotherSessionIsRefused) {
   }
   first.close();
   second.close();
+}
+
+// The shared libraries this process has mapped now.
+std::set<std::string> mapped_libraries() {
+  std::set<std::string> result;
+  std::ifstream maps("/proc/self/maps");
+  for (std::string line; std::getline(maps, line);) {
+    const size_t path = line.find('/');
+    if (path != std::string::npos && line.find(".so", path) != std::string::npos) result.insert(line.substr(path));
+  }
+  return result;
+}
+
+TEST(SessionUseTest, SessionsShareTheProcesssInstanceAndTheDriverStaysLoaded) {
+  // gpu/instance.h: the driver is loaded once per process, not once per session (NVIDIA's driver
+  // failed vkCreateInstance after about 60 load and unload cycles in one process).
+  std::set<std::string> with_a_session;
+  {
+    Session first(validated()), second(validated());
+    EXPECT_EQ(*first.context().instance(), *second.context().instance());
+    EXPECT_NO_THROW(second.render(second.upload(shipped("cornell.json")), with_image({}, {16, 16, 1})));
+    with_a_session = mapped_libraries();
+    first.close();
+    second.close();
+  }
+  const std::set<std::string> after = mapped_libraries();
+  for (const auto& library : with_a_session) EXPECT_TRUE(after.count(library)) << library << " was unloaded";
 }
 
 TEST(SessionUseTest, ClosingWhileASceneIsHeldIsAnInternalError) {

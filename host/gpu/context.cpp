@@ -7,11 +7,10 @@
 
 #include "base/errors.h"
 #include "base/interrupt.h"
+#include "gpu/instance.h"
 
 namespace vkray::gpu {
 namespace {
-
-constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
 std::atomic<bool> g_work_left_running{false};
 
@@ -53,29 +52,6 @@ std::optional<uint32_t> compute_queue_family(const vk::raii::PhysicalDevice& pd)
   return std::nullopt;
 }
 
-vk::raii::Instance make_instance(const vk::raii::Context& context, bool validation) {
-  if (context.enumerateInstanceVersion() < VK_API_VERSION_1_2)
-    throw DeviceError("the Vulkan loader supports only Vulkan " + version_string(context.enumerateInstanceVersion()) +
-                      "; vkray needs 1.2");
-  std::vector<const char*> layers, extensions;
-  if (validation) {
-    const auto available = context.enumerateInstanceLayerProperties();
-    if (std::none_of(available.begin(), available.end(),
-                     [](const vk::LayerProperties& p) { return std::string_view(p.layerName) == kValidationLayer; }))
-      throw DeviceError(std::string(kValidationLayer) +
-                        " is not installed (Debian: apt-get install vulkan-validationlayers)");
-    layers.push_back(kValidationLayer);
-    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-  }
-  const vk::ApplicationInfo app("vkray", 1, "vkray", 1, VK_API_VERSION_1_2);
-  // Synchronization validation on top of the default checks: a missing barrier is a bug too.
-  const vk::ValidationFeatureEnableEXT enables[] = {vk::ValidationFeatureEnableEXT::eSynchronizationValidation};
-  const vk::ValidationFeaturesEXT features(enables);
-  vk::InstanceCreateInfo info({}, &app, layers, extensions);
-  if (validation) info.pNext = &features;
-  return vk::raii::Instance(context, info);
-}
-
 VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                      VkDebugUtilsMessageTypeFlagsEXT,
                                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
@@ -102,10 +78,9 @@ size_t ValidationLog::count() const {
 }
 
 std::vector<DeviceInfo> list_devices() {
-  vk::raii::Context context;
-  vk::raii::Instance instance = make_instance(context, false);
+  const auto instance = shared_instance(false);
   std::vector<DeviceInfo> result;
-  const vk::raii::PhysicalDevices devices(instance);
+  const vk::raii::PhysicalDevices devices(instance->instance);
   for (uint32_t i = 0; i < devices.size(); ++i) {
     const auto& pd = devices[i];
     const auto chain = pd.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
@@ -124,19 +99,19 @@ std::vector<DeviceInfo> list_devices() {
   return result;
 }
 
-Context::Context(const ContextOptions& options) : log_(options.validation_log) {
-  instance_ = make_instance(context_, log_ != nullptr);
+Context::Context(const ContextOptions& options)
+    : log_(options.validation_log), instance_(shared_instance(log_ != nullptr)) {
   if (log_) {
     using S = vk::DebugUtilsMessageSeverityFlagBitsEXT;
     using T = vk::DebugUtilsMessageTypeFlagBitsEXT;
     messenger_ = vk::raii::DebugUtilsMessengerEXT(
-        instance_, vk::DebugUtilsMessengerCreateInfoEXT({}, S::eWarning | S::eError,
+        instance_->instance, vk::DebugUtilsMessengerCreateInfoEXT({}, S::eWarning | S::eError,
                                                         T::eGeneral | T::eValidation | T::ePerformance,
                                                         &on_validation_message, log_.get()));
   }
 
   // ---- choose the physical device ----
-  vk::raii::PhysicalDevices devices(instance_);
+  vk::raii::PhysicalDevices devices(instance_->instance);
   if (devices.empty()) throw DeviceError("no Vulkan device found (install mesa-vulkan-drivers for lavapipe)");
   std::optional<size_t> chosen;
   if (!options.device.empty()) {
@@ -177,13 +152,14 @@ Context::Context(const ContextOptions& options) : log_(options.validation_log) {
   queue_ = vk::raii::Queue(device_, queue_family_, 0);
 }
 
+const vk::raii::Instance& Context::instance() const { return instance_->instance; }
+
 Context::~Context() {
   if (!work_abandoned_) return;
-  // Work may still run on the device: leave the device (and the instance it belongs to) to the
-  // process instead of destroying them under it.
+  // Work may still run on the device: leave the device to the process instead of destroying it
+  // under the work (the instance is the process's anyway).
   static_cast<void>(device_.release());
   static_cast<void>(messenger_.release());
-  static_cast<void>(instance_.release());
 }
 
 void Context::abandon_work() const {

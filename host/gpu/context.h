@@ -15,6 +15,8 @@
 
 namespace vkray::gpu {
 
+struct Instance;
+
 // Messages from the Khronos validation layer. Shared, so that whoever made the Context can read it
 // after the Context (whose destruction can itself produce messages, such as leaked objects) is gone.
 class ValidationLog {
@@ -39,6 +41,7 @@ class Context {
  public:
   explicit Context(const ContextOptions& options = {});
 
+  const vk::raii::Instance& instance() const;  // the process's (gpu/instance.h), shared with other Contexts
   const vk::raii::Device& device() const { return device_; }
   const vk::raii::PhysicalDevice& physical_device() const { return physical_device_; }
   const vk::raii::Queue& queue() const { return queue_; }
@@ -66,8 +69,7 @@ class Context {
   std::shared_ptr<ValidationLog> log_;
   mutable std::atomic<bool> work_abandoned_{false};
   // Declaration order is destruction order reversed: the messenger outlives the device.
-  vk::raii::Context context_;
-  vk::raii::Instance instance_{nullptr};
+  std::shared_ptr<const Instance> instance_;  // the process's (gpu/instance.h)
   vk::raii::DebugUtilsMessengerEXT messenger_{nullptr};
   vk::raii::PhysicalDevice physical_device_{nullptr};
   vk::PhysicalDeviceProperties properties_;

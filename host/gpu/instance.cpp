@@ -1,0 +1,58 @@
+#include "gpu/instance.h"
+
+#include <algorithm>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "base/errors.h"
+
+namespace vkray::gpu {
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+std::string version_string(uint32_t v) {
+  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+         std::to_string(VK_API_VERSION_PATCH(v));
+}
+
+std::shared_ptr<Instance> make_instance(bool validation) {
+  auto result = std::make_shared<Instance>();
+  const vk::raii::Context& context = result->context;
+  if (context.enumerateInstanceVersion() < VK_API_VERSION_1_2)
+    throw DeviceError("the Vulkan loader supports only Vulkan " + version_string(context.enumerateInstanceVersion()) +
+                      "; vkray needs 1.2");
+  std::vector<const char*> layers, extensions;
+  if (validation) {
+    const auto available = context.enumerateInstanceLayerProperties();
+    if (std::none_of(available.begin(), available.end(),
+                     [](const vk::LayerProperties& p) { return std::string_view(p.layerName) == kValidationLayer; }))
+      throw DeviceError(std::string(kValidationLayer) +
+                        " is not installed (Debian: apt-get install vulkan-validationlayers)");
+    layers.push_back(kValidationLayer);
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  const vk::ApplicationInfo app("vkray", 1, "vkray", 1, VK_API_VERSION_1_2);
+  // Synchronization validation on top of the default checks: a missing barrier is a bug too.
+  const vk::ValidationFeatureEnableEXT enables[] = {vk::ValidationFeatureEnableEXT::eSynchronizationValidation};
+  const vk::ValidationFeaturesEXT features(enables);
+  vk::InstanceCreateInfo info({}, &app, layers, extensions);
+  if (validation) info.pNext = &features;
+  result->instance = vk::raii::Instance(context, info);
+  return result;
+}
+
+}  // namespace
+
+std::shared_ptr<const Instance> shared_instance(bool validation) {
+  static std::mutex mutex;
+  static std::shared_ptr<Instance> instances[2];  // destroyed at exit, after every Context
+  std::lock_guard lock(mutex);
+  auto& slot = instances[validation ? 1 : 0];
+  if (!slot) slot = make_instance(validation);
+  return slot;
+}
+
+}  // namespace vkray::gpu

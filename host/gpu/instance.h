@@ -1,0 +1,28 @@
+// The process's Vulkan instances: one with the Khronos validation layer, one without, each created
+// by the first Context (or device listing) that needs it and kept until the process ends.
+//
+// Why not one per Context: the loader loads the driver with the first instance and unloads it with
+// the last, so a process that opens device after device (the test binary, a Python loop, `vkray
+// check`) loads and unloads the driver each time. NVIDIA's driver (580.159.04, H100) stopped creating
+// instances after about 60 such cycles in one process (vkCreateInstance: ErrorIncompatibleDriver,
+// for every test after that), and other projects report the same driver corrupting state over
+// repeated instance cycles. Devices are still created and destroyed per Context.
+#pragma once
+
+#include <memory>
+
+#include <vulkan/vulkan_raii.hpp>
+
+namespace vkray::gpu {
+
+struct Instance {
+  vk::raii::Context context;  // the loader's entry points: declared first, destroyed last
+  vk::raii::Instance instance{nullptr};
+};
+
+// The instance for `validation` (VK_LAYER_KHRONOS_validation with synchronization validation and
+// VK_EXT_debug_utils, or neither). Throws DeviceError when the loader is older than Vulkan 1.2 or the
+// layer is missing; a later call tries again. Thread-safe.
+std::shared_ptr<const Instance> shared_instance(bool validation);
+
+}  // namespace vkray::gpu
