@@ -1,8 +1,9 @@
 // Direct Lambertian shading from point lights plus an ambient term, exactly the scene contract:
-//   L = albedo * (A + sum_lights V * I * max(0, n . w) / (pi r^2))
+//   L = albedo * (A + sum_lights V * I * (n . w) / (pi r^2))
 // with n the normal facing the incoming ray (the interpolated vertex normal for smooth meshes, the
-// geometric normal otherwise), w the unit vector to the light, r its distance, and V = 0 when a
-// shadow ray finds anything closer than the light.
+// geometric normal otherwise), w the unit vector to the light, r its distance, and V = 0 when the
+// light is at most epsilon above the plane of n at x (n . (light - x) <= epsilon) or a shadow ray
+// finds anything closer than the light.
 #ifndef VKRAY_SHADE_GLSL
 #define VKRAY_SHADE_GLSL
 
@@ -35,8 +36,9 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
     vec3 to_light = light_pos - x;
     float r2 = dot(to_light, to_light);
     float cos_theta = dot(n, to_light * inversesqrt(r2));
-    // Written as > 0 so a light exactly at x (0/0 = NaN) contributes nothing.
-    bool lit = cos_theta > 0.0;
+    // Lit only by a light more than epsilon above the plane of n at x (the contract's height rule:
+    // a light on the surface, or at x itself, lights nothing there, whatever the rounding of x).
+    bool lit = dot(n, to_light) > frame.epsilon;
     if (SHADOW_RAYS && lit) {
       vec3 shadow_dir = light_pos - shadow_origin;
       float shadow_dist = length(shadow_dir);

@@ -94,7 +94,9 @@ class Tracer {
       const dvec3 to_light = light - x;
       const double r2 = glm::dot(to_light, to_light);
       const double cos_theta = glm::dot(shading_n, to_light / std::sqrt(r2));
-      if (!(cos_theta > 0)) continue;
+      // The light must stand more than epsilon above the plane of the normal: one on the surface
+      // (or at x) lights nothing there.
+      if (!(glm::dot(shading_n, to_light) > epsilon_)) continue;
       if (shadows_) {
         ++rays;
         const dvec3 shadow = light - shadow_origin;
