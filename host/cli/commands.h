@@ -20,6 +20,7 @@ struct Command {
 
 Command add_render_command(CLI::App& app);
 Command add_parity_command(CLI::App& app);
+Command add_check_command(CLI::App& app);
 Command add_watch_command(CLI::App& app);
 Command add_bench_command(CLI::App& app);
 Command add_devices_command(CLI::App& app);

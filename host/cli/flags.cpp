@@ -33,12 +33,13 @@ void add_device_flags(CLI::App& command, DeviceFlags& flags, bool validate) {
   if (validate) command.add_flag("--validate", flags.validate, "Enable the Khronos validation layer; any message is an error");
 }
 
-void add_gpu_flags(CLI::App& command, GpuFlags& flags) {
+void add_gpu_flags(CLI::App& command, GpuFlags& flags, bool inline_scene) {
   command
       .add_option("--tile-timeout", flags.tile_timeout_ms,
                   "Longest one GPU submission (a tile) may run, in milliseconds, before the render fails with exit 3 "
                   "(default 60000)")
       ->check(CLI::Range(1, 3600000));
+  if (!inline_scene) return;
   static const std::map<std::string, InlineScene> names{
       {"auto", InlineScene::automatic}, {"always", InlineScene::always}, {"never", InlineScene::never}};
   command

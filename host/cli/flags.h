@@ -37,7 +37,8 @@ struct CpuFlags {
 void add_scene_flags(CLI::App& command, SceneFlags& flags);
 // `validate`: whether the command offers --validate (`vkray bench` measures without the layer).
 void add_device_flags(CLI::App& command, DeviceFlags& flags, bool validate = true);
-void add_gpu_flags(CLI::App& command, GpuFlags& flags);
+// `inline_scene`: whether the command offers --inline-scene (`vkray check` runs both paths).
+void add_gpu_flags(CLI::App& command, GpuFlags& flags, bool inline_scene = true);
 void add_cpu_flags(CLI::App& command, CpuFlags& flags, const std::string& description);
 
 // Rules every option value follows, set once for all commands by the option's type, so that no

@@ -12,6 +12,7 @@
 #include "base/errors.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
+#include "cli/parity_report.h"
 #include "cli/report.h"
 #include "image/image.h"
 #include "session/parity.h"
@@ -29,39 +30,6 @@ struct ParityArgs {
   std::filesystem::path diff;  // where to write the difference heatmap; empty: none
   bool json = false;
 };
-
-nlohmann::json to_json(const ParityResult& r, const std::string& scene, const std::string& device) {
-  const ParityMetrics& m = r.metrics;
-  const glm::vec3 worst_gpu = r.gpu.image.at(m.worst_x, m.worst_y), worst_cpu = r.cpu.image.at(m.worst_x, m.worst_y);
-  return {
-      {"scene", scene},
-      {"width", m.width},
-      {"height", m.height},
-      {"samples_per_pixel", r.image.samples_per_pixel},
-      {"device", device},
-      {"gpu_trace_seconds", r.gpu.stats.trace_seconds},
-      {"cpu_trace_seconds", r.cpu.stats.trace_seconds},
-      {"cpu_threads", r.cpu.stats.threads},
-      {"rays", r.cpu.stats.rays},
-      {"max_abs_diff", m.max_abs},
-      {"mean_abs_diff", m.mean_abs},
-      {"psnr_db", std::isinf(m.psnr) ? nlohmann::json(nullptr) : nlohmann::json(m.psnr)},
-      {"share_over_1", m.share_over_1()},
-      {"share_over_2", m.share_over_2()},
-      {"pixels_over_1", m.over_1},
-      {"pixels_over_2", m.over_2},
-      {"edge_pixels", m.edge_pixels},
-      {"edge_pixels_over_1", m.edge_over_1},
-      {"interior_pixels_over_1", m.interior_over_1},
-      {"interior_pixels_over_2", m.interior_over_2},
-      {"worst_pixel", {m.worst_x, m.worst_y}},
-      {"worst_gpu", {worst_gpu.r, worst_gpu.g, worst_gpu.b}},
-      {"worst_cpu", {worst_cpu.r, worst_cpu.g, worst_cpu.b}},
-      {"tolerance", describe_tolerance(r.tolerance)},
-      {"pass", m.pass},
-      {"vkray_version", version_string()},
-  };
-}
 
 void print_text(const ParityResult& r, const std::string& device, const std::filesystem::path& diff, bool diff_is_pfm,
                 int max_steps) {
@@ -117,15 +85,11 @@ int run_parity(const ParityArgs& args) {
   const ParityResult result = compare_with_reference(session, loaded.scene, options);
   session.close();
 
-  // A PNG shows what a person can see (8-bit steps); a PFM holds the raw linear differences.
   int max_steps = 0;
   const bool diff_is_pfm = args.diff.extension() == ".pfm";
-  if (!args.diff.empty())
-    write_image(diff_is_pfm ? absolute_difference(result.gpu.image, result.cpu.image)
-                            : difference_heatmap(result.gpu.image, result.cpu.image, max_steps),
-                args.diff);
+  if (!args.diff.empty()) max_steps = write_difference(result, args.diff);
   if (args.json) {
-    nlohmann::json j = to_json(result, loaded.scene->file.string(), device);
+    nlohmann::json j = parity_json(result, loaded.scene->file.string(), device);
     if (!args.diff.empty()) {
       j["diff_image"] = args.diff.string();
       if (!diff_is_pfm) j["diff_max_steps"] = max_steps;

@@ -62,6 +62,20 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverity
   return VK_FALSE;  // never abort the call: we report, then fail at the next check
 }
 
+DeviceInfo describe_device(const vk::raii::PhysicalDevice& pd, uint32_t index) {
+  const auto chain = pd.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
+  const auto& props = chain.get<vk::PhysicalDeviceProperties2>().properties;
+  const auto& driver = chain.get<vk::PhysicalDeviceDriverProperties>();
+  uint64_t local = 0;
+  const auto memory = pd.getMemoryProperties();
+  for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
+    if (memory.memoryHeaps[h].flags & vk::MemoryHeapFlagBits::eDeviceLocal) local += memory.memoryHeaps[h].size;
+  return {index, props.deviceName.data(), type_name(props.deviceType),
+          std::string(driver.driverName.data()) + " " + driver.driverInfo.data(), version_string(props.apiVersion),
+          compute_queue_family(pd).has_value(), props.limits.maxComputeWorkGroupInvocations,
+          props.limits.maxTexelBufferElements, props.limits.maxStorageBufferRange, local};
+}
+
 }  // namespace
 
 void ValidationLog::add(std::string message) {
@@ -81,21 +95,7 @@ std::vector<DeviceInfo> list_devices() {
   const auto instance = shared_instance(false);
   std::vector<DeviceInfo> result;
   const vk::raii::PhysicalDevices devices(instance->instance);
-  for (uint32_t i = 0; i < devices.size(); ++i) {
-    const auto& pd = devices[i];
-    const auto chain = pd.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
-    const auto& props = chain.get<vk::PhysicalDeviceProperties2>().properties;
-    const auto& driver = chain.get<vk::PhysicalDeviceDriverProperties>();
-    uint64_t local = 0;
-    const auto memory = pd.getMemoryProperties();
-    for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
-      if (memory.memoryHeaps[h].flags & vk::MemoryHeapFlagBits::eDeviceLocal) local += memory.memoryHeaps[h].size;
-    result.push_back({i, props.deviceName.data(), type_name(props.deviceType),
-                      std::string(driver.driverName.data()) + " " + driver.driverInfo.data(),
-                      version_string(props.apiVersion), compute_queue_family(pd).has_value(),
-                      props.limits.maxComputeWorkGroupInvocations, props.limits.maxTexelBufferElements,
-                      props.limits.maxStorageBufferRange, local});
-  }
+  for (uint32_t i = 0; i < devices.size(); ++i) result.push_back(describe_device(devices[i], i));
   return result;
 }
 
@@ -138,6 +138,7 @@ Context::Context(const ContextOptions& options)
     }
     if (!chosen) throw DeviceError("no Vulkan 1.2 device with a compute queue found");
   }
+  info_ = describe_device(devices[*chosen], uint32_t(*chosen));
   physical_device_ = std::move(devices[*chosen]);
   const auto chain = physical_device_.getProperties2<vk::PhysicalDeviceProperties2, vk::PhysicalDeviceDriverProperties>();
   properties_ = chain.get<vk::PhysicalDeviceProperties2>().properties;

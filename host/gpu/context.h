@@ -49,6 +49,7 @@ class Context {
   const vk::PhysicalDeviceLimits& limits() const { return properties_.limits; }
   const std::string& device_name() const { return device_name_; }
   const std::string& driver_name() const { return driver_name_; }
+  const DeviceInfo& info() const { return info_; }  // as `vkray devices` lists it, index included
 
   // Index of a memory type allowed by `type_bits` with all of `required` (and all of `preferred`
   // if such a type exists). Throws DeviceError if none has `required`.
@@ -73,6 +74,7 @@ class Context {
   vk::raii::DebugUtilsMessengerEXT messenger_{nullptr};
   vk::raii::PhysicalDevice physical_device_{nullptr};
   vk::PhysicalDeviceProperties properties_;
+  DeviceInfo info_;
   std::string device_name_, driver_name_;
   uint32_t queue_family_ = 0;
   vk::raii::Device device_{nullptr};

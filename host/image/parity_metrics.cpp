@@ -103,4 +103,15 @@ std::string describe_tolerance(const ParityTolerance& t) {
   return text;
 }
 
+std::string describe_metrics(const ParityMetrics& m) {
+  char text[300];
+  std::snprintf(text, sizeof text,
+                "> 1 step on %llu pixels away from edges and on %llu of %llu edge pixels; > 2 steps on %llu; "
+                "max |diff| %.3g at (%u, %u)",
+                static_cast<unsigned long long>(m.interior_over_1), static_cast<unsigned long long>(m.edge_over_1),
+                static_cast<unsigned long long>(m.edge_pixels), static_cast<unsigned long long>(m.over_2), m.max_abs,
+                m.worst_x, m.worst_y);
+  return text;
+}
+
 }  // namespace vkray

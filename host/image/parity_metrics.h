@@ -53,5 +53,8 @@ Image difference_heatmap(const Image& a, const Image& reference, int& max_steps)
 Image absolute_difference(const Image& a, const Image& b);
 
 std::string describe_tolerance(const ParityTolerance& tolerance);
+// "> 1 step on 2 pixels away from edges and on 3 of 2513 edge pixels; > 2 steps on 5; max |diff|
+// 0.274 at (8, 8)": what the tolerance is judged on.
+std::string describe_metrics(const ParityMetrics& metrics);
 
 }  // namespace vkray

@@ -135,7 +135,8 @@ class SceneParser {
 void SceneParser::parse(const json& root_json) {
   const Value root{root_json, ""};
   expect_object(root);
-  check_keys(root, {"image", "camera", "background", "ambient", "materials", "lights", "objects"});
+  check_keys(root, {"description", "image", "camera", "background", "ambient", "materials", "lights", "objects"});
+  if (root.has("description")) scene_.description = printable(string(root["description"]), 1000);
   if (root.has("image")) parse_image(root["image"]);
   parse_camera(require(root, "camera"));
   if (root.has("background")) scene_.background = color(root["background"]);

@@ -72,6 +72,7 @@ struct Triangle {
 struct Scene {
   std::filesystem::path file;  // where it was loaded from; paths inside are relative to its folder
   std::string name;            // the file's stem: "cornell" for scenes/cornell.json
+  std::string description;     // what the scene is for, in a sentence: free text, never rendered
   ImageSettings image;
   Camera camera;
   glm::vec3 background{0.0f};

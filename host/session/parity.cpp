@@ -6,14 +6,24 @@
 namespace vkray {
 
 ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scene> scene, const RenderOptions& options) {
-  ParityResult result;
-  result.image = image_settings(*scene, options);
+  const ImageSettings image = image_settings(*scene, options);  // a bad override fails before any work
   const Bvh bvh = build_bvh(primitive_boxes(*scene));  // one hierarchy, traversed by both
+  RenderResult gpu;
   {
     const DeviceScene on_device = session.upload(scene, &bvh);
-    result.gpu = session.render(on_device, options);
+    gpu = session.render(on_device, options);
   }
-  result.cpu = render_on_cpu(*scene, options, &bvh, &result.signatures);
+  std::vector<uint64_t> signatures;
+  RenderResult cpu = render_on_cpu(*scene, options, &bvh, &signatures);
+  return judge_parity(image, std::move(gpu), std::move(cpu), std::move(signatures));
+}
+
+ParityResult judge_parity(const ImageSettings& image, RenderResult gpu, RenderResult cpu, std::vector<uint64_t> signatures) {
+  ParityResult result;
+  result.image = image;
+  result.gpu = std::move(gpu);
+  result.cpu = std::move(cpu);
+  result.signatures = std::move(signatures);
   result.metrics = compare_images(result.gpu.image, result.cpu.image, result.signatures, result.tolerance);
   return result;
 }

@@ -24,4 +24,7 @@ struct ParityResult {
 
 ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scene> scene, const RenderOptions& options);
 
+// The comparison alone, of a GPU render and a reference rendered with `signatures`, both of `image`.
+ParityResult judge_parity(const ImageSettings& image, RenderResult gpu, RenderResult cpu, std::vector<uint64_t> signatures);
+
 }  // namespace vkray

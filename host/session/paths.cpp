@@ -23,6 +23,10 @@ std::filesystem::path find(const char* relative, const char* source_tree_dir, co
 
 std::filesystem::path default_shader_dir() { return find("shaders", VKRAY_SOURCE_SHADER_DIR, "trace.comp"); }
 
-std::filesystem::path default_scene() { return find("scenes", VKRAY_SOURCE_SCENE_DIR, "cornell.json") / "cornell.json"; }
+std::filesystem::path default_scene_dir() { return find("scenes", VKRAY_SOURCE_SCENE_DIR, "cornell.json"); }
+
+std::filesystem::path default_scene() { return default_scene_dir() / "cornell.json"; }
+
+std::filesystem::path default_check_dir() { return find("checks", VKRAY_SOURCE_CHECK_DIR, "light-on-surface.json"); }
 
 }  // namespace vkray

@@ -1,4 +1,4 @@
-// Where vkray finds its shaders and default scene: next to an installed executable
+// Where vkray finds its shaders, scenes and check cases: next to an installed executable
 // (<prefix>/bin/vkray -> <prefix>/share/vkray/...), else in the source tree it was built from.
 #pragma once
 
@@ -7,6 +7,8 @@
 namespace vkray {
 
 std::filesystem::path default_shader_dir();
+std::filesystem::path default_scene_dir();
 std::filesystem::path default_scene();
+std::filesystem::path default_check_dir();  // the adversarial cases of `vkray check`
 
 }  // namespace vkray

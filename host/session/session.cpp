@@ -61,6 +61,7 @@ const gpu::Context& Session::device() const {
 
 const std::string& Session::device_name() const { return device().device_name(); }
 const std::string& Session::driver_name() const { return device().driver_name(); }
+const gpu::DeviceInfo& Session::device_info() const { return device().info(); }
 std::string Session::device_description() const { return device_name() + " (" + driver_name() + ")"; }
 
 bool Session::has_shaders() const { return ctx_ && shaders_->pipeline != nullptr; }

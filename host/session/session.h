@@ -49,6 +49,7 @@ class Session {
   const std::string& device_name() const;
   const std::string& driver_name() const;
   std::string device_description() const;  // "name (driver)"
+  const gpu::DeviceInfo& device_info() const;  // as `vkray devices` lists it: index, type, driver, Vulkan version
 
   // ---- Shaders ----------------------------------------------------------------------------------
   struct ShaderCompile {

@@ -21,9 +21,7 @@ void ParityTest::expect_parity(const ParityResult& run, const std::string& name)
   int max_steps = 0;
   write_image(difference_heatmap(run.gpu.image, run.cpu.image, max_steps), dir / (name + ".png"));
   ADD_FAILURE() << name << ": parity tolerance (" << describe_tolerance(run.tolerance) << ") does not hold:\n"
-                << "  > 1 step on " << m.interior_over_1 << " pixels away from edges and on " << m.edge_over_1 << " of "
-                << m.edge_pixels << " edge pixels; > 2 steps on " << m.over_2 << "; max |diff| " << m.max_abs << " at ("
-                << m.worst_x << ", " << m.worst_y << ")\n"
+                << "  " << describe_metrics(m) << "\n"
                 << "  heatmap (1 to " << max_steps << " steps): " << (dir / (name + ".png")).string();
 }
 

@@ -1,0 +1,73 @@
+#include "session/check.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+
+#include "base/errors.h"
+#include "base/interrupt.h"
+#include "bvh/bvh.h"
+#include "packing/inline_scene.h"
+#include "session/cpu_render.h"
+#include "session/session.h"
+
+namespace vkray {
+
+const char* path_name(InlineScene path) { return path == InlineScene::always ? "inline" : "bvh"; }
+
+std::string case_name(const CheckCase& c) {
+  return c.scene.stem().string() + "/" + path_name(c.path) + "/" + std::to_string(c.samples_per_pixel) + "spp";
+}
+
+std::vector<std::filesystem::path> check_scenes(const std::vector<std::filesystem::path>& folders) {
+  std::vector<std::filesystem::path> result;
+  for (const auto& folder : folders) {
+    std::vector<std::filesystem::path> files;
+    for (const auto& entry : std::filesystem::directory_iterator(folder))
+      if (entry.path().extension() == ".json") files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    result.insert(result.end(), files.begin(), files.end());
+  }
+  return result;
+}
+
+std::vector<CheckResult> run_check(Session& session, const CheckOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  std::vector<CheckResult> results;
+  for (const auto& file : options.scenes) {
+    throw_if_interrupted();
+    if (options.on_scene) options.on_scene(file);
+    const auto scene = std::make_shared<const Scene>(load_scene(file));
+    const Bvh bvh = build_bvh(primitive_boxes(*scene));  // one hierarchy, traversed by both renderers
+    const DeviceScene on_device = session.upload(scene, &bvh);
+    std::vector<InlineScene> paths{InlineScene::never};
+    const size_t primitives = scene->triangles.size() + scene->spheres.size();
+    if (primitives > 0 && primitives <= gpu::kMaxInlinePrimitives)
+      paths.push_back(InlineScene::always);
+    for (const uint32_t spp : options.samples_per_pixel) {
+      RenderOptions render = options.render;
+      render.width = options.width;
+      render.height = options.height;
+      render.samples_per_pixel = spp;
+      // The reference does not depend on the GPU path: rendered once for both.
+      const auto cpu_start = Clock::now();
+      std::vector<uint64_t> signatures;
+      const RenderResult cpu = render_on_cpu(*scene, render, &bvh, &signatures);
+      const double cpu_seconds = std::chrono::duration<double>(Clock::now() - cpu_start).count();
+      for (const InlineScene path : paths) {
+        const auto start = Clock::now();
+        render.inline_scene = path;
+        CheckResult result{{file, path, spp}, scene->description, {}, 0};
+        result.parity = judge_parity(image_settings(*scene, render), session.render(on_device, render), cpu, signatures);
+        if (result.parity.gpu.stats.inline_scene != (path == InlineScene::always))
+          throw InternalError(case_name(result.c) + ": the render did not take the path it was asked for");
+        result.seconds = std::chrono::duration<double>(Clock::now() - start).count() + cpu_seconds;
+        if (options.on_result) options.on_result(result);
+        results.push_back(std::move(result));
+      }
+    }
+  }
+  return results;
+}
+
+}  // namespace vkray
