@@ -4,6 +4,7 @@
 #include <cctype>
 #include <iostream>
 #include <optional>
+#include <string_view>
 
 #include "base/errors.h"
 #include "base/interrupt.h"
@@ -50,6 +51,21 @@ std::optional<uint32_t> compute_queue_family(const vk::raii::PhysicalDevice& pd)
   for (uint32_t i = 0; i < families.size(); ++i)
     if (families[i].queueFlags & vk::QueueFlagBits::eCompute) return i;
   return std::nullopt;
+}
+
+// The clock features to enable: both of the device's when it can read the device clock (shaders
+// may then read it: tests make a tile slow with it, tests/support/slow_shaders.h), else none.
+std::optional<vk::PhysicalDeviceShaderClockFeaturesKHR> shader_clock(const vk::raii::PhysicalDevice& pd) {
+  const auto extensions = pd.enumerateDeviceExtensionProperties();
+  if (std::none_of(extensions.begin(), extensions.end(), [](const vk::ExtensionProperties& e) {
+        return std::string_view(e.extensionName) == VK_KHR_SHADER_CLOCK_EXTENSION_NAME;
+      }))
+    return std::nullopt;
+  const auto chain = pd.getFeatures2<vk::PhysicalDeviceFeatures2, vk::PhysicalDeviceShaderClockFeaturesKHR>();
+  vk::PhysicalDeviceShaderClockFeaturesKHR clock = chain.get<vk::PhysicalDeviceShaderClockFeaturesKHR>();
+  if (!clock.shaderDeviceClock) return std::nullopt;
+  clock.pNext = nullptr;
+  return clock;
 }
 
 VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -149,7 +165,18 @@ Context::Context(const ContextOptions& options)
   // ---- logical device and queue ----
   const float priority = 1.0f;
   const vk::DeviceQueueCreateInfo queue_info({}, queue_family_, 1, &priority);
-  device_ = vk::raii::Device(physical_device_, vk::DeviceCreateInfo({}, queue_info));
+  std::vector<const char*> extensions;
+  vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceShaderClockFeaturesKHR> device_info;
+  device_info.get<vk::DeviceCreateInfo>().setQueueCreateInfos(queue_info);
+  if (const auto clock = shader_clock(physical_device_)) {
+    extensions.push_back(VK_KHR_SHADER_CLOCK_EXTENSION_NAME);
+    device_info.get<vk::PhysicalDeviceShaderClockFeaturesKHR>() = *clock;
+    has_device_clock_ = true;
+  } else {
+    device_info.unlink<vk::PhysicalDeviceShaderClockFeaturesKHR>();
+  }
+  device_info.get<vk::DeviceCreateInfo>().setPEnabledExtensionNames(extensions);
+  device_ = vk::raii::Device(physical_device_, device_info.get<vk::DeviceCreateInfo>());
   queue_ = vk::raii::Queue(device_, queue_family_, 0);
 }
 

@@ -50,6 +50,9 @@ class Context {
   const std::string& device_name() const { return device_name_; }
   const std::string& driver_name() const { return driver_name_; }
   const DeviceInfo& info() const { return info_; }  // as `vkray devices` lists it, index included
+  // Whether shaders may read the device clock (VK_KHR_shader_clock with shaderDeviceClock, and
+  // shaderSubgroupClock where the device has it; GL_EXT_shader_realtime_clock, GL_ARB_shader_clock).
+  bool has_device_clock() const { return has_device_clock_; }
 
   // Index of a memory type allowed by `type_bits` with all of `required` (and all of `preferred`
   // if such a type exists). Throws DeviceError if none has `required`.
@@ -77,6 +80,7 @@ class Context {
   DeviceInfo info_;
   std::string device_name_, driver_name_;
   uint32_t queue_family_ = 0;
+  bool has_device_clock_ = false;
   vk::raii::Device device_{nullptr};
   vk::raii::Queue queue_{nullptr};
 };

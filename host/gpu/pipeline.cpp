@@ -1,5 +1,8 @@
 #include "gpu/pipeline.h"
 
+#include <glslang/SPIRV/spirv.hpp>
+
+#include "base/errors.h"
 #include "shared/types.h"
 
 namespace vkray::gpu {
@@ -21,6 +24,19 @@ constexpr BindingSlot kTraceBindings[] = {
     {VKRAY_BINDING_OUTPUT, vk::DescriptorType::eStorageBuffer, "output"},
 };
 
+// Whether a SPIR-V module declares `capability` (its OpCapability instructions come first).
+bool declares(const std::vector<uint32_t>& spirv, spv::Capability capability) {
+  constexpr size_t kHeaderWords = 5;
+  for (size_t at = kHeaderWords; at < spirv.size();) {
+    const uint32_t words = spirv[at] >> spv::WordCountShift, opcode = spirv[at] & spv::OpCodeMask;
+    if (opcode == spv::OpCapability && words == 2 && at + 1 < spirv.size() && spirv[at + 1] == uint32_t(capability))
+      return true;
+    if (words == 0) break;
+    at += words;
+  }
+  return false;
+}
+
 }  // namespace
 
 TracePipeline::TracePipeline(std::shared_ptr<const Context> ctx, std::filesystem::path shader_dir,
@@ -30,7 +46,7 @@ TracePipeline::TracePipeline(std::shared_ptr<const Context> ctx, std::filesystem
       shader_dir_(std::move(shader_dir)),
       shader_(std::move(shader)),
       descriptors_(ctx_->device(), kTraceBindings) {
-  descriptors_.check(shader_, shader_dir_ / "trace.comp");
+  check(shader_);
   const vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, sizeof(TileConstants));
   const vk::DescriptorSetLayout set_layout = *descriptors_.layout();
   layout_ = vk::raii::PipelineLayout(ctx_->device(), vk::PipelineLayoutCreateInfo({}, set_layout, push));
@@ -59,13 +75,24 @@ void TracePipeline::forget_inline_variants() const {
   inline_order_.clear();
 }
 
+void TracePipeline::check(const CompiledShader& shader) const {
+  const std::filesystem::path entry = shader_dir_ / "trace.comp";
+  descriptors_.check(shader, entry);
+  // A module with a capability the device did not enable is invalid usage, not an error the
+  // driver reports: refuse it here, where the user can be told why.
+  if (!ctx_->has_device_clock() && declares(shader.spirv, spv::CapabilityShaderClockKHR))
+    throw ShaderError(entry.string() + ": error: the shaders read the clock (GL_EXT_shader_realtime_clock or " +
+                      "GL_ARB_shader_clock), and " + ctx_->device_name() +
+                      " has no VK_KHR_shader_clock with shaderDeviceClock");
+}
+
 std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVariant& variant) const {
   // A scene compiled in is a module of its own; the module may go once the pipeline exists.
   vk::raii::ShaderModule inline_module{nullptr};
   if (!variant.inline_scene.empty()) {
     const CompiledShader shader =
         compile_compute_shader(shader_dir_ / "trace.comp", {shader_dir_}, {{"inline_scene.glsl", variant.inline_scene}});
-    descriptors_.check(shader, shader_dir_ / "trace.comp");
+    check(shader);
     inline_module = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, shader.spirv));
   }
   const vk::ShaderModule module = variant.inline_scene.empty() ? *module_ : *inline_module;

@@ -36,7 +36,8 @@ class TracePipeline {
   // `shader`: shader_dir/trace.comp as compiled (compile_compute_shader); variants with a scene
   // compiled in are compiled from shader_dir when first needed. `cache` (optional) makes
   // re-creating a pipeline from SPIR-V seen before in this process cheap. Throws ShaderError when
-  // the shader declares its bindings otherwise than vkray binds them.
+  // the shader declares its bindings otherwise than vkray binds them, or reads the clock on a
+  // device without one (Context::has_device_clock()).
   TracePipeline(std::shared_ptr<const Context> ctx, std::filesystem::path shader_dir, CompiledShader shader,
                 std::shared_ptr<const vk::raii::PipelineCache> cache = nullptr);
   ~TracePipeline();
@@ -57,6 +58,8 @@ class TracePipeline {
 
  private:
   std::shared_ptr<const vk::raii::Pipeline> create(const ShaderVariant& variant) const;
+  // Throws ShaderError for a shader this pipeline layout or this device cannot run.
+  void check(const CompiledShader& shader) const;
 
   std::shared_ptr<const Context> ctx_;  // first: destroyed last
   std::shared_ptr<const vk::raii::PipelineCache> cache_;
