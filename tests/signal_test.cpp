@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "support/child_process.h"
+#include "support/slow_shaders.h"
 #include "support/temp_dir.h"
 
 namespace vkray::test {
@@ -117,15 +118,11 @@ TEST(SignalTest, BenchStopsWithinASecond) {
 // within a second and still leaving nothing behind.
 TEST(SignalTest, AStageThatCannotBeInterruptedIsNotWaitedFor) {
   TempDir shaders;
-  std::filesystem::copy(VKRAY_SHADER_DIR, shaders.path(), std::filesystem::copy_options::recursive);
-  std::string text = read_file(shaders / "trace.comp");
-  std::string slow = "  float slow = float(gl_LocalInvocationID.x);\n";
+  copy_shipped_shaders(shaders.path());
+  std::string slow = "  load_frame();\n  float slow = float(gl_LocalInvocationID.x);\n";
   for (int i = 0; i < 20000; ++i) slow += "  slow = sin(slow * 1.0001 + " + std::to_string(i) + ".5);\n";
   slow += "  if (slow > 1e30) return;\n";
-  const std::string entry = "  load_frame();\n";
-  ASSERT_NE(text.find(entry), std::string::npos);
-  text.insert(text.find(entry) + entry.size(), slow);
-  std::ofstream(shaders / "trace.comp") << text;
+  replace_in_trace(shaders.path(), "  load_frame();\n", slow);
 
   TempDir dir;
   add_old_output(dir);
