@@ -14,6 +14,7 @@
 
 #include "image/image.h"
 #include "support/run_vkray.h"
+#include "support/slow_shaders.h"
 #include "support/temp_dir.h"
 
 namespace vkray::test {
@@ -249,8 +250,12 @@ TEST(CliTest, BenchPrintsJsonForEachScene) {
 }
 
 TEST(CliTest, TileTimeoutExitsThreeAndWritesNothing) {
+  // A tile of these shaders lasts about 200 ms on any device (support/slow_shaders.h): far past 1 ms.
+  const SlowShaders shaders;
   TempDir dir;
-  const Result run = vkray("render --validate " + kScenes + "/teapot.json --spp 4 --tile-timeout 1 -o out.png", dir.path());
+  const Result run = vkray("render --validate --shader-dir " + shaders.path().string() + " " + kScenes +
+                               "/teapot.json --spp 4 --tile-timeout 1 -o out.png",
+                           dir.path());
   EXPECT_EQ(run.exit_code, 3) << run.err;
   EXPECT_NE(run.err.find("VK_TIMEOUT"), std::string::npos) << run.err;
   EXPECT_FALSE(has_image_files(dir.path()));

@@ -13,6 +13,7 @@
 #include "gpu/context.h"
 #include "session/session.h"
 #include "support/gpu_fixture.h"
+#include "support/slow_shaders.h"
 
 namespace vkray::test {
 namespace {
@@ -27,21 +28,29 @@ SessionOptions validated() {
   return options;
 }
 
-using SessionTest = GpuTest;
+// A session whose every tile lasts about 200 ms on any device (support/slow_shaders.h).
+class SessionTest : public GpuTest {
+ protected:
+  std::filesystem::path shader_dir() const override { return shaders_.path(); }
+
+ private:
+  SlowShaders shaders_;
+};
 
 TEST_F(SessionTest, ATimedOutRenderKeepsWhatItUsesAndTheNextRenderWaitsForIt) {
-  // 1 ms a tile is far too little for the teapot at 16 spp on lavapipe: the render times out with
-  // its tile still running. What that tile uses must stay alive (the validation layer reports an
-  // object destroyed while in use), an upload is refused at once rather than queued behind it, and
-  // a render with time to spare waits for it and then gives the image an undisturbed render gives.
+  // 1 ms is far too little for a tile of these shaders: the render times out with its tile still
+  // running. What that tile uses must stay alive (the validation layer reports an object destroyed
+  // while in use), an upload is refused at once rather than queued behind it, and a render with
+  // time to spare waits for it and then gives the image an undisturbed render gives. (128x128 at
+  // 16 spp is one tile of the teapot.)
   const auto teapot = shipped("teapot.json");
   const DeviceScene on_device = session().upload(teapot);
-  RenderOptions hurried = with_image({}, {256, 256, 16});
+  RenderOptions hurried = with_image({}, {128, 128, 16});
   hurried.tile_timeout = std::chrono::milliseconds(1);
   EXPECT_THROW(session().render(on_device, hurried), TimeoutError);
   EXPECT_THROW(session().upload(teapot), TimeoutError);
-  const Image after = session().render(on_device, with_image({}, {256, 256, 16})).image;
-  const Image undisturbed = session().render(on_device, with_image({}, {256, 256, 16})).image;
+  const Image after = session().render(on_device, with_image({}, {128, 128, 16})).image;
+  const Image undisturbed = session().render(on_device, with_image({}, {128, 128, 16})).image;
   EXPECT_TRUE(after.pixels == undisturbed.pixels);
 }
 

@@ -12,6 +12,7 @@
 #include "image/image.h"
 #include "support/child_process.h"
 #include "support/run_vkray.h"
+#include "support/slow_shaders.h"
 #include "support/temp_dir.h"
 
 namespace vkray::test {
@@ -29,7 +30,7 @@ std::string read_text(const std::filesystem::path& file) {
 class WatchTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::filesystem::copy(VKRAY_SHADER_DIR, dir_ / "shaders", std::filesystem::copy_options::recursive);
+    copy_shipped_shaders(dir_ / "shaders");
     std::filesystem::copy(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json", dir_ / "cornell.json");
   }
 
@@ -187,10 +188,12 @@ TEST_F(WatchTest, ABrokenMeshIsSurvivedLikeABrokenScene) {
 }
 
 TEST_F(WatchTest, ATileTimeoutIsAnErrorOfItsReloadAndWatchingGoesOn) {
-  // --tile-timeout holds in watch as in render. A render far longer than 1 ms a tile (on lavapipe)
-  // times out: reported, no image written, the watch goes on; what the timed-out work uses stays
-  // alive until it is done, so stopping leaves nothing behind for the validation layer to report.
-  start({"--tile-timeout", "1", "--spp", "256"});
+  // --tile-timeout holds in watch as in render. A render whose tiles last about 200 ms on any
+  // device (support/slow_shaders.h) times out: reported, no image written, the watch goes on; what
+  // the timed-out work uses stays alive until it is done, so stopping leaves nothing behind for the
+  // validation layer to report.
+  make_tiles_slow(dir_ / "shaders");
+  start({"--tile-timeout", "1"});
   const std::string output = child_->all_output();
   EXPECT_NE(output.find("did not finish within 1 ms"), std::string::npos) << output;
   EXPECT_NE(output.find("initial: scene"), std::string::npos) << output;

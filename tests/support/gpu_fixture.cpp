@@ -15,9 +15,11 @@ RenderOptions with_image(RenderOptions options, const ImageSettings& image) {
 void GpuTest::SetUp() {
   SessionOptions options;
   options.validation = true;
-  options.shader_dir = VKRAY_SHADER_DIR;
+  options.shader_dir = shader_dir();
   session_ = std::make_unique<Session>(options);  // no device is a failure, never a skip
 }
+
+std::filesystem::path GpuTest::shader_dir() const { return VKRAY_SHADER_DIR; }
 
 void GpuTest::TearDown() {
   try {

@@ -2,6 +2,7 @@
 // any validation message (during the test or while the device is torn down) fails the test.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 
 #include <gtest/gtest.h>
@@ -14,6 +15,8 @@ class GpuTest : public ::testing::Test {
  protected:
   void SetUp() override;
   void TearDown() override;
+  // The shaders the session compiles: the shipped ones unless a test's fixture says otherwise.
+  virtual std::filesystem::path shader_dir() const;
   Session& session() { return *session_; }
   // The scene's image at `image`, rendered on the device or with the CPU reference.
   Image render(const Scene& scene, const ImageSettings& image, RenderOptions options = {}, bool cpu = false);
