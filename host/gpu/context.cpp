@@ -185,9 +185,9 @@ const vk::raii::Instance& Context::instance() const { return instance_->instance
 Context::~Context() {
   if (!work_abandoned_) return;
   // Work may still run on the device: leave the device to the process instead of destroying it
-  // under the work (the instance is the process's anyway).
+  // under the work. The messenger is destroyed as usual (no device work uses it, and left on the
+  // process's instance it would report to a log that is gone); the instance is never destroyed.
   static_cast<void>(device_.release());
-  static_cast<void>(messenger_.release());
 }
 
 void Context::abandon_work() const {

@@ -48,7 +48,9 @@ std::shared_ptr<Instance> make_instance(bool validation) {
 
 std::shared_ptr<const Instance> shared_instance(bool validation) {
   static std::mutex mutex;
-  static std::shared_ptr<Instance> instances[2];  // destroyed at exit, after every Context
+  // Never destroyed: destroying them in static teardown could race a device left running work
+  // (Context::abandon_work()), and nobody would read the validation layer's report then.
+  static auto* const instances = new std::shared_ptr<Instance>[2];
   std::lock_guard lock(mutex);
   auto& slot = instances[validation ? 1 : 0];
   if (!slot) slot = make_instance(validation);

@@ -1,5 +1,7 @@
 // The process's Vulkan instances: one with the Khronos validation layer, one without, each created
-// by the first Context (or device listing) that needs it and kept until the process ends.
+// by the first Context (or device listing) that needs it and kept until the process ends. Each
+// validated Context has its own messenger on the shared instance, so sessions open at the same time
+// each see the validation messages of all of them (tests and commands open one at a time).
 //
 // Why not one per Context: the loader loads the driver with the first instance and unloads it with
 // the last, so a process that opens device after device (the test binary, a Python loop, `vkray
