@@ -1,6 +1,7 @@
 // `vkray check` as a user runs it: the report of a passing and of a failing device, the command that
 // reproduces a failure, the JUnit and JSON reports, and a case that cannot run. The whole suite runs
 // installed in installed_check.sh; these use one or two scenes at a small size.
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -72,13 +73,19 @@ TEST(CheckTest, AFailingDeviceExitsFourWithHeatmapsJunitAndTheCommandThatReprodu
   EXPECT_NE(junit.find("<testcase classname=\"vkray.check.cornell\" name=\"inline_16spp\""), std::string::npos) << junit;
   EXPECT_NE(junit.find("<failure message=\"parity tolerance does not hold: &gt; 1 step on "), std::string::npos) << junit;
 
-  // The printed command reproduces the failure on its own.
-  const std::string marker = "reproduce: vkray ";
+  // The printed command reproduces the failure on its own: this vkray, this device, the loader's
+  // environment of the run (CTest points VK_DRIVER_FILES at lavapipe), run from another folder.
+  const std::string marker = "reproduce: ";
   const size_t at = run.out.find(marker);
   ASSERT_NE(at, std::string::npos) << run.out;
   const std::string command = run.out.substr(at + marker.size(), run.out.find('\n', at) - at - marker.size());
+  EXPECT_NE(command.find(std::string(VKRAY_EXECUTABLE) + " parity "), std::string::npos) << command;
   EXPECT_NE(command.find("--inline-scene never --device 0 --shader-dir "), std::string::npos) << command;
-  const CommandResult again = run_vkray(command, dir.path());
+  if (std::getenv("VK_DRIVER_FILES")) {
+    EXPECT_EQ(command.rfind("VK_DRIVER_FILES=", 0), 0u) << command;
+  }
+  const TempDir elsewhere;
+  const CommandResult again = run_command(command, elsewhere.path());
   EXPECT_EQ(again.exit_code, 4) << command << "\n" << again.err;
   EXPECT_NE(again.out.find("FAIL"), std::string::npos) << again.out;
 }
@@ -92,15 +99,35 @@ TEST(CheckTest, ACaseThatCannotRunIsAnErrorInTheReportAndEndsTheCheck) {
   EXPECT_NE(run.err.find("trace.comp"), std::string::npos) << run.err;
   const std::string junit = read_text(dir / "report.xml");
   EXPECT_NE(junit.find("errors=\"1\""), std::string::npos) << junit;
-  EXPECT_NE(junit.find("<testcase classname=\"vkray.check.cornell\" name=\"run\""), std::string::npos) << junit;
+  // The case that was running: the first, whose render compiles the shaders.
+  EXPECT_NE(junit.find("<testcase classname=\"vkray.check.cornell\" name=\"bvh_1spp\""), std::string::npos) << junit;
+  EXPECT_NE(junit.find("<error message=\""), std::string::npos) << junit;
+
+  // A device that cannot be opened is the report's one error.
+  const CommandResult no_device = run_vkray("check --device no-such-device --junit none.xml", dir.path());
+  EXPECT_EQ(no_device.exit_code, 3) << no_device.err;
+  const std::string report = read_text(dir / "none.xml");
+  EXPECT_NE(report.find("tests=\"1\" failures=\"0\" errors=\"1\""), std::string::npos) << report;
+  EXPECT_NE(report.find("<testcase classname=\"vkray.check\" name=\"device\""), std::string::npos) << report;
+  EXPECT_NE(report.find("no Vulkan device matches --device"), std::string::npos) << report;
 }
 
-TEST(CheckTest, AnUnknownCaseIsAUsageErrorNamingTheCases) {
+TEST(CheckTest, AnUnknownCaseOrAnUnusableOutputIsRefusedBeforeAnyCase) {
   TempDir dir;
   const CommandResult run = run_vkray("check --case no-such-scene", dir.path());
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("--case no-such-scene: no such case; the cases are bunny,"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("light-on-surface"), std::string::npos) << run.err;
+
+  // Where failures and the report go is checked before any case runs.
+  std::ofstream(dir / "a-file") << "x";
+  const CommandResult failures = run_vkray("check --case cornell --failures a-file", dir.path());
+  EXPECT_EQ(failures.exit_code, 1);
+  EXPECT_NE(failures.err.find("a-file: exists and is not a folder"), std::string::npos) << failures.err;
+  EXPECT_EQ(failures.out, "");
+  const CommandResult junit = run_vkray("check --case cornell --junit no/such/folder/r.xml", dir.path());
+  EXPECT_EQ(junit.exit_code, 1);
+  EXPECT_NE(junit.err.find("folder no/such/folder does not exist"), std::string::npos) << junit.err;
 }
 
 }  // namespace

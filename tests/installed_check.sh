@@ -6,8 +6,9 @@
 # Usage: installed_check.sh BUILD_DIR CMAKE
 set -euo pipefail
 build=$1 cmake=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+work=$(cd "$(mktemp -d)" && pwd -P)  # as /proc/self/exe will name it, with no symlink in the way
+keep() { echo "installed_check: kept $work (the install, out.txt, report.xml, vkray-check-failures/)" >&2; }
+trap 'status=$?; if [ $status -eq 0 ]; then rm -rf "$work"; else keep; fi' EXIT
 "$cmake" --install "$build" --prefix "$work/prefix" > /dev/null
 cd "$work"
 status=0

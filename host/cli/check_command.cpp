@@ -2,6 +2,7 @@
 // line per case, the command that reproduces each failure), for CI (JUnit XML) and for scripts (JSON).
 // What a driver developer pastes into a bug report: the header names vkray, the device and driver.
 #include <algorithm>
+#include <cstdlib>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -20,7 +22,6 @@
 #include "cli/junit.h"
 #include "cli/parity_report.h"
 #include "cli/report.h"
-#include "packing/inline_scene.h"
 #include "session/check.h"
 #include "session/paths.h"
 #include "session/session.h"
@@ -50,12 +51,25 @@ std::string shell_word(const std::string& word) {
   return quoted + "'";
 }
 
-// The one command that renders `c` again as the check did and prints its metrics.
+// The Vulkan loader's variables that choose drivers, devices and layers, as they are set: what a
+// driver developer uses to test their own build, so a reproduce command carries them.
+std::string loader_environment() {
+  std::string words;
+  for (const char* name : {"VK_DRIVER_FILES", "VK_ICD_FILENAMES", "VK_ADD_DRIVER_FILES", "VK_LOADER_DRIVERS_SELECT",
+                           "VK_LOADER_DRIVERS_DISABLE", "VK_LAYER_PATH", "VK_ADD_LAYER_PATH"})
+    if (const char* value = std::getenv(name)) words += std::string(name) + "=" + shell_word(value) + " ";
+  return words;
+}
+
+// The one command that renders `c` again as the check did, in a process of its own, and prints its
+// metrics: this vkray, on this device, with the loader's environment of this run.
 std::string reproduce_command(const CheckCase& c, const CheckArgs& args, const CheckOptions& options,
                               const DeviceInfo& device) {
-  std::string command = "vkray parity " + shell_word(std::filesystem::absolute(c.scene).lexically_normal().string()) +
-                        " --width " + std::to_string(options.width) + " --height " + std::to_string(options.height) +
-                        " --spp " + std::to_string(c.samples_per_pixel) + " --inline-scene " +
+  const auto exe = executable_path();
+  std::string command = loader_environment() + shell_word(exe.empty() ? "vkray" : exe.string()) + " parity " +
+                        shell_word(std::filesystem::absolute(c.scene).lexically_normal().string()) + " --width " +
+                        std::to_string(options.width) + " --height " + std::to_string(options.height) + " --spp " +
+                        std::to_string(c.samples_per_pixel) + " --inline-scene " +
                         (c.path == InlineScene::always ? "always" : "never") + " --device " +
                         std::to_string(device.index);
   if (!args.device.shader_dir.empty())
@@ -91,19 +105,21 @@ struct Outcome {
 
 class CheckReport {
  public:
-  CheckReport(const CheckArgs& args, const CheckOptions& options, const DeviceInfo& device)
-      : args_(args), options_(options), device_(device) {}
+  CheckReport(const CheckArgs& args, const CheckOptions& options) : args_(args), options_(options) {}
 
-  void header(size_t scenes) const {
+  // The device, once it is open: the header names it.
+  void opened(const DeviceInfo& device) {
+    device_ = device;
     if (args_.json) return;
     std::printf("vkray check: vkray %s\n", version_string());
     std::printf("device %u: %s (%s), driver %s, Vulkan %s\n", device_.index, device_.name.c_str(), device_.type.c_str(),
                 device_.driver.c_str(), device_.api_version.c_str());
-    std::printf("%zu scenes at %ux%u, each on the BVH and, with %u primitives or fewer, compiled into the shader; at 1 "
-                "and 16 spp; tolerance: %s\n",
-                scenes, options_.width, options_.height, gpu::kMaxInlinePrimitives, describe_tolerance({}).c_str());
+    if (!loader_environment().empty()) std::printf("loader: %s\n", loader_environment().c_str());
+    std::printf("%s; tolerance: %s\n", describe_plan(options_).c_str(), describe_tolerance({}).c_str());
     std::fflush(stdout);
   }
+
+  void running(const CheckCase& c) { running_ = c; }
 
   void add(const CheckResult& r) {
     Outcome o;
@@ -131,8 +147,9 @@ class CheckReport {
     outcomes_.push_back(std::move(o));
   }
 
-  // The case that could not run, and why.
-  void error(const std::filesystem::path& scene, const std::string& message) { error_ = {scene, message}; }
+  // The case that could not run (or the scene that could not load, or the device that could not
+  // open), and why.
+  void error(const std::string& message) { error_ = message; }
 
   size_t failed() const {
     return size_t(std::count_if(outcomes_.begin(), outcomes_.end(), [](const Outcome& o) { return !o.pass; }));
@@ -157,16 +174,23 @@ class CheckReport {
             {"device_type", device_.type},
             {"driver", device_.driver},
             {"vulkan_version", device_.api_version},
+            {"loader_environment", loader_environment()},
             {"image", std::to_string(options_.width) + "x" + std::to_string(options_.height)},
             {"tolerance", describe_tolerance({})}};
   }
 
+  // JUnit's names of a case (or, before any case ran, of the device).
+  std::pair<std::string, std::string> junit_names(const std::optional<CheckCase>& c) const {
+    if (!c) return {"vkray.check", "device"};
+    return {"vkray.check." + c->scene.stem().string(),
+            std::string(path_name(c->path)) + "_" + std::to_string(c->samples_per_pixel) + "spp"};
+  }
+
   JunitSuite junit() const {
-    JunitSuite suite{"vkray check", now_iso8601(), properties(), {}};
+    JunitSuite suite{"vkray check", timestamp_, properties(), {}};
     for (const auto& o : outcomes_) {
       JunitCase c;
-      c.classname = "vkray.check." + o.c.scene.stem().string();
-      c.name = std::string(path_name(o.c.path)) + "_" + std::to_string(o.c.samples_per_pixel) + "spp";
+      std::tie(c.classname, c.name) = junit_names(o.c);
       c.seconds = o.seconds;
       c.output = o.summary + "\n" + (o.description.empty() ? "" : o.description + "\n") + "reproduce: " + o.command;
       if (!o.pass)
@@ -176,9 +200,8 @@ class CheckReport {
     }
     if (error_) {
       JunitCase c;
-      c.classname = "vkray.check." + error_->first.stem().string();
-      c.name = "run";
-      c.error = JunitCase::Problem{error_->second, error_->second};
+      std::tie(c.classname, c.name) = junit_names(running_);
+      c.error = JunitCase::Problem{*error_, *error_};
       suite.cases.push_back(std::move(c));
     }
     return suite;
@@ -200,15 +223,17 @@ class CheckReport {
     j["cases"] = std::move(cases);
     j["passed"] = outcomes_.size() - failed();
     j["failed"] = failed();
-    if (error_) j["error"] = {{"scene", error_->first.string()}, {"message", error_->second}};
+    if (error_) j["error"] = {{"case", running_ ? case_name(*running_) : "device"}, {"message", *error_}};
     return j;
   }
 
   const CheckArgs& args_;
   const CheckOptions& options_;
-  const DeviceInfo device_;  // a copy: the session closes before the report is finished
+  const std::string timestamp_ = now_iso8601();  // when the check started
+  DeviceInfo device_{};  // a copy: the session closes before the report is finished
   std::vector<Outcome> outcomes_;
-  std::optional<std::pair<std::filesystem::path, std::string>> error_;
+  std::optional<CheckCase> running_;
+  std::optional<std::string> error_;
 };
 
 // The scenes the check runs: every shipped scene and every adversarial case, or those --case names.
@@ -228,29 +253,47 @@ std::vector<std::filesystem::path> chosen_scenes(const std::vector<std::string>&
   return chosen;
 }
 
+// Throws OutputError unless `folder` is a folder or can be made one (its parent exists).
+void check_failures_folder(const std::filesystem::path& folder) {
+  std::error_code ec;
+  if (std::filesystem::exists(folder, ec)) {
+    if (!std::filesystem::is_directory(folder, ec)) throw OutputError(folder.string() + ": exists and is not a folder");
+  } else {
+    check_output_folder(folder);
+  }
+}
+
 int run_check_command(const CheckArgs& args) {
   if (!args.junit.empty()) check_output_folder(args.junit);
+  check_failures_folder(args.failures);
   CheckOptions options;
   options.scenes = chosen_scenes(args.cases);
   options.width = args.width.value_or(options.width);
   options.height = args.height.value_or(options.height);
   options.render = render_options(nullptr, &args.gpu, &args.cpu);
 
-  Session session(session_options(args.device));
-  CheckReport report(args, options, session.device_info());
-  report.header(options.scenes.size());
-  std::filesystem::path running;
-  options.on_scene = [&](const std::filesystem::path& scene) { running = scene; };
+  CheckReport report(args, options);
+  // A scene that cannot load is reported as its first case.
+  options.on_scene = [&](const std::filesystem::path& scene) {
+    report.running({scene, InlineScene::never, options.samples_per_pixel.front()});
+  };
+  options.on_case = [&](const CheckCase& c) { report.running(c); };
   options.on_result = [&](const CheckResult& r) { report.add(r); };
   try {
+    Session session(session_options(args.device));
+    report.opened(session.device_info());
     run_check(session, options);
     session.close();
   } catch (const Cancelled&) {
-    throw;  // Ctrl-C: nothing more is written
+    throw;  // Ctrl-C: no report
   } catch (const Error& e) {
     // The report so far, with the case that could not run, then the error as any command reports it.
-    report.error(running, e.what());
-    report.finish();
+    report.error(e.what());
+    try {
+      report.finish();
+    } catch (const Error& also) {
+      std::cerr << "vkray: " << also.what() << "\n";
+    }
     throw;
   }
   report.finish();

@@ -26,14 +26,27 @@ std::vector<std::filesystem::path> check_scenes(const std::vector<std::filesyste
     for (const auto& entry : std::filesystem::directory_iterator(folder))
       if (entry.path().extension() == ".json") files.push_back(entry.path());
     std::sort(files.begin(), files.end());
+    for (const auto& file : files)
+      for (const auto& earlier : result)
+        if (earlier.stem() == file.stem())
+          throw InternalError("check cases " + earlier.string() + " and " + file.string() + " have one name");
     result.insert(result.end(), files.begin(), files.end());
   }
   return result;
 }
 
-std::vector<CheckResult> run_check(Session& session, const CheckOptions& options) {
+std::string describe_plan(const CheckOptions& options) {
+  std::string counts;
+  for (const uint32_t spp : options.samples_per_pixel)
+    counts += (counts.empty() ? "" : spp == options.samples_per_pixel.back() ? " and " : ", ") + std::to_string(spp);
+  return std::to_string(options.scenes.size()) + " scenes at " + std::to_string(options.width) + "x" +
+         std::to_string(options.height) + ", each on the BVH and, with " + std::to_string(gpu::kMaxInlinePrimitives) +
+         " primitives or fewer, compiled into the shader; at " + counts + " spp";
+}
+
+void run_check(Session& session, const CheckOptions& options) {
   using Clock = std::chrono::steady_clock;
-  std::vector<CheckResult> results;
+  const auto since = [](Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); };
   for (const auto& file : options.scenes) {
     throw_if_interrupted();
     if (options.on_scene) options.on_scene(file);
@@ -42,32 +55,33 @@ std::vector<CheckResult> run_check(Session& session, const CheckOptions& options
     const DeviceScene on_device = session.upload(scene, &bvh);
     std::vector<InlineScene> paths{InlineScene::never};
     const size_t primitives = scene->triangles.size() + scene->spheres.size();
-    if (primitives > 0 && primitives <= gpu::kMaxInlinePrimitives)
-      paths.push_back(InlineScene::always);
+    if (primitives > 0 && primitives <= gpu::kMaxInlinePrimitives) paths.push_back(InlineScene::always);
     for (const uint32_t spp : options.samples_per_pixel) {
       RenderOptions render = options.render;
       render.width = options.width;
       render.height = options.height;
       render.samples_per_pixel = spp;
+      if (options.on_case) options.on_case({file, paths.front(), spp});
       // The reference does not depend on the GPU path: rendered once for both.
       const auto cpu_start = Clock::now();
       std::vector<uint64_t> signatures;
       const RenderResult cpu = render_on_cpu(*scene, render, &bvh, &signatures);
-      const double cpu_seconds = std::chrono::duration<double>(Clock::now() - cpu_start).count();
+      double shared_seconds = since(cpu_start);
       for (const InlineScene path : paths) {
+        const CheckCase c{file, path, spp};
+        if (options.on_case && path != paths.front()) options.on_case(c);
         const auto start = Clock::now();
         render.inline_scene = path;
-        CheckResult result{{file, path, spp}, scene->description, {}, 0};
+        CheckResult result{c, scene->description, {}, 0};
         result.parity = judge_parity(image_settings(*scene, render), session.render(on_device, render), cpu, signatures);
         if (result.parity.gpu.stats.inline_scene != (path == InlineScene::always))
-          throw InternalError(case_name(result.c) + ": the render did not take the path it was asked for");
-        result.seconds = std::chrono::duration<double>(Clock::now() - start).count() + cpu_seconds;
+          throw InternalError(case_name(c) + ": the render did not take the path it was asked for");
+        result.seconds = since(start) + shared_seconds;
+        shared_seconds = 0;
         if (options.on_result) options.on_result(result);
-        results.push_back(std::move(result));
       }
     }
   }
-  return results;
 }
 
 }  // namespace vkray

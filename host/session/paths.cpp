@@ -3,12 +3,18 @@
 #include <system_error>
 
 namespace vkray {
+
+std::filesystem::path executable_path() {
+  std::error_code ec;
+  auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : exe;
+}
+
 namespace {
 
 std::filesystem::path installed_data_dir() {
-  std::error_code ec;
-  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
+  const auto exe = executable_path();
+  if (exe.empty()) return {};
   return exe.parent_path().parent_path() / "share" / "vkray";
 }
 

@@ -6,6 +6,8 @@
 
 namespace vkray {
 
+// The running program's own file (empty when /proc is not there).
+std::filesystem::path executable_path();
 std::filesystem::path default_shader_dir();
 std::filesystem::path default_scene_dir();
 std::filesystem::path default_scene();
