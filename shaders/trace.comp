@@ -13,7 +13,7 @@
 layout(local_size_x = VKRAY_WORKGROUP_X, local_size_y = VKRAY_WORKGROUP_Y, local_size_z = 1) in;
 
 layout(push_constant) uniform Tile { TileConstants tile; };
-layout(std430, set = 0, binding = VKRAY_BINDING_OUTPUT) writeonly buffer Output { vec4 radiance[]; };
+layout(std430, set = 0, binding = VKRAY_BINDING_OUTPUT) buffer Output { vec4 radiance[]; };
 
 void main() {
   load_frame();
@@ -27,10 +27,15 @@ void main() {
   // The samples as a do-while: llvmpipe runs a loop's body until no lane is left in it, so a loop
   // that tests its condition first runs the whole body once more, masked, after the last iteration
   // (here a second camera ray's traversal and shading for every pixel; docs/design.md, "What the
-  // time goes to"). samples_per_pixel >= 1.
+  // time goes to"). sample_end > sample_begin.
   vec3 sum = vec3(0.0);
   uint rays = 0u;
-  uint k = 0u;
+  if (tile.sample_begin > 0u) {  // an earlier dispatch's running sum (TileConstants::sample_begin)
+    vec4 so_far = radiance[index];
+    sum = so_far.rgb;
+    rays = floatBitsToUint(so_far.a);
+  }
+  uint k = tile.sample_begin;
   do {
     vec2 xi = sample_offset(index, k, frame.samples_per_pixel, frame.strata_x, frame.inv_strata_x,
                             frame.inv_strata_y);
@@ -38,7 +43,8 @@ void main() {
     rays += 1u;
     Hit hit = trace_closest(ray, frame.epsilon, FAR);
     sum += (hit.prim == NO_HIT) ? frame.background.rgb : shade(ray, hit, rays);
-  } while (++k < frame.samples_per_pixel);
+  } while (++k < tile.sample_end);
   // Alpha carries the number of rays traced for this pixel (bit pattern of a uint) for the rays/s figure.
-  radiance[index] = vec4(sum * frame.inv_samples_per_pixel, uintBitsToFloat(rays));
+  vec3 stored = tile.sample_end == frame.samples_per_pixel ? sum * frame.inv_samples_per_pixel : sum;
+  radiance[index] = vec4(stored, uintBitsToFloat(rays));
 }

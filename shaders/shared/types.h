@@ -93,6 +93,11 @@ struct TileConstants {
   // contiguous share of a dispatch's workgroups; scattered rows give every share a like mix of
   // cheap and costly pixels, so no thread finishes long before the others (gpu::row_stride).
   uint row_stride;
+  // The dispatch traces samples [sample_begin, sample_end) of each pixel, continuing the running sum
+  // an earlier dispatch of the tile left in the output (the same float additions in the same order
+  // as one loop over all samples); the one that ends at samples_per_pixel stores the mean.
+  uint sample_begin;
+  uint sample_end;
 };
 #ifdef __cplusplus
 static_assert(offsetof(TileConstants, x0) == 0);
@@ -100,7 +105,9 @@ static_assert(offsetof(TileConstants, y0) == 4);
 static_assert(offsetof(TileConstants, width) == 8);
 static_assert(offsetof(TileConstants, height) == 12);
 static_assert(offsetof(TileConstants, row_stride) == 16);
-static_assert(sizeof(TileConstants) == 20);
+static_assert(offsetof(TileConstants, sample_begin) == 20);
+static_assert(offsetof(TileConstants, sample_end) == 24);
+static_assert(sizeof(TileConstants) == 28);
 #endif
 
 VKRAY_SHARED_END
