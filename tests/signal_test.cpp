@@ -117,6 +117,13 @@ TEST(SignalTest, BenchStopsWithinASecond) {
   for (const int delay : {100, 1000}) expect_stops({VKRAY_EXECUTABLE, "bench", "--repeat", "1"}, std::chrono::milliseconds(delay), SIGINT);
 }
 
+TEST(SignalTest, CheckStopsWithinASecondWritingNoReport) {
+  // Loading the 2-million-triangle field, building its BVH, then its cases: no JUnit file is left.
+  for (const int delay : {300, 2500})
+    expect_stops({VKRAY_EXECUTABLE, "check", "--case", "dragon-field", "--junit", "report.xml"},
+                 std::chrono::milliseconds(delay), SIGINT);
+}
+
 // A stage that polls nothing: glslang compiling a shader of 20000 dependent lines (seconds). The
 // signal thread does not wait past StopSignals::kGrace for it and ends the process itself, still
 // within a second and still leaving nothing behind.
