@@ -21,7 +21,10 @@ struct Image {
 };
 
 // round(255 * sRGB_encode(clamp(linear, 0, 1))), the PNG encoding of the shading contract.
+// encode_srgb8 gives exactly encode_srgb8_by_formula's result, from a table (tests check every float
+// in [0, 1] that matters: each threshold and its neighbours).
 uint8_t encode_srgb8(float linear);
+uint8_t encode_srgb8_by_formula(float linear);
 float decode_srgb8(uint8_t encoded);
 
 // Writes by extension: ".png" (8-bit sRGB) or ".pfm" (32-bit float linear, rows bottom to top,
