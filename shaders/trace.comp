@@ -22,7 +22,8 @@ void main() {
   uvec2 local = group * uvec2(VKRAY_WORKGROUP_X, VKRAY_WORKGROUP_Y) + gl_LocalInvocationID.xy;
   if (local.x >= tile.width || local.y >= tile.height) return;
   uvec2 pixel = uvec2(tile.x0, tile.y0) + local;
-  uint index = pixel.y * frame.width + pixel.x;
+  uint pixel_index = pixel.y * frame.width + pixel.x;  // the sample pattern's: the same in any tile
+  uint index = tile.output_offset + local.y * tile.width + local.x;  // in the tile's part of the output
 
   // The samples as a do-while: llvmpipe runs a loop's body until no lane is left in it, so a loop
   // that tests its condition first runs the whole body once more, masked, after the last iteration
@@ -37,7 +38,7 @@ void main() {
   }
   uint k = tile.sample_begin;
   do {
-    vec2 xi = sample_offset(index, k, frame.samples_per_pixel, frame.strata_x, frame.inv_strata_x,
+    vec2 xi = sample_offset(pixel_index, k, frame.samples_per_pixel, frame.strata_x, frame.inv_strata_x,
                             frame.inv_strata_y);
     Ray ray = camera_ray(pixel, xi);
     rays += 1u;

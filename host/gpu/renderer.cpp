@@ -36,11 +36,12 @@ struct Renderer::Frame {
   std::shared_ptr<const GpuScene> scene;
   std::shared_ptr<const vk::raii::Pipeline> pipeline;
   Buffer uniforms;
-  Buffer output;
+  Buffer output;  // two tiles' slots: one traced while the other is read back
   std::optional<DescriptorSet> descriptors;
   vk::raii::CommandPool command_pool{nullptr};
-  vk::raii::CommandBuffers command_buffers{nullptr};
-  vk::raii::Fence fence{nullptr};
+  vk::raii::CommandBuffers command_buffers{nullptr};  // one per slot
+  std::vector<vk::raii::Fence> fences;                // one per slot
+  std::vector<vk::Fence> in_flight;                   // submitted and not yet waited for
 };
 
 Renderer::Renderer(std::shared_ptr<const Context> ctx) : ctx_(std::move(ctx)) {}
@@ -61,7 +62,10 @@ bool Renderer::busy(std::chrono::milliseconds wait) {
   for (auto it = abandoned_.begin(); it != abandoned_.end();) {
     const auto left = std::max(std::chrono::nanoseconds(0), std::chrono::nanoseconds(deadline - Clock::now()));
     try {
-      if (ctx_->device().waitForFences({*(*it)->fence}, VK_TRUE, uint64_t(left.count())) == vk::Result::eTimeout) return true;
+      const auto& fences = (*it)->in_flight;
+      if (!fences.empty() &&
+          ctx_->device().waitForFences(fences, VK_TRUE, uint64_t(left.count())) == vk::Result::eTimeout)
+        return true;
     } catch (const vk::DeviceLostError&) {  // nothing runs on a lost device any more
     }
     it = abandoned_.erase(it);
@@ -80,47 +84,59 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
 
   // ---- per-frame data: uniforms, output, descriptors ----
   auto start = Clock::now();
-  const vk::DeviceSize pixel_bytes =
-      checked_mul(checked_mul(image.width, image.height, "output image"), sizeof(glm::vec4), "output image");
-  if (pixel_bytes > ctx_->limits().maxStorageBufferRange)
-    throw DeviceError("image too large for " + ctx_->device_name() + ": " + std::to_string(pixel_bytes) +
+  // The output holds two tiles, not the image: any image size fits the device's
+  // maxStorageBufferRange (128 MiB on lavapipe), the tile made smaller when two would not.
+  constexpr uint32_t kSlots = 2;
+  uint32_t side = request.tile_side ? request.tile_side : tile_side(scene->scene(), image);
+  const auto slot_pixels = [&] { return uint64_t(std::min(side, image.width)) * std::min(side, image.height); };
+  while (side > VKRAY_WORKGROUP_X && kSlots * slot_pixels() * sizeof(glm::vec4) > ctx_->limits().maxStorageBufferRange)
+    side -= VKRAY_WORKGROUP_X;
+  const vk::DeviceSize output_bytes = kSlots * slot_pixels() * sizeof(glm::vec4);
+  if (output_bytes > ctx_->limits().maxStorageBufferRange)
+    throw DeviceError("a render tile does not fit " + ctx_->device_name() + ": " + std::to_string(output_bytes) +
                       " bytes of output, maxStorageBufferRange is " + std::to_string(ctx_->limits().maxStorageBufferRange));
+  Image result(image.width, image.height);  // the host's copy, filled tile by tile
   auto frame = std::make_unique<Frame>();
   frame->trace_pipeline = std::move(trace_pipeline);
   frame->scene = std::move(scene);
   const FrameUniforms uniforms = pack_frame(frame->scene->scene(), frame->scene->primitive_count(), image);
   frame->uniforms = upload_buffer(*ctx_, &uniforms, sizeof(uniforms), vk::BufferUsageFlagBits::eUniformBuffer);
   using M = vk::MemoryPropertyFlagBits;
-  frame->output = create_buffer(*ctx_, pixel_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
+  frame->output = create_buffer(*ctx_, output_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
   DescriptorWriter writer = frame->trace_pipeline->descriptors().writer();
   writer.buffer(VKRAY_BINDING_FRAME, *frame->uniforms.buffer).buffer(VKRAY_BINDING_OUTPUT, *frame->output.buffer);
   frame->scene->bind(writer);
   frame->descriptors = writer.write();
   stats.upload_seconds = seconds_since(start);
 
-  // ---- trace, one submission per tile ----
+  // ---- trace, one submission per tile; each tile read back while the next one traces ----
   frame->pipeline = frame->trace_pipeline->pipeline(request.variant);  // compiled here unless asked for before
   start = Clock::now();
+  double readback_seconds = 0;
   frame->command_pool = vk::raii::CommandPool(device, {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, ctx_->queue_family()});
-  frame->command_buffers = vk::raii::CommandBuffers(device, {*frame->command_pool, vk::CommandBufferLevel::ePrimary, 1});
-  frame->fence = vk::raii::Fence(device, vk::FenceCreateInfo{});
-  const vk::raii::CommandBuffer& cb = frame->command_buffers[0];
+  frame->command_buffers = vk::raii::CommandBuffers(device, {*frame->command_pool, vk::CommandBufferLevel::ePrimary, kSlots});
+  for (uint32_t slot = 0; slot < kSlots; ++slot) frame->fences.emplace_back(device, vk::FenceCreateInfo{});
   const vk::PipelineLayout layout = *frame->trace_pipeline->layout();
-  const uint32_t side = request.tile_side ? request.tile_side : tile_side(frame->scene->scene(), image);
   const uint32_t tiles_x = (image.width + side - 1) / side, tiles_y = (image.height + side - 1) / side;
   const uint32_t tile_count = tiles_x * tiles_y;
+  std::vector<TileConstants> tiles(tile_count);
   for (uint32_t tile_index = 0; tile_index < tile_count; ++tile_index) {
-    TileConstants tile;
+    TileConstants& tile = tiles[tile_index];
     tile.x0 = (tile_index % tiles_x) * side;
     tile.y0 = (tile_index / tiles_x) * side;
     tile.width = std::min(side, image.width - tile.x0);
     tile.height = std::min(side, image.height - tile.y0);
+    tile.row_stride = row_stride((tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y);
+    tile.output_offset = uint32_t((tile_index % kSlots) * slot_pixels());
+  }
+  const auto submit = [&](uint32_t tile_index) {
+    TileConstants tile = tiles[tile_index];
     const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
     const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
-    tile.row_stride = row_stride(groups_y);
-
+    const vk::raii::CommandBuffer& cb = frame->command_buffers[tile_index % kSlots];
     cb.reset();
     cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+    // The slot's last reader was the host, after its fence (and a submission is ordered after it).
     cb.bindPipeline(vk::PipelineBindPoint::eCompute, **frame->pipeline);
     cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, layout, 0, frame->descriptors->get(), {});
     // The samples in dispatches of at most kSamplesPerDispatch, each continuing the last one's sums.
@@ -140,30 +156,46 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
     cb.end();
     const vk::CommandBuffer raw = *cb;
-    ctx_->queue().submit(vk::SubmitInfo({}, {}, raw), *frame->fence);
+    const vk::Fence fence = *frame->fences[tile_index % kSlots];
+    ctx_->queue().submit(vk::SubmitInfo({}, {}, raw), fence);
+    frame->in_flight.push_back(fence);
+  };
+  // Waits for a tile, copies its pixels into the image and frees its slot.
+  const auto finish = [&](uint32_t tile_index) {
+    const vk::raii::Fence& fence = frame->fences[tile_index % kSlots];
     try {
-      ctx_->wait(frame->fence, request.tile_timeout, "a render tile");
-    } catch (...) {  // timed out or interrupted: the tile may still run
+      ctx_->wait(fence, request.tile_timeout, "a render tile");
+    } catch (...) {  // timed out or interrupted: this tile and the next may still run
       abandoned_.push_back(std::move(frame));  // kept until the device is done with it
       throw;
     }
-    device.resetFences(*frame->fence);
+    const auto read_start = Clock::now();
+    std::erase(frame->in_flight, *fence);
+    device.resetFences(*fence);
+    frame->output.invalidate(device);
+    const TileConstants& tile = tiles[tile_index];
+    const auto* texels = static_cast<const glm::vec4*>(frame->output.mapped) + tile.output_offset;
+    for (uint32_t y = 0; y < tile.height; ++y)
+      for (uint32_t x = 0; x < tile.width; ++x) {
+        const glm::vec4& texel = texels[size_t(y) * tile.width + x];
+        result.at(tile.x0 + x, tile.y0 + y) = glm::vec3(texel);
+        stats.rays += std::bit_cast<uint32_t>(texel.w);
+      }
+    readback_seconds += seconds_since(read_start);
     if (request.progress) request.progress(tile_index + 1, tile_count);
-    if (tile_index + 1 < tile_count) throw_if_interrupted();
+  };
+  for (uint32_t tile_index = 0; tile_index < tile_count; ++tile_index) {
+    submit(tile_index);
+    if (tile_index > 0) finish(tile_index - 1);
+    if (tile_index + 1 < tile_count && interrupt_requested()) {
+      abandoned_.push_back(std::move(frame));  // the tile just submitted may still run
+      throw_if_interrupted();
+    }
   }
-  stats.trace_seconds = seconds_since(start);
+  finish(tile_count - 1);
+  stats.trace_seconds = seconds_since(start) - readback_seconds;
+  stats.readback_seconds = readback_seconds;
   stats.tiles = tile_count;
-
-  // ---- read back ----
-  start = Clock::now();
-  frame->output.invalidate(device);
-  Image result(image.width, image.height);
-  const auto* texels = static_cast<const glm::vec4*>(frame->output.mapped);
-  for (size_t i = 0; i < result.pixels.size(); ++i) {
-    result.pixels[i] = glm::vec3(texels[i]);
-    stats.rays += std::bit_cast<uint32_t>(texels[i].w);
-  }
-  stats.readback_seconds = seconds_since(start);
   if (stats_out) *stats_out = stats;
   return result;
 }

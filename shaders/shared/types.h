@@ -98,6 +98,9 @@ struct TileConstants {
   // as one loop over all samples); the one that ends at samples_per_pixel stores the mean.
   uint sample_begin;
   uint sample_end;
+  // Where the tile's pixels start in the output, which holds a tile or two, not the image (any
+  // image size fits a device's maxStorageBufferRange): row-major in the tile, width pixels a row.
+  uint output_offset;
 };
 #ifdef __cplusplus
 static_assert(offsetof(TileConstants, x0) == 0);
@@ -107,7 +110,8 @@ static_assert(offsetof(TileConstants, height) == 12);
 static_assert(offsetof(TileConstants, row_stride) == 16);
 static_assert(offsetof(TileConstants, sample_begin) == 20);
 static_assert(offsetof(TileConstants, sample_end) == 24);
-static_assert(sizeof(TileConstants) == 28);
+static_assert(offsetof(TileConstants, output_offset) == 28);
+static_assert(sizeof(TileConstants) == 32);
 #endif
 
 VKRAY_SHARED_END
