@@ -19,12 +19,21 @@ namespace {
 // with 2 cores, so no single submission runs long.
 constexpr double kTestsPerTile = double(1 << 26);
 
+// Ray-primitive tests one sample costs, roughly: a ray visits on the order of log2(N) nodes and a few
+// leaves, for the camera ray and each light's shadow ray.
+double tests_per_sample(const Scene& scene) {
+  const double primitives = double(scene.triangles.size() + scene.spheres.size()) + 1.0;
+  return (8.0 + 4.0 * std::log2(primitives)) * (1.0 + double(scene.lights.size()));
+}
+
 // The most samples of a pixel one dispatch traces. llvmpipe ends every loop of an invocation once
 // the invocation has made 65535 loop iterations in all (Mesa 22.3's loop limiter), without a word:
 // at 16 x 16 pixels of the Cornell box, 2048 spp in one dispatch gave an image 29% too dark (1024 did
-// not). A sample costs tens of iterations there (the sample loop, the BVH walk, the lights, the
-// shadow rays' walks), a few hundred in the largest scenes: 64 samples keep a dispatch far below.
-constexpr uint32_t kSamplesPerDispatch = 64;
+// not). A sample's loop iterations (the sample loop, the light loop, each ray's BVH walk) are bounded
+// by its estimated tests; a dispatch gets at most half the limit of them, and at most 64 samples.
+uint32_t samples_in_one_dispatch(const Scene& scene) {
+  return uint32_t(std::clamp(32768.0 / tests_per_sample(scene), 1.0, 64.0));
+}
 
 }  // namespace
 
@@ -115,33 +124,37 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   double readback_seconds = 0;
   frame->command_pool = vk::raii::CommandPool(device, {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, ctx_->queue_family()});
   frame->command_buffers = vk::raii::CommandBuffers(device, {*frame->command_pool, vk::CommandBufferLevel::ePrimary, kSlots});
+  frame->fences.reserve(kSlots);
   for (uint32_t slot = 0; slot < kSlots; ++slot) frame->fences.emplace_back(device, vk::FenceCreateInfo{});
+  frame->in_flight.reserve(kSlots);  // so that recording a submission cannot fail after it is made
+  abandoned_.reserve(abandoned_.size() + 1);  // nor keeping the frame when the device still runs it
   const vk::PipelineLayout layout = *frame->trace_pipeline->layout();
   const uint32_t tiles_x = (image.width + side - 1) / side, tiles_y = (image.height + side - 1) / side;
   const uint32_t tile_count = tiles_x * tiles_y;
-  std::vector<TileConstants> tiles(tile_count);
-  for (uint32_t tile_index = 0; tile_index < tile_count; ++tile_index) {
-    TileConstants& tile = tiles[tile_index];
+  const uint32_t samples_per_dispatch = samples_in_one_dispatch(frame->scene->scene());
+  const auto tile_at = [&](uint32_t tile_index) {
+    TileConstants tile{};
     tile.x0 = (tile_index % tiles_x) * side;
     tile.y0 = (tile_index / tiles_x) * side;
     tile.width = std::min(side, image.width - tile.x0);
     tile.height = std::min(side, image.height - tile.y0);
     tile.row_stride = row_stride((tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y);
     tile.output_offset = uint32_t((tile_index % kSlots) * slot_pixels());
-  }
+    return tile;
+  };
   const auto submit = [&](uint32_t tile_index) {
-    TileConstants tile = tiles[tile_index];
+    TileConstants tile = tile_at(tile_index);
     const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
     const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
     const vk::raii::CommandBuffer& cb = frame->command_buffers[tile_index % kSlots];
+    // The slot's command buffer and output were last used by tile_index - 2, waited for and read.
     cb.reset();
     cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
-    // The slot's last reader was the host, after its fence (and a submission is ordered after it).
     cb.bindPipeline(vk::PipelineBindPoint::eCompute, **frame->pipeline);
     cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, layout, 0, frame->descriptors->get(), {});
-    // The samples in dispatches of at most kSamplesPerDispatch, each continuing the last one's sums.
+    // The samples in dispatches of at most samples_per_dispatch, each continuing the last one's sums.
     for (tile.sample_begin = 0; tile.sample_begin < image.samples_per_pixel; tile.sample_begin = tile.sample_end) {
-      tile.sample_end = std::min(image.samples_per_pixel, tile.sample_begin + kSamplesPerDispatch);
+      tile.sample_end = std::min(image.samples_per_pixel, tile.sample_begin + samples_per_dispatch);
       if (tile.sample_begin > 0) {  // the last dispatch's sums are read by this one
         const vk::MemoryBarrier sums(vk::AccessFlagBits::eShaderWrite,
                                      vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
@@ -158,22 +171,17 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     const vk::CommandBuffer raw = *cb;
     const vk::Fence fence = *frame->fences[tile_index % kSlots];
     ctx_->queue().submit(vk::SubmitInfo({}, {}, raw), fence);
-    frame->in_flight.push_back(fence);
+    frame->in_flight.push_back(fence);  // reserved: cannot throw
   };
   // Waits for a tile, copies its pixels into the image and frees its slot.
   const auto finish = [&](uint32_t tile_index) {
     const vk::raii::Fence& fence = frame->fences[tile_index % kSlots];
-    try {
-      ctx_->wait(fence, request.tile_timeout, "a render tile");
-    } catch (...) {  // timed out or interrupted: this tile and the next may still run
-      abandoned_.push_back(std::move(frame));  // kept until the device is done with it
-      throw;
-    }
+    ctx_->wait(fence, request.tile_timeout, "a render tile");
     const auto read_start = Clock::now();
     std::erase(frame->in_flight, *fence);
     device.resetFences(*fence);
     frame->output.invalidate(device);
-    const TileConstants& tile = tiles[tile_index];
+    const TileConstants tile = tile_at(tile_index);
     const auto* texels = static_cast<const glm::vec4*>(frame->output.mapped) + tile.output_offset;
     for (uint32_t y = 0; y < tile.height; ++y)
       for (uint32_t x = 0; x < tile.width; ++x) {
@@ -184,16 +192,22 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     readback_seconds += seconds_since(read_start);
     if (request.progress) request.progress(tile_index + 1, tile_count);
   };
-  for (uint32_t tile_index = 0; tile_index < tile_count; ++tile_index) {
-    submit(tile_index);
-    if (tile_index > 0) finish(tile_index - 1);
-    if (tile_index + 1 < tile_count && interrupt_requested()) {
-      abandoned_.push_back(std::move(frame));  // the tile just submitted may still run
-      throw_if_interrupted();
+  try {
+    for (uint32_t tile_index = 0; tile_index < tile_count; ++tile_index) {
+      submit(tile_index);
+      if (tile_index > 0) finish(tile_index - 1);
+      if (tile_index + 1 < tile_count && interrupt_requested()) throw Cancelled();
     }
+    finish(tile_count - 1);
+  } catch (...) {
+    // Timed out, interrupted, or any other failure while a tile may still run: what it uses is kept
+    // until the device is done with it (busy()), never destroyed under it.
+    if (!frame->in_flight.empty()) abandoned_.push_back(std::move(frame));  // reserved: cannot throw
+    throw;
   }
-  finish(tile_count - 1);
-  stats.trace_seconds = seconds_since(start) - readback_seconds;
+  // Reading back overlaps tracing: the trace is the whole span (so rays/s are not flattered), the
+  // read back its own part of it.
+  stats.trace_seconds = seconds_since(start);
   stats.readback_seconds = readback_seconds;
   stats.tiles = tile_count;
   if (stats_out) *stats_out = stats;
@@ -201,10 +215,7 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
 }
 
 uint32_t tile_side(const Scene& scene, const ImageSettings& image) {
-  // With the BVH a ray visits on the order of log2(N) nodes and a few leaves.
-  const double primitives = double(scene.triangles.size() + scene.spheres.size()) + 1.0;
-  const double tests_per_sample = (8.0 + 4.0 * std::log2(primitives)) * (1.0 + double(scene.lights.size()));
-  const double pixels = kTestsPerTile / (tests_per_sample * image.samples_per_pixel);
+  const double pixels = kTestsPerTile / (tests_per_sample(scene) * image.samples_per_pixel);
   const uint32_t side = static_cast<uint32_t>(std::sqrt(pixels)) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
   const uint32_t largest = (std::max(image.width, image.height) + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
   return std::clamp<uint32_t>(side, VKRAY_WORKGROUP_X, largest);

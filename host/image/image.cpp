@@ -14,6 +14,7 @@
 #include <memory>
 #include <string>
 #include <vector>
+#include <system_error>
 #include <thread>
 #include <mutex>
 #include <condition_variable>
@@ -50,9 +51,13 @@ class SrgbRows {
   explicit SrgbRows(const Image& image) : image_(image), row_bytes_(size_t(image.width) * 3) {
     encode_srgb8(0.5f);  // builds the table here, where an exception can still be thrown
     for (auto& block : blocks_) block.resize(row_bytes_ * kRowsPerBlock);
-    thread_ = std::thread([this] { convert(); });
+    try {
+      thread_ = std::thread([this] { convert(); });
+    } catch (const std::system_error&) {  // no thread to be had (a process or memory limit): row() converts
+    }
   }
   ~SrgbRows() {
+    if (!thread_.joinable()) return;
     {
       std::lock_guard lock(mutex_);
       stop_ = true;
@@ -63,8 +68,14 @@ class SrgbRows {
   SrgbRows(const SrgbRows&) = delete;
   SrgbRows& operator=(const SrgbRows&) = delete;
 
-  // Row y, asked for in order from 0: valid until a row of the block after the next is asked for.
+  // Row y, asked for in order from 0: valid until a row of the next block is asked for.
   const png_byte* row(uint32_t y) {
+    if (!thread_.joinable()) {  // converted here, a row at a time
+      png_byte* out = blocks_[0].data();
+      for (uint32_t x = 0; x < image_.width; ++x)
+        for (int c = 0; c < 3; ++c) *out++ = encode_srgb8(image_.at(x, y)[c]);
+      return blocks_[0].data();
+    }
     const uint32_t block = y / kRowsPerBlock;
     std::unique_lock lock(mutex_);
     if (block > released_) {
@@ -115,6 +126,7 @@ class SrgbRows {
 // Speed over size: the "up" filter alone and zlib level 1 wrote a 4096 x 4096 Cornell box in 180 ms
 // (1.47 MB) where libpng's defaults (every filter tried per row, level 6) took 870 ms (0.77 MB).
 bool encode_png(const Image& image, FILE* out, std::string& error) {
+  SrgbRows rows(image);  // first: it may throw (no memory, no thread), and nothing is there to leak yet
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_failed, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!info) {
@@ -122,7 +134,6 @@ bool encode_png(const Image& image, FILE* out, std::string& error) {
     error = "out of memory";
     return false;
   }
-  SrgbRows rows(image);
   bool interrupted = false;
   errno = 0;
   if (setjmp(png_jmpbuf(png))) {
@@ -174,9 +185,10 @@ namespace {
 
 // encode_srgb8 by table. The floats in [0, 1] fall into buckets by the top 16 bits of their bit
 // pattern (sign, exponent, 7 bits of mantissa); across one bucket the formula's result rises by at
-// most 1 (a bucket spans under half an 8-bit step at any slope the curve has), so each bucket holds
-// the encoding at its start and the first float where it rises, found by bisection over the bit
-// patterns. The formula is monotonic in its argument; tests compare the two on every float in [0, 1].
+// most 1 (a bucket spans at most 0.66 of an 8-bit step, at [0.5, 0.5039); checked as the table is
+// built), so each bucket holds the encoding at its start and the first float where it rises, found
+// by bisection over the bit patterns. The formula is monotonic in its argument; tests compare the
+// two on every float in [0, 1] where they could differ.
 struct Srgb8Bucket {
   float rise;  // the first float of the bucket encoded as `value + 1`; infinity when none is
   uint8_t value;
