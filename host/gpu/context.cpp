@@ -41,11 +41,6 @@ int type_rank(vk::PhysicalDeviceType type) {
   }
 }
 
-std::string version_string(uint32_t v) {
-  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
-         std::to_string(VK_API_VERSION_PATCH(v));
-}
-
 std::optional<uint32_t> compute_queue_family(const vk::raii::PhysicalDevice& pd) {
   const auto families = pd.getQueueFamilyProperties();
   for (uint32_t i = 0; i < families.size(); ++i)
@@ -87,7 +82,7 @@ DeviceInfo describe_device(const vk::raii::PhysicalDevice& pd, uint32_t index) {
   for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
     if (memory.memoryHeaps[h].flags & vk::MemoryHeapFlagBits::eDeviceLocal) local += memory.memoryHeaps[h].size;
   return {index, props.deviceName.data(), type_name(props.deviceType),
-          std::string(driver.driverName.data()) + " " + driver.driverInfo.data(), version_string(props.apiVersion),
+          std::string(driver.driverName.data()) + " " + driver.driverInfo.data(), api_version_string(props.apiVersion),
           compute_queue_family(pd).has_value(), props.limits.maxComputeWorkGroupInvocations,
           props.limits.maxTexelBufferElements, props.limits.maxStorageBufferRange, local};
 }

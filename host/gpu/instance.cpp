@@ -13,16 +13,11 @@ namespace {
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
-std::string version_string(uint32_t v) {
-  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
-         std::to_string(VK_API_VERSION_PATCH(v));
-}
-
 std::shared_ptr<Instance> make_instance(bool validation) {
   auto result = std::make_shared<Instance>();
   const vk::raii::Context& context = result->context;
   if (context.enumerateInstanceVersion() < VK_API_VERSION_1_2)
-    throw DeviceError("the Vulkan loader supports only Vulkan " + version_string(context.enumerateInstanceVersion()) +
+    throw DeviceError("the Vulkan loader supports only Vulkan " + api_version_string(context.enumerateInstanceVersion()) +
                       "; vkray needs 1.2");
   std::vector<const char*> layers, extensions;
   if (validation) {
@@ -45,6 +40,11 @@ std::shared_ptr<Instance> make_instance(bool validation) {
 }
 
 }  // namespace
+
+std::string api_version_string(uint32_t v) {
+  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+         std::to_string(VK_API_VERSION_PATCH(v));
+}
 
 std::shared_ptr<const Instance> shared_instance(bool validation) {
   static std::mutex mutex;

@@ -11,7 +11,9 @@
 // repeated instance cycles. Devices are still created and destroyed per Context.
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <string>
 
 #include <vulkan/vulkan_raii.hpp>
 
@@ -26,5 +28,8 @@ struct Instance {
 // VK_EXT_debug_utils, or neither). Throws DeviceError when the loader is older than Vulkan 1.2 or the
 // layer is missing; a later call tries again. Thread-safe.
 std::shared_ptr<const Instance> shared_instance(bool validation);
+
+// A Vulkan version number as "1.3.230".
+std::string api_version_string(uint32_t version);
 
 }  // namespace vkray::gpu
