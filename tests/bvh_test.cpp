@@ -104,5 +104,47 @@ TEST(BvhTest, BoundsPastTheCoordinateLimitAreRefused) {
   EXPECT_EQ(bvh.order.size(), at_limit.size());
 }
 
+// The build splits large ranges across threads and bins them in parallel blocks; the tree must not
+// depend on how many threads did it (DECISIONS.md: nothing that changes pixels may depend on the
+// number of threads). 200,000 boxes go through both the parallel top and the parallel binning.
+TEST(BvhTest, TheTreeIsTheSameOnAnyNumberOfThreads) {
+  const std::vector<Aabb> boxes = random_boxes(200000, 5);
+  const Bvh one = build_bvh(boxes, 1);
+  check_tree(boxes);
+  for (unsigned threads : {2u, 3u, 8u}) {
+    SCOPED_TRACE(threads);
+    const Bvh other = build_bvh(boxes, threads);
+    EXPECT_EQ(other.order, one.order);
+    EXPECT_EQ(other.depth, one.depth);
+    ASSERT_EQ(other.nodes.size(), one.nodes.size());
+    for (size_t i = 0; i < one.nodes.size(); ++i)
+      for (int c = 0; c < 2; ++c) {
+        ASSERT_EQ(other.nodes[i].link[c], one.nodes[i].link[c]) << "node " << i;
+        ASSERT_EQ(other.nodes[i].child[c].min, one.nodes[i].child[c].min) << "node " << i;
+        ASSERT_EQ(other.nodes[i].child[c].max, one.nodes[i].child[c].max) << "node " << i;
+      }
+  }
+}
+
+// Two clusters of four unit cubes, far apart along x: SAH separates the clusters first, then each
+// cluster into its halves. The cost follows from the boxes by hand.
+TEST(BvhTest, SahCostOfATreeWorkedOutByHand) {
+  std::vector<Aabb> boxes;
+  for (float x : {0.0f, 100.0f})
+    for (float y : {0.0f, 10.0f})
+      for (float z : {0.0f, 10.0f}) boxes.push_back({glm::vec3(x, y, z), glm::vec3(x + 1, y + 1, z + 1)});
+  const Bvh bvh = build_bvh(boxes);
+  // Expected shape: the root splits x; each cluster (1 x 11 x 11) splits in y or z into two leaves
+  // of two cubes (1 x 1 x 11 each).
+  const double root = 101.0 * 11 + 11 * 11 + 11 * 101.0, cluster = 1 * 11 + 11 * 11 + 11 * 1, pair = 1 * 1 + 1 * 11 + 11 * 1;
+  const double expected = (root + 2 * cluster + 4 * 2 * pair) / root;
+  EXPECT_EQ(bvh.nodes.size(), 3u);
+  EXPECT_NEAR(sah_cost(bvh), expected, 1e-6);
+  // A single leaf would cost one test a box: the tree is cheaper.
+  EXPECT_LT(sah_cost(bvh), double(boxes.size()));
+}
+
+TEST(BvhTest, SahCostOfNoTreeIsZero) { EXPECT_EQ(sah_cost(build_bvh({})), 0.0); }
+
 }  // namespace
 }  // namespace vkray

@@ -4,8 +4,18 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <numeric>
+#include <memory>
 #include <string>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/task_arena.h>
 
 #include "base/check.h"
 #include "base/errors.h"
@@ -21,6 +31,25 @@ constexpr uint32_t kSahDepth = 32;
 // SAH costs, relative to one primitive test.
 constexpr float kTraversalCost = 1.0f;
 constexpr float kIntersectionCost = 1.0f;
+// A range smaller than this is built by one task; a larger one is split by the parallel top part of
+// the build, which hands its two halves to two tasks.
+constexpr uint32_t kTaskSize = 4096;
+// A range of at least two of these blocks bins its primitives block by block in parallel.
+constexpr uint32_t kBinBlock = 32768;
+
+// A primitive's box and its index in the caller's list; the builder reorders these in place.
+struct PrimRef {
+  Aabb box;
+  uint32_t index;
+  glm::vec3 centroid() const { return 0.5f * (box.min + box.max); }
+};
+
+// primitives[begin, end) with the bounds of their boxes and of their centroids.
+struct Range {
+  uint32_t begin = 0, end = 0;
+  Aabb box, centroids;
+  uint32_t count() const { return end - begin; }
+};
 
 // The bin of a centroid coordinate, always in [0, kBins): scale and lo are finite for the boxes
 // build_bvh() accepts, and a NaN (which cannot occur then) would still land in a valid bin.
@@ -29,104 +58,203 @@ int bin_of(float coordinate, float lo, float scale) {
   return b >= 0.0f ? int(std::min(b, float(kBins - 1))) : 0;
 }
 
-class Builder {
- public:
-  explicit Builder(const std::vector<Aabb>& boxes) : boxes_(boxes), centroids_(boxes.size()) {
-    for (size_t i = 0; i < boxes.size(); ++i) centroids_[i] = 0.5f * (boxes[i].min + boxes[i].max);
-    bvh_.order.resize(boxes.size());
-    std::iota(bvh_.order.begin(), bvh_.order.end(), 0u);
+// Four floats in one SSE register where there is SSE, four in a row elsewhere: the binning loop
+// below, on x, y, z (and a fourth lane it ignores) at once. Each operation rounds exactly as its
+// scalar counterpart, so the bins are the same either way.
+#if defined(__SSE2__)
+struct Float4 {
+  __m128 v;
+  static Float4 load(const float* p) { return {_mm_loadu_ps(p)}; }  // reads p[0..3]
+  static Float4 splat(float x) { return {_mm_set1_ps(x)}; }
+  friend Float4 operator+(Float4 a, Float4 b) { return {_mm_add_ps(a.v, b.v)}; }
+  friend Float4 operator-(Float4 a, Float4 b) { return {_mm_sub_ps(a.v, b.v)}; }
+  friend Float4 operator*(Float4 a, Float4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+  friend Float4 min4(Float4 a, Float4 b) { return {_mm_min_ps(a.v, b.v)}; }
+  friend Float4 max4(Float4 a, Float4 b) { return {_mm_max_ps(a.v, b.v)}; }
+  // bin_of() on each lane: clamped to [0, kBins - 1], NaN to 0.
+  std::array<int32_t, 4> bins() const {
+    const __m128 clamped = _mm_min_ps(_mm_max_ps(v, _mm_setzero_ps()), _mm_set1_ps(float(kBins - 1)));
+    std::array<int32_t, 4> out;
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out.data()), _mm_cvttps_epi32(clamped));
+    return out;
   }
+  glm::vec3 xyz() const {
+    alignas(16) float f[4];
+    _mm_store_ps(f, v);
+    return {f[0], f[1], f[2]};
+  }
+};
+#else
+struct Float4 {
+  std::array<float, 4> v;
+  static Float4 load(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
+  static Float4 splat(float x) { return {{x, x, x, x}}; }
+  template <typename Op>
+  static Float4 each(Float4 a, Float4 b, Op op) {
+    return {{op(a.v[0], b.v[0]), op(a.v[1], b.v[1]), op(a.v[2], b.v[2]), op(a.v[3], b.v[3])}};
+  }
+  friend Float4 operator+(Float4 a, Float4 b) { return each(a, b, [](float x, float y) { return x + y; }); }
+  friend Float4 operator-(Float4 a, Float4 b) { return each(a, b, [](float x, float y) { return x - y; }); }
+  friend Float4 operator*(Float4 a, Float4 b) { return each(a, b, [](float x, float y) { return x * y; }); }
+  friend Float4 min4(Float4 a, Float4 b) { return each(a, b, [](float x, float y) { return x < y ? x : y; }); }
+  friend Float4 max4(Float4 a, Float4 b) { return each(a, b, [](float x, float y) { return x > y ? x : y; }); }
+  std::array<int32_t, 4> bins() const {
+    std::array<int32_t, 4> out;
+    for (int i = 0; i < 4; ++i) out[size_t(i)] = bin_of(v[size_t(i)], 0.0f, 1.0f);
+    return out;
+  }
+  glm::vec3 xyz() const { return {v[0], v[1], v[2]}; }
+};
+#endif
 
-  Bvh build() {
-    if (boxes_.empty()) return std::move(bvh_);
-    bvh_.nodes.emplace_back();
-    const Aabb all = bounds(0, uint32_t(boxes_.size()));
-    const uint32_t link = subtree(0, uint32_t(boxes_.size()), all, 1);
-    if (is_leaf(link)) {  // everything fits one leaf: a root with one empty child
-      bvh_.nodes[0].child[0] = all;
-      bvh_.nodes[0].link[0] = link;
-      bvh_.nodes[0].link[1] = leaf_link(0, 0);  // count 0: never entered, its box is empty
-      bvh_.depth = 1;
+// Maps centroids to bins along each axis of a range's centroid bounds. An axis along which every
+// centroid is the same gets scale 0 (all in bin 0) and is never split.
+struct BinMap {
+  glm::vec4 lo, scale;  // w: 0, for the fourth lane of a Float4
+  explicit BinMap(const Aabb& centroids) : lo(centroids.min, 0.0f), scale(0.0f) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const float extent = centroids.max[axis] - lo[axis];
+      if (extent > 0.0f) scale[axis] = float(kBins) / extent;
     }
-    return std::move(bvh_);
   }
+  int bin(const glm::vec3& centroid, int axis) const { return bin_of(centroid[axis], lo[axis], scale[axis]); }
+};
 
- private:
-  Aabb bounds(uint32_t begin, uint32_t end) const {
-    Aabb b;
-    for (uint32_t i = begin; i < end; ++i) b.grow(boxes_[bvh_.order[i]]);
-    return b;
+// A bin's bounds, of the boxes and of the centroids, in Float4 lanes x, y, z. Set by the first
+// primitive to fall in it: a bin whose count is 0 holds no bounds at all.
+struct BinBounds {
+  Float4 min, max, centroid_min, centroid_max;
+  void set(Float4 box_min, Float4 box_max, Float4 centroid) {
+    min = box_min;
+    max = box_max;
+    centroid_min = centroid_max = centroid;
   }
+  void grow(Float4 box_min, Float4 box_max, Float4 c_min, Float4 c_max) {
+    min = min4(min, box_min);
+    max = max4(max, box_max);
+    centroid_min = min4(centroid_min, c_min);
+    centroid_max = max4(centroid_max, c_max);
+  }
+  Aabb box() const { return {min.xyz(), max.xyz()}; }
+  Aabb centroids() const { return {centroid_min.xyz(), centroid_max.xyz()}; }
+};
 
-  // Builds the subtree over order[begin, end) and returns its link. The root (depth 1) is written
-  // into nodes[0]; other inner nodes are appended.
-  uint32_t subtree(uint32_t begin, uint32_t end, const Aabb& box, uint32_t depth) {
-    throw_if_interrupted();  // one relaxed load a node: a large build stops within milliseconds
-    const uint32_t count = end - begin;
-    // The GPU's traversal stack is sized for kMaxDepth levels (VKRAY_TRAVERSAL_STACK): deeper would
-    // lose nodes silently there.
-    VKRAY_CHECK(depth < kMaxDepth, "the BVH grew deeper than the GPU's traversal stack holds");
-    VKRAY_CHECK(count >= 1, "the BVH builder made an empty subtree");
-    bvh_.depth = std::max(bvh_.depth, depth);
-    uint32_t mid = 0;
-    if (count <= 2 || !split(begin, end, box, depth, mid)) {
-      if (count <= kMaxLeafSize) return leaf_link(begin, count);
-      mid = median_split(begin, end);
+// Every primitive of a range counted into the bins of all three axes in one pass. Merging is exact
+// (a union of boxes, a sum of counts), so the bins are the same however the range is cut up.
+struct Bins {
+  std::array<std::array<BinBounds, kBins>, 3> bounds;  // left unset: most bins of a small range stay empty
+  std::array<std::array<uint32_t, kBins>, 3> count{};
+
+  void add(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map) {
+    const Float4 lo = Float4::load(&map.lo.x), scale = Float4::load(&map.scale.x), half = Float4::splat(0.5f);
+    for (uint32_t i = begin; i < end; ++i) {
+      // Lane 3 of each load is the next member (box.max.x, index): read, never used.
+      const Float4 box_min = Float4::load(&refs[i].box.min.x), box_max = Float4::load(&refs[i].box.max.x);
+      const Float4 centroid = half * (box_min + box_max);
+      const std::array<int32_t, 4> bin = ((centroid - lo) * scale).bins();
+      for (size_t a = 0; a < 3; ++a) {
+        const size_t b = size_t(bin[a]);
+        if (count[a][b]++ == 0)
+          bounds[a][b].set(box_min, box_max, centroid);
+        else
+          bounds[a][b].grow(box_min, box_max, centroid, centroid);
+      }
     }
-    const uint32_t index = depth == 1 ? 0 : uint32_t(bvh_.nodes.size());
-    if (depth > 1) bvh_.nodes.emplace_back();
-    const Aabb left = bounds(begin, mid), right = bounds(mid, end);
-    const uint32_t left_link = subtree(begin, mid, left, depth + 1);
-    const uint32_t right_link = subtree(mid, end, right, depth + 1);
-    BvhNode& node = bvh_.nodes[index];
-    node.child[0] = left;
-    node.child[1] = right;
-    node.link[0] = left_link;
-    node.link[1] = right_link;
-    return index;
   }
+  void merge(const Bins& other) {
+    for (size_t a = 0; a < 3; ++a)
+      for (size_t b = 0; b < kBins; ++b) {
+        if (other.count[a][b] == 0) continue;
+        const BinBounds& theirs = other.bounds[a][b];
+        if (count[a][b] == 0)
+          bounds[a][b] = theirs;
+        else
+          bounds[a][b].grow(theirs.min, theirs.max, theirs.centroid_min, theirs.centroid_max);
+        count[a][b] += other.count[a][b];
+      }
+  }
+};
 
-  // Binned SAH over all three axes. Returns false when a leaf is cheaper than any split.
-  bool split(uint32_t begin, uint32_t end, const Aabb& box, uint32_t depth, uint32_t& mid) {
-    if (depth > kSahDepth) return false;
-    Aabb centroid_box;
-    for (uint32_t i = begin; i < end; ++i) centroid_box.grow(centroids_[bvh_.order[i]]);
-    const uint32_t count = end - begin;
+// Bounds grown box by box in Float4 lanes, with Aabb::half_area()'s arithmetic.
+struct SweepBox {
+  Float4 min = Float4::splat(1e30f), max = Float4::splat(-1e30f);
+  void grow(const BinBounds& b) {
+    min = min4(min, b.min);
+    max = max4(max, b.max);
+  }
+  float half_area() const { return Aabb{min.xyz(), max.xyz()}.half_area(); }
+};
+
+// Fills `bins` (which the caller keeps, to spare a copy of a few kB a node).
+void bin_range(const PrimRef* refs, const Range& range, const BinMap& map, Bins& bins) {
+  if (range.count() < 2 * kBinBlock) {
+    bins.add(refs, range.begin, range.end, map);
+    return;
+  }
+  bins = tbb::parallel_reduce(
+      tbb::blocked_range<uint32_t>(range.begin, range.end, kBinBlock), Bins(),
+      [&](const tbb::blocked_range<uint32_t>& block, Bins block_bins) {
+        block_bins.add(refs, block.begin(), block.end(), map);
+        return block_bins;
+      },
+      [](Bins a, const Bins& b) {
+        a.merge(b);
+        return a;
+      });
+}
+
+// The bounds of primitives[begin, end) and of their centroids, for ranges not cut along bins.
+void bound(const PrimRef* refs, Range& range) {
+  range.box = range.centroids = Aabb();
+  for (uint32_t i = range.begin; i < range.end; ++i) {
+    range.box.grow(refs[i].box);
+    range.centroids.grow(refs[i].centroid());
+  }
+}
+
+// Splits a range in two, by binned SAH over all three axes or, past kSahDepth or where SAH finds
+// no split cheaper than a leaf too large for the leaf encoding, at the median. Returns false where
+// the range becomes a leaf.
+bool split(PrimRef* refs, const Range& range, uint32_t depth, Range& left, Range& right) {
+  const uint32_t count = range.count();
+  if (count <= 2) return false;
+  if (depth <= kSahDepth) {
+    const BinMap map(range.centroids);
+    Bins bins;
+    bin_range(refs, range, map, bins);
     float best_cost = kIntersectionCost * float(count);  // the cost of a leaf
     int best_axis = -1, best_bin = 0;
+    const float parent_area = std::max(range.box.half_area(), 1e-30f);
     for (int axis = 0; axis < 3; ++axis) {
-      const float lo = centroid_box.min[axis], extent = centroid_box.max[axis] - lo;
-      if (!(extent > 0.0f)) continue;
-      const float scale = float(kBins) / extent;
-      std::array<Aabb, kBins> bin_box;
-      std::array<uint32_t, kBins> bin_count{};
-      for (uint32_t i = begin; i < end; ++i) {
-        const uint32_t p = bvh_.order[i];
-        const int b = bin_of(centroids_[p][axis], lo, scale);
-        bin_box[size_t(b)].grow(boxes_[p]);
-        ++bin_count[size_t(b)];
-      }
-      // Sweep from the right, then from the left, to cost every plane between bins.
+      if (map.scale[axis] == 0.0f) continue;
+      const auto& bounds = bins.bounds[size_t(axis)];
+      const auto& counts = bins.count[size_t(axis)];
+      // Sweep from the right, then from the left, to cost every plane between bins. A plane after
+      // an empty bin costs what the plane before it did, so it never wins and is not costed.
       std::array<float, kBins> right_area{};
       std::array<uint32_t, kBins> right_count{};
-      Aabb acc;
+      SweepBox acc;
       uint32_t n = 0;
+      float area = 0.0f;
       for (int b = kBins - 1; b > 0; --b) {
-        acc.grow(bin_box[size_t(b)]);
-        n += bin_count[size_t(b)];
-        right_area[size_t(b)] = acc.half_area();
+        if (counts[size_t(b)] > 0) {
+          acc.grow(bounds[size_t(b)]);
+          n += counts[size_t(b)];
+          area = acc.half_area();
+        }
+        right_area[size_t(b)] = area;
         right_count[size_t(b)] = n;
       }
-      acc = Aabb();
+      acc = SweepBox();
       n = 0;
-      const float parent_area = box.half_area();
       for (int b = 0; b < kBins - 1; ++b) {
-        acc.grow(bin_box[size_t(b)]);
-        n += bin_count[size_t(b)];
-        if (n == 0 || right_count[size_t(b + 1)] == 0) continue;
+        if (counts[size_t(b)] == 0) continue;
+        acc.grow(bounds[size_t(b)]);
+        n += counts[size_t(b)];
+        if (right_count[size_t(b + 1)] == 0) break;
         const float cost = kTraversalCost + kIntersectionCost *
                                                 (acc.half_area() * float(n) + right_area[size_t(b + 1)] * float(right_count[size_t(b + 1)])) /
-                                                std::max(parent_area, 1e-30f);
+                                                parent_area;
         if (cost < best_cost) {
           best_cost = cost;
           best_axis = axis;
@@ -134,36 +262,163 @@ class Builder {
         }
       }
     }
-    if (best_axis < 0) return false;
-    const float lo = centroid_box.min[best_axis];
-    const float scale = float(kBins) / (centroid_box.max[best_axis] - lo);
-    const auto first = bvh_.order.begin() + begin, last = bvh_.order.begin() + end;
-    const auto middle = std::partition(first, last, [&](uint32_t p) {
-      return bin_of(centroids_[p][best_axis], lo, scale) <= best_bin;
+    if (best_axis >= 0) {
+      const uint32_t mid = uint32_t(std::partition(refs + range.begin, refs + range.end,
+                                                   [&](const PrimRef& p) { return map.bin(p.centroid(), best_axis) <= best_bin; }) -
+                                    refs);
+      if (mid != range.begin && mid != range.end) {
+        left = {range.begin, mid, {}, {}};
+        right = {mid, range.end, {}, {}};
+        for (int b = 0; b < kBins; ++b) {
+          if (bins.count[size_t(best_axis)][size_t(b)] == 0) continue;
+          Range& side = b <= best_bin ? left : right;
+          side.box.grow(bins.bounds[size_t(best_axis)][size_t(b)].box());
+          side.centroids.grow(bins.bounds[size_t(best_axis)][size_t(b)].centroids());
+        }
+        return true;
+      }
+    }
+  }
+  if (count <= kMaxLeafSize) return false;
+  // The median along the centroids' longest axis.
+  const glm::vec3 extent = range.centroids.max - range.centroids.min;
+  const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+  const uint32_t mid = range.begin + count / 2;
+  std::nth_element(refs + range.begin, refs + mid, refs + range.end,
+                   [&](const PrimRef& a, const PrimRef& b) { return a.centroid()[axis] < b.centroid()[axis]; });
+  left = {range.begin, mid, {}, {}};
+  right = {mid, range.end, {}, {}};
+  bound(refs, left);
+  bound(refs, right);
+  return true;
+}
+
+// The work of one task: the subtree over a range, its nodes numbered from 0 in depth-first order,
+// parent before children and left before right.
+class SubtreeBuilder {
+ public:
+  explicit SubtreeBuilder(PrimRef* refs) : refs_(refs) {}
+
+  // Returns the subtree's link: a leaf, or 0 for nodes()[0].
+  uint32_t build(const Range& range, uint32_t depth) {
+    throw_if_interrupted();  // one relaxed load a node: a large build stops within milliseconds
+    // The GPU's traversal stack is sized for kMaxDepth levels (VKRAY_TRAVERSAL_STACK): deeper would
+    // lose nodes silently there.
+    VKRAY_CHECK(depth < kMaxDepth, "the BVH grew deeper than the GPU's traversal stack holds");
+    VKRAY_CHECK(range.count() >= 1, "the BVH builder made an empty subtree");
+    depth_ = std::max(depth_, depth);
+    Range left, right;
+    if (!split(refs_, range, depth, left, right)) return leaf_link(range.begin, range.count());
+    const uint32_t index = uint32_t(nodes_.size());
+    nodes_.emplace_back();
+    const uint32_t left_link = build(left, depth + 1);
+    const uint32_t right_link = build(right, depth + 1);
+    nodes_[index] = {{left.box, right.box}, {left_link, right_link}};
+    return index;
+  }
+
+  std::vector<BvhNode>& nodes() { return nodes_; }
+  uint32_t depth() const { return depth_; }
+
+ private:
+  PrimRef* refs_;
+  std::vector<BvhNode> nodes_;
+  uint32_t depth_ = 0;
+};
+
+// The parallel build: ranges of kTaskSize or more become nodes of a small top tree, each splitting
+// its range (binning in parallel where large) and building its halves in two tasks; smaller ranges
+// become subtrees of their own. Numbering them all at the end, the top in depth-first order and
+// each subtree's nodes shifted to where that order puts them, gives the tree a single thread would
+// have built, node for node, whatever the number of threads.
+class ParallelBuilder {
+ public:
+  explicit ParallelBuilder(PrimRef* refs) : refs_(refs) {}
+
+  Bvh build(const Range& all) {
+    Bvh bvh;
+    const Part root = part(all, 1);
+    bvh.depth = root.depth;
+    if (!root.top && root.nodes.empty()) {  // everything fits one leaf: a root with one empty child
+      bvh.nodes.resize(1);
+      bvh.nodes[0].child[0] = all.box;
+      bvh.nodes[0].link[0] = root.link;
+      bvh.nodes[0].link[1] = leaf_link(0, 0);  // count 0: never entered, its box is empty
+      return bvh;
+    }
+    bvh.nodes.resize(root.node_count);
+    std::vector<std::pair<uint32_t, const Part*>> subtrees;  // where each subtree's nodes go
+    uint32_t next = 0;
+    place(root, bvh.nodes, next, subtrees);
+    tbb::parallel_for(size_t(0), subtrees.size(), [&](size_t s) {
+      const auto [base, subtree] = subtrees[s];
+      for (size_t i = 0; i < subtree->nodes.size(); ++i) {
+        BvhNode node = subtree->nodes[i];
+        for (uint32_t& link : node.link)
+          if (!is_leaf(link)) link += base;
+        bvh.nodes[base + i] = node;
+      }
     });
-    mid = uint32_t(middle - bvh_.order.begin());
-    return mid != begin && mid != end;
+    return bvh;
   }
 
-  uint32_t median_split(uint32_t begin, uint32_t end) {
-    Aabb centroid_box;
-    for (uint32_t i = begin; i < end; ++i) centroid_box.grow(centroids_[bvh_.order[i]]);
-    const glm::vec3 extent = centroid_box.max - centroid_box.min;
-    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
-    const uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(bvh_.order.begin() + begin, bvh_.order.begin() + mid, bvh_.order.begin() + end,
-                     [&](uint32_t a, uint32_t b) { return centroids_[a][axis] < centroids_[b][axis]; });
-    return mid;
+ private:
+  // A node of the top tree, or a subtree built by one task (link: a leaf, or 0 for nodes[0]).
+  struct Part {
+    Aabb box;
+    std::unique_ptr<std::array<Part, 2>> top;
+    std::vector<BvhNode> nodes;
+    uint32_t link = 0;
+    uint32_t depth = 0;       // the deepest level in it
+    uint32_t node_count = 0;  // inner nodes in it
+  };
+
+  Part part(const Range& range, uint32_t depth) {
+    Part p;
+    p.box = range.box;
+    if (range.count() < kTaskSize) {
+      SubtreeBuilder subtree(refs_);
+      p.link = subtree.build(range, depth);
+      p.nodes = std::move(subtree.nodes());
+      p.depth = subtree.depth();
+      p.node_count = uint32_t(p.nodes.size());
+      return p;
+    }
+    throw_if_interrupted();
+    VKRAY_CHECK(depth < kMaxDepth, "the BVH grew deeper than the GPU's traversal stack holds");
+    Range left, right;
+    // kTaskSize > kMaxLeafSize: a range this large always splits.
+    VKRAY_CHECK(split(refs_, range, depth, left, right), "the BVH builder left a large range unsplit");
+    p.top = std::make_unique<std::array<Part, 2>>();
+    tbb::parallel_invoke([&] { (*p.top)[0] = part(left, depth + 1); }, [&] { (*p.top)[1] = part(right, depth + 1); });
+    p.depth = std::max((*p.top)[0].depth, (*p.top)[1].depth);
+    p.node_count = 1 + (*p.top)[0].node_count + (*p.top)[1].node_count;
+    return p;
   }
 
-  const std::vector<Aabb>& boxes_;
-  std::vector<glm::vec3> centroids_;
-  Bvh bvh_;
+  // Numbers a part's nodes from `next` on in depth-first order and returns its link: top nodes are
+  // written here, subtrees are listed to be copied.
+  static uint32_t place(const Part& p, std::vector<BvhNode>& nodes, uint32_t& next,
+                        std::vector<std::pair<uint32_t, const Part*>>& subtrees) {
+    if (!p.top) {
+      if (p.nodes.empty()) return p.link;
+      subtrees.emplace_back(next, &p);
+      next += uint32_t(p.nodes.size());
+      return next - uint32_t(p.nodes.size());
+    }
+    const uint32_t index = next++;
+    const uint32_t left = place((*p.top)[0], nodes, next, subtrees);
+    const uint32_t right = place((*p.top)[1], nodes, next, subtrees);
+    nodes[index] = {{(*p.top)[0].box, (*p.top)[1].box}, {left, right}};
+    return index;
+  }
+
+  PrimRef* refs_;
 };
 
 }  // namespace
 
-Bvh build_bvh(const std::vector<Aabb>& boxes) {
+Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads) {
   if (boxes.size() > kMaxScenePrimitives)
     throw LimitError("too many primitives for the BVH: " + std::to_string(boxes.size()) + " (at most " +
                      std::to_string(kMaxScenePrimitives) + ")");
@@ -175,9 +430,48 @@ Bvh build_bvh(const std::vector<Aabb>& boxes) {
             std::abs(boxes[i].max[axis]) <= kMaxCoordinate))
         throw LimitError("primitive " + std::to_string(i) + "'s bounds lie outside the coordinates vkray renders (+-1e9)");
   const auto start = std::chrono::steady_clock::now();
-  Bvh bvh = Builder(boxes).build();
+  Bvh bvh;
+  if (!boxes.empty()) {
+    const uint32_t count = uint32_t(boxes.size());
+    std::vector<PrimRef> refs(count);
+    Range all{0, count, {}, {}};
+    const auto build = [&] {
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, count, kBinBlock), [&](const tbb::blocked_range<uint32_t>& block) {
+        for (uint32_t i = block.begin(); i < block.end(); ++i) refs[i] = {boxes[i], i};
+      });
+      bound(refs.data(), all);
+      bvh = ParallelBuilder(refs.data()).build(all);
+      bvh.order.resize(count);
+      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, count, kBinBlock), [&](const tbb::blocked_range<uint32_t>& block) {
+        for (uint32_t i = block.begin(); i < block.end(); ++i) bvh.order[i] = refs[i].index;
+      });
+    };
+    if (count < kTaskSize) {
+      build();  // one task: no threads to start
+    } else {
+      tbb::task_arena arena(threads > 0 ? int(threads) : tbb::task_arena::automatic);
+      arena.execute(build);
+    }
+  }
   bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return bvh;
+}
+
+double sah_cost(const Bvh& bvh) {
+  if (bvh.nodes.empty()) return 0;
+  double cost = 0;
+  const auto area = [](const Aabb& b) { return double(b.half_area()); };
+  Aabb root;
+  for (const Aabb& b : bvh.nodes[0].child) root.grow(b);
+  for (const BvhNode& node : bvh.nodes) {
+    Aabb box;
+    for (int c = 0; c < 2; ++c) {
+      box.grow(node.child[c]);
+      if (is_leaf(node.link[c])) cost += double(kIntersectionCost) * leaf_count(node.link[c]) * area(node.child[c]);
+    }
+    cost += double(kTraversalCost) * area(box);
+  }
+  return cost / std::max(area(root), 1e-30);
 }
 
 std::vector<Aabb> primitive_boxes(const Scene& scene) {

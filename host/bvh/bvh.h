@@ -1,5 +1,5 @@
-// A bounding volume hierarchy over the scene's primitives, built on the host with binned SAH and
-// binary nodes that hold both children's boxes. The CPU reference traverses it as it is; the GPU
+// A bounding volume hierarchy over the scene's primitives, built on the host with binned SAH (in
+// parallel, with Intel oneTBB) and binary nodes that hold both children's boxes. The CPU reference traverses it as it is; the GPU
 // path reads a 4-wide, quantized copy of it (packing/scene_packing.h).
 #pragma once
 
@@ -55,8 +55,15 @@ struct Bvh {
   double build_seconds = 0;
 };
 
-// Builds over primitives given by their bounding boxes. Throws LimitError beyond kMaxScenePrimitives.
-Bvh build_bvh(const std::vector<Aabb>& boxes);
+// Builds over primitives given by their bounding boxes, on `threads` threads (0: one per hardware
+// thread). The tree is the same for any number of threads. Throws LimitError beyond
+// kMaxScenePrimitives.
+Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads = 0);
+
+// The tree's SAH cost: the expected cost of a ray through it, in primitive tests (a traversal step
+// costs as much as one), by surface area: every inner node weighted by its area, every leaf by its
+// area times its count, over the root's area. Lower is a better tree.
+double sah_cost(const Bvh& bvh);
 
 // A scene's primitives are numbered triangles first, then spheres: primitive i < triangles.size()
 // is triangles[i], the rest are spheres[i - triangles.size()].
