@@ -355,16 +355,22 @@ void SceneParser::check_primitive_count(const Value& where, size_t adding) const
 }
 
 void SceneParser::add_triangles(const Value& where, std::vector<Triangle>& triangles) {
+  const auto within_limit = [](const glm::vec3& p) { return glm::all(glm::lessThanEqual(glm::abs(p), glm::vec3(kMaxCoordinate))); };
+  std::vector<bool> degenerate(triangles.size());
+  size_t left_out = 0;
   for (size_t i = 0; i < triangles.size(); ++i) {
     if (i % 4096 == 0) throw_if_interrupted();  // a mesh of millions takes a while to place
-    for (const glm::vec3& p : triangles[i].v)
-      check_coordinates(where, p, ("triangle " + std::to_string(i) + " (after the transform)").c_str());
+    const Triangle& t = triangles[i];
+    for (const glm::vec3& p : t.v)  // the message is made only for a triangle that fails
+      if (!within_limit(p)) check_coordinates(where, p, ("triangle " + std::to_string(i) + " (after the transform)").c_str());
+    degenerate[i] = glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f;
+    left_out += degenerate[i];
   }
-  const auto degenerate = [](const Triangle& t) { return glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f; };
-  const size_t left_out = size_t(std::count_if(triangles.begin(), triangles.end(), degenerate));
   check_primitive_count(where, triangles.size() - left_out);
-  for (const Triangle& t : triangles)
-    if (!degenerate(t)) scene_.triangles.push_back(t);
+  const size_t needed = scene_.triangles.size() + triangles.size() - left_out;  // grown geometrically, as push_back would
+  if (needed > scene_.triangles.capacity()) scene_.triangles.reserve(std::max(needed, 2 * scene_.triangles.capacity()));
+  for (size_t i = 0; i < triangles.size(); ++i)
+    if (!degenerate[i]) scene_.triangles.push_back(triangles[i]);
   if (left_out > 0) warn(where, std::to_string(left_out) + " degenerate (zero-area) triangles left out");
 }
 
