@@ -5,6 +5,9 @@
 #include <cmath>
 #include <numeric>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "base/check.h"
 #include "base/interrupt.h"
 #include "scene/camera.h"
@@ -26,27 +29,40 @@ uint32_t scale_exponent(double extent) {
   return uint32_t(e + 127);
 }
 
+// Packs the binary tree into wide nodes: each wide node takes a binary node's children and, for
+// each child that is an inner node, that node's children in its place. Wide nodes are numbered in
+// depth-first order first (cheap, one pass), then written in parallel (the quantization is most of
+// the work).
 class NodePacker {
  public:
-  explicit NodePacker(const Bvh& bvh) : bvh_(bvh) {}
+  explicit NodePacker(const Bvh& bvh) : bvh_(bvh), wide_of_(bvh.nodes.size(), 0) {}
 
   std::vector<glm::uvec4> pack() {
-    if (!bvh_.nodes.empty()) emit(0);
+    if (bvh_.nodes.empty()) return {};
+    number(0);
+    texels_.resize(binary_of_.size() * VKRAY_TEXELS_PER_NODE);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, binary_of_.size(), 4096), [&](const tbb::blocked_range<size_t>& block) {
+      throw_if_interrupted();
+      for (size_t wide = block.begin(); wide < block.end(); ++wide) {
+        Child children[VKRAY_NODE_WIDTH];
+        const int count = gather(binary_of_[wide], children);
+        for (int c = 0; c < count; ++c)
+          if (!is_leaf(children[c].link)) children[c].link = wide_of_[children[c].link];
+        write(uint32_t(wide), children, count);
+      }
+    });
     return std::move(texels_);
   }
 
  private:
   struct Child {
-    uint32_t link;
+    uint32_t link;  // a leaf, or a binary node's index (a wide node's once gathered)
     Aabb box;
   };
 
-  // Writes the wide node for binary node `index` (and, first, the wide nodes below it); returns its
-  // index. The root is 0, which is why 0 can mean "no child".
-  uint32_t emit(uint32_t index) {
-    const uint32_t wide = uint32_t(texels_.size() / VKRAY_TEXELS_PER_NODE);
-    texels_.resize(texels_.size() + VKRAY_TEXELS_PER_NODE);
-    Child children[VKRAY_NODE_WIDTH];
+  // The children of the wide node made from binary node `index`. The root is 0, which is why 0
+  // can mean "no child".
+  int gather(uint32_t index, Child* children) const {
     int count = 0;
     const BvhNode& node = bvh_.nodes[index];
     for (int c = 0; c < 2; ++c) {
@@ -59,10 +75,17 @@ class NodePacker {
       for (int g = 0; g < 2; ++g)
         if (!is_leaf(child.link[g]) || leaf_count(child.link[g]) > 0) children[count++] = {child.link[g], child.child[g]};
     }
+    return count;
+  }
+
+  // Numbers the wide node made from binary node `index` and, after it, those below it.
+  void number(uint32_t index) {
+    wide_of_[index] = uint32_t(binary_of_.size());
+    binary_of_.push_back(index);
+    Child children[VKRAY_NODE_WIDTH];
+    const int count = gather(index, children);
     for (int c = 0; c < count; ++c)
-      if (!is_leaf(children[c].link)) children[c].link = emit(children[c].link);
-    write(wide, children, count);
-    return wide;
+      if (!is_leaf(children[c].link)) number(children[c].link);
   }
 
   void write(uint32_t wide, const Child* children, int count) {
@@ -97,6 +120,8 @@ class NodePacker {
   static void set_byte(uint32_t& word, int c, uint32_t value) { word |= value << (8 * c); }
 
   const Bvh& bvh_;
+  std::vector<uint32_t> wide_of_;    // binary node -> its wide node, for binary nodes that start one
+  std::vector<uint32_t> binary_of_;  // wide node -> the binary node it is made from
   std::vector<glm::uvec4> texels_;
 };
 
@@ -151,23 +176,28 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
   PackedScene packed;
   const size_t triangle_count = scene.triangles.size();
   const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
-  packed.primitives.reserve(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);
+  packed.primitives.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);
   if (any_smooth) packed.normals.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
-  for (size_t slot = 0; slot < bvh.order.size(); ++slot) {
-    if (slot % 4096 == 0) throw_if_interrupted();
-    const uint32_t p = bvh.order[slot];
-    PrimitiveTexels texels;
-    if (p < triangle_count) {
-      const Triangle& t = scene.triangles[p];
-      texels = triangle_texels(t.v[0], t.v[1], t.v[2], t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u), p);
-      if (t.smooth)
-        for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
-    } else {
-      const Sphere& s = scene.spheres[p - triangle_count];
-      texels = sphere_texels(s.center, s.radius, s.material, p);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, bvh.order.size(), 4096), [&](const tbb::blocked_range<size_t>& block) {
+    throw_if_interrupted();
+    for (size_t slot = block.begin(); slot < block.end(); ++slot) {
+      const uint32_t p = bvh.order[slot];
+      PrimitiveTexels texels;
+      if (p < triangle_count) {
+        const Triangle& t = scene.triangles[p];
+        texels = triangle_texels(t.v[0], t.v[1], t.v[2], t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u), p);
+        if (t.smooth)
+          for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
+      } else {
+        const Sphere& sphere = scene.spheres[p - triangle_count];
+        texels = sphere_texels(sphere.center, sphere.radius, sphere.material, p);
+      }
+      glm::vec4* out = &packed.primitives[slot * VKRAY_TEXELS_PER_PRIMITIVE];
+      out[0] = texels.a;
+      out[1] = texels.b;
+      out[2] = texels.c;
     }
-    packed.primitives.insert(packed.primitives.end(), {texels.a, texels.b, texels.c});
-  }
+  });
   packed.nodes = pack_nodes(bvh);
   packed.materials.resize(scene.materials.size() * VKRAY_TEXELS_PER_MATERIAL);
   for (size_t i = 0; i < scene.materials.size(); ++i)
