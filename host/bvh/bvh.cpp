@@ -350,7 +350,7 @@ class ParallelBuilder {
     std::vector<std::pair<uint32_t, const Part*>> subtrees;  // where each subtree's nodes go
     uint32_t next = 0;
     place(root, bvh.nodes, next, subtrees);
-    tbb::parallel_for(size_t(0), subtrees.size(), [&](size_t s) {
+    const auto copy = [&](size_t s) {
       const auto [base, subtree] = subtrees[s];
       for (size_t i = 0; i < subtree->nodes.size(); ++i) {
         BvhNode node = subtree->nodes[i];
@@ -358,7 +358,11 @@ class ParallelBuilder {
           if (!is_leaf(link)) link += base;
         bvh.nodes[base + i] = node;
       }
-    });
+    };
+    if (subtrees.size() > 1)
+      tbb::parallel_for(size_t(0), subtrees.size(), copy);
+    else if (!subtrees.empty())
+      copy(0);  // a small tree, built on the caller's thread: so is its copy
     return bvh;
   }
 
@@ -435,22 +439,32 @@ Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads) {
     const uint32_t count = uint32_t(boxes.size());
     std::vector<PrimRef> refs(count);
     Range all{0, count, {}, {}};
+    // Small inputs stay on this thread: starting oneTBB's workers costs more than their build.
+    const bool parallel = count >= kTaskSize;
+    const auto for_each_block = [&](auto&& body) {
+      if (parallel)
+        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, count, kBinBlock), [&](const tbb::blocked_range<uint32_t>& block) {
+          body(block.begin(), block.end());
+        });
+      else
+        body(0u, count);
+    };
     const auto build = [&] {
-      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, count, kBinBlock), [&](const tbb::blocked_range<uint32_t>& block) {
-        for (uint32_t i = block.begin(); i < block.end(); ++i) refs[i] = {boxes[i], i};
+      for_each_block([&](uint32_t begin, uint32_t end) {
+        for (uint32_t i = begin; i < end; ++i) refs[i] = {boxes[i], i};
       });
       bound(refs.data(), all);
       bvh = ParallelBuilder(refs.data()).build(all);
       bvh.order.resize(count);
-      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, count, kBinBlock), [&](const tbb::blocked_range<uint32_t>& block) {
-        for (uint32_t i = block.begin(); i < block.end(); ++i) bvh.order[i] = refs[i].index;
+      for_each_block([&](uint32_t begin, uint32_t end) {
+        for (uint32_t i = begin; i < end; ++i) bvh.order[i] = refs[i].index;
       });
     };
-    if (count < kTaskSize) {
-      build();  // one task: no threads to start
-    } else {
+    if (parallel) {
       tbb::task_arena arena(threads > 0 ? int(threads) : tbb::task_arena::automatic);
       arena.execute(build);
+    } else {
+      build();
     }
   }
   bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -15,6 +15,19 @@
 namespace vkray::gpu {
 namespace {
 
+// Runs body(begin, end) over [0, count) in blocks on oneTBB's threads; a count of one block runs on
+// the caller's thread, so that small scenes never start the workers.
+template <typename Body>
+void for_blocks(size_t count, const Body& body) {
+  constexpr size_t kBlock = 4096;
+  if (count <= kBlock) {
+    body(size_t(0), count);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kBlock),
+                    [&](const tbb::blocked_range<size_t>& block) { body(block.begin(), block.end()); });
+}
+
 // Side q (0..255) of a quantized box along one axis, decoded by the shader's own code.
 float dequantize(float origin, float scale, uint32_t q) { return node_child_sides(origin, scale, q).x; }
 
@@ -41,9 +54,9 @@ class NodePacker {
     if (bvh_.nodes.empty()) return {};
     number(0);
     texels_.resize(binary_of_.size() * VKRAY_TEXELS_PER_NODE);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, binary_of_.size(), 4096), [&](const tbb::blocked_range<size_t>& block) {
+    for_blocks(binary_of_.size(), [&](size_t begin, size_t end) {
       throw_if_interrupted();
-      for (size_t wide = block.begin(); wide < block.end(); ++wide) {
+      for (size_t wide = begin; wide < end; ++wide) {
         Child children[VKRAY_NODE_WIDTH];
         const int count = gather(binary_of_[wide], children);
         for (int c = 0; c < count; ++c)
@@ -178,9 +191,9 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
   const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
   packed.primitives.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);
   if (any_smooth) packed.normals.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, bvh.order.size(), 4096), [&](const tbb::blocked_range<size_t>& block) {
+  for_blocks(bvh.order.size(), [&](size_t begin, size_t end) {
     throw_if_interrupted();
-    for (size_t slot = block.begin(); slot < block.end(); ++slot) {
+    for (size_t slot = begin; slot < end; ++slot) {
       const uint32_t p = bvh.order[slot];
       PrimitiveTexels texels;
       if (p < triangle_count) {
