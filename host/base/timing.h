@@ -17,6 +17,10 @@ inline double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+inline double seconds_between(Clock::time_point start, Clock::time_point end) {
+  return std::chrono::duration<double>(end - start).count();
+}
+
 // "0.27 ms", "8.5 ms", "123 ms": about three significant digits.
 inline std::string format_ms(double ms) {
   char text[32];

@@ -9,14 +9,15 @@
 #include "base/interrupt.h"
 #include "base/timing.h"
 #include "gpu/buffer.h"
+#include "gpu/tiling.h"
 #include "packing/scene_packing.h"
 #include "shared/types.h"
 
 namespace vkray::gpu {
 namespace {
 
-// One submission aims at about this many ray-primitive tests: a fraction of a second on lavapipe
-// with 2 cores, so no single submission runs long.
+// A render's first submission aims at about this many ray-primitive tests: a fraction of a second
+// on lavapipe with 2 cores, so that not even the first one runs long on a slow device.
 constexpr double kTestsPerTile = double(1 << 26);
 
 // Ray-primitive tests one sample costs, roughly: a ray visits on the order of log2(N) nodes and a few
@@ -34,6 +35,14 @@ double tests_per_sample(const Scene& scene) {
 uint32_t samples_in_one_dispatch(const Scene& scene) {
   return uint32_t(std::clamp(32768.0 / tests_per_sample(scene), 1.0, 64.0));
 }
+
+// Every submission after the first aims at this much device time, at the rate the ones before it
+// ran: long enough that a submission's fixed costs vanish on a fast GPU, short enough that
+// progress, Ctrl-C (which waits for the running submission) and a display watchdog are not kept
+// waiting on a slow one. Well below --tile-timeout's default of a minute (DECISIONS.md).
+constexpr double kSubmissionSeconds = 0.1;
+// The most pixels a submission (an output slot) holds: 64 MiB a slot, two slots.
+constexpr uint64_t kMostSlotPixels = uint64_t(1) << 22;
 
 }  // namespace
 
@@ -93,17 +102,23 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
 
   // ---- per-frame data: uniforms, output, descriptors ----
   auto start = Clock::now();
-  // The output holds two tiles, not the image: any image size fits the device's
-  // maxStorageBufferRange (128 MiB on lavapipe), the tile made smaller when two would not.
+  // The output holds two submissions' pixels (slots), not the image: any image size fits the
+  // device's maxStorageBufferRange (128 MiB on lavapipe). Submissions are square tiles of
+  // request.tile_side when asked for, and otherwise bands sized by SubmissionSizer.
   constexpr uint32_t kSlots = 2;
-  uint32_t side = request.tile_side ? request.tile_side : tile_side(scene->scene(), image);
-  const auto slot_pixels = [&] { return uint64_t(std::min(side, image.width)) * std::min(side, image.height); };
-  while (side > VKRAY_WORKGROUP_X && kSlots * slot_pixels() * sizeof(glm::vec4) > ctx_->limits().maxStorageBufferRange)
-    side -= VKRAY_WORKGROUP_X;
-  const vk::DeviceSize output_bytes = kSlots * slot_pixels() * sizeof(glm::vec4);
-  if (output_bytes > ctx_->limits().maxStorageBufferRange)
-    throw DeviceError("a render tile does not fit " + ctx_->device_name() + ": " + std::to_string(output_bytes) +
-                      " bytes of output, maxStorageBufferRange is " + std::to_string(ctx_->limits().maxStorageBufferRange));
+  constexpr uint32_t kGranule = VKRAY_WORKGROUP_X;
+  const uint64_t slot_limit = ctx_->limits().maxStorageBufferRange / (kSlots * sizeof(glm::vec4));
+  const uint64_t image_pixels = uint64_t(image.width) * image.height;
+  const bool fixed_tiles = request.tile_side > 0;
+  uint32_t side = request.tile_side;
+  const auto square_pixels = [&] { return uint64_t(std::min(side, image.width)) * std::min(side, image.height); };
+  while (fixed_tiles && side > kGranule && square_pixels() > slot_limit) side -= kGranule;
+  const uint64_t slot_pixels =
+      fixed_tiles ? square_pixels() : std::min({kMostSlotPixels, slot_limit, std::max<uint64_t>(image_pixels, kGranule * kGranule)});
+  if (slot_pixels > slot_limit || slot_pixels < std::min<uint64_t>(image_pixels, kGranule * kGranule))
+    throw DeviceError("a render tile does not fit " + ctx_->device_name() + ": " + std::to_string(kSlots * kGranule * kGranule * sizeof(glm::vec4)) +
+                      " bytes of output at least, maxStorageBufferRange is " + std::to_string(ctx_->limits().maxStorageBufferRange));
+  const vk::DeviceSize output_bytes = kSlots * slot_pixels * sizeof(glm::vec4);
   Image result(image.width, image.height);  // the host's copy, filled tile by tile
   auto frame = std::make_unique<Frame>();
   frame->trace_pipeline = std::move(trace_pipeline);
@@ -129,25 +144,38 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   frame->in_flight.reserve(kSlots);  // so that recording a submission cannot fail after it is made
   abandoned_.reserve(abandoned_.size() + 1);  // nor keeping the frame when the device still runs it
   const vk::PipelineLayout layout = *frame->trace_pipeline->layout();
-  const uint32_t tiles_x = (image.width + side - 1) / side, tiles_y = (image.height + side - 1) / side;
-  const uint32_t tile_count = tiles_x * tiles_y;
   const uint32_t samples_per_dispatch = samples_in_one_dispatch(frame->scene->scene());
-  const auto tile_at = [&](uint32_t tile_index) {
+  TileCursor cursor(image.width, image.height, kGranule);
+  // The first submission is the size the cost model gives (a bounded number of ray-primitive
+  // tests); the sizer takes over from the time it took.
+  const uint64_t first = uint64_t(first_tile_side(frame->scene->scene(), image)) * first_tile_side(frame->scene->scene(), image);
+  SubmissionSizer sizer(first, std::max<uint64_t>(kGranule * kGranule, first / 64), slot_pixels, kSubmissionSeconds);
+  struct Submitted {
+    TileRect rect;
+    Clock::time_point at;
+  };
+  std::vector<Submitted> submitted;
+  Clock::time_point last_finished = start;
+  uint64_t pixels_done = 0;
+  const auto tile_constants = [&](uint32_t index) {
+    const TileRect& rect = submitted[index].rect;
     TileConstants tile{};
-    tile.x0 = (tile_index % tiles_x) * side;
-    tile.y0 = (tile_index / tiles_x) * side;
-    tile.width = std::min(side, image.width - tile.x0);
-    tile.height = std::min(side, image.height - tile.y0);
+    tile.x0 = rect.x0;
+    tile.y0 = rect.y0;
+    tile.width = rect.width;
+    tile.height = rect.height;
     tile.row_stride = row_stride((tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y);
-    tile.output_offset = uint32_t((tile_index % kSlots) * slot_pixels());
+    tile.output_offset = uint32_t((index % kSlots) * slot_pixels);
     return tile;
   };
-  const auto submit = [&](uint32_t tile_index) {
-    TileConstants tile = tile_at(tile_index);
+  const auto submit = [&] {
+    const uint32_t index = uint32_t(submitted.size());
+    submitted.push_back({fixed_tiles ? cursor.next_square(side) : cursor.next(sizer.next()), Clock::now()});
+    TileConstants tile = tile_constants(index);
     const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
     const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
-    const vk::raii::CommandBuffer& cb = frame->command_buffers[tile_index % kSlots];
-    // The slot's command buffer and output were last used by tile_index - 2, waited for and read.
+    const vk::raii::CommandBuffer& cb = frame->command_buffers[index % kSlots];
+    // The slot's command buffer and output were last used by submission index - 2, waited for and read.
     cb.reset();
     cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
     cb.bindPipeline(vk::PipelineBindPoint::eCompute, **frame->pipeline);
@@ -169,19 +197,23 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
     cb.end();
     const vk::CommandBuffer raw = *cb;
-    const vk::Fence fence = *frame->fences[tile_index % kSlots];
+    const vk::Fence fence = *frame->fences[index % kSlots];
     ctx_->queue().submit(vk::SubmitInfo({}, {}, raw), fence);
     frame->in_flight.push_back(fence);  // reserved: cannot throw
   };
-  // Waits for a tile, copies its pixels into the image and frees its slot.
-  const auto finish = [&](uint32_t tile_index) {
-    const vk::raii::Fence& fence = frame->fences[tile_index % kSlots];
+  // Waits for a submission, gives the sizer its time, copies its pixels into the image and frees its slot.
+  const auto finish = [&](uint32_t index) {
+    const vk::raii::Fence& fence = frame->fences[index % kSlots];
     ctx_->wait(fence, request.tile_timeout, "a render tile");
     const auto read_start = Clock::now();
+    // The device ran it from when it was submitted or, queued behind the one before, from when
+    // that one finished.
+    sizer.finished(submitted[index].rect.pixels(), seconds_between(std::max(submitted[index].at, last_finished), read_start));
+    last_finished = read_start;
     std::erase(frame->in_flight, *fence);
     device.resetFences(*fence);
     frame->output.invalidate(device);
-    const TileConstants tile = tile_at(tile_index);
+    const TileConstants tile = tile_constants(index);
     const auto* texels = static_cast<const glm::vec4*>(frame->output.mapped) + tile.output_offset;
     for (uint32_t y = 0; y < tile.height; ++y)
       for (uint32_t x = 0; x < tile.width; ++x) {
@@ -189,16 +221,17 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
         result.at(tile.x0 + x, tile.y0 + y) = glm::vec3(texel);
         stats.rays += std::bit_cast<uint32_t>(texel.w);
       }
+    pixels_done += submitted[index].rect.pixels();
     readback_seconds += seconds_since(read_start);
-    if (request.progress) request.progress(tile_index + 1, tile_count);
+    if (request.progress) request.progress(uint32_t(pixels_done), uint32_t(image_pixels));
   };
   try {
-    for (uint32_t tile_index = 0; tile_index < tile_count; ++tile_index) {
-      submit(tile_index);
-      if (tile_index > 0) finish(tile_index - 1);
-      if (tile_index + 1 < tile_count && interrupt_requested()) throw Cancelled();
+    submit();
+    for (uint32_t finished = 0; finished < submitted.size(); ++finished) {
+      if (!cursor.done()) submit();  // queued behind the one waited for below: the device never idles
+      finish(finished);
+      if (!cursor.done() && interrupt_requested()) throw Cancelled();
     }
-    finish(tile_count - 1);
   } catch (...) {
     // Timed out, interrupted, or any other failure while a tile may still run: what it uses is kept
     // until the device is done with it (busy()), never destroyed under it.
@@ -209,12 +242,12 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   // read back its own part of it.
   stats.trace_seconds = seconds_since(start);
   stats.readback_seconds = readback_seconds;
-  stats.tiles = tile_count;
+  stats.tiles = uint32_t(submitted.size());
   if (stats_out) *stats_out = stats;
   return result;
 }
 
-uint32_t tile_side(const Scene& scene, const ImageSettings& image) {
+uint32_t first_tile_side(const Scene& scene, const ImageSettings& image) {
   const double pixels = kTestsPerTile / (tests_per_sample(scene) * image.samples_per_pixel);
   const uint32_t side = static_cast<uint32_t>(std::sqrt(pixels)) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
   const uint32_t largest = (std::max(image.width, image.height) + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;

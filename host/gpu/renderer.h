@@ -23,9 +23,9 @@ struct TraceRequest {
   ShaderVariant variant;
   // Longest one tile may run before the render fails with TimeoutError.
   std::chrono::milliseconds tile_timeout{60000};
-  // Tile side in pixels; 0 chooses it from the scene (tile_side()).
+  // Square tiles of this side in pixels; 0: submissions sized by the time they take (gpu/tiling.h).
   uint32_t tile_side = 0;
-  // Called after each tile with (tiles done, tiles in all).
+  // Called after each tile with (pixels done, pixels in all).
   std::function<void(uint32_t, uint32_t)> progress;
 };
 
@@ -64,8 +64,8 @@ class Renderer {
   std::vector<std::unique_ptr<Frame>> abandoned_;  // frames whose last tile timed out
 };
 
-// Tile side in pixels (a multiple of the workgroup size) so that one submission stays near a fixed
-// budget of ray-primitive tests whatever the scene size and sample count.
-uint32_t tile_side(const Scene& scene, const ImageSettings& image);
+// The side in pixels (a multiple of the workgroup size) of a square whose ray-primitive tests stay
+// near a fixed budget whatever the scene size and sample count: the first submission's size.
+uint32_t first_tile_side(const Scene& scene, const ImageSettings& image);
 
 }  // namespace vkray::gpu

@@ -33,14 +33,14 @@ struct RenderOptions {
   std::optional<uint32_t> width, height, samples_per_pixel;
   // false: no shadow rays, every light counts as visible (benchmarks of camera rays alone).
   bool shadows = true;
-  // GPU: how a small scene is traced; the longest one submission (a tile) may run; the tile side in
-  // pixels (0: chosen from the scene, so that a tile is a bounded amount of work).
+  // GPU: how a small scene is traced; the longest one submission (a tile) may run; square tiles of
+  // this side in pixels (0: submissions sized by the time they take, gpu/tiling.h).
   InlineScene inline_scene = InlineScene::automatic;
   std::chrono::milliseconds tile_timeout{60000};
   uint32_t tile_side = 0;
   // CPU reference: threads (0: one per hardware thread). The image does not depend on it.
   unsigned threads = 0;
-  // Called as the render proceeds with the unit ("tiles" on the GPU, "rows" on the CPU), the units
+  // Called as the render proceeds with the unit ("pixels" on the GPU, "rows" on the CPU), the units
   // done and the units in all.
   std::function<void(const char* unit, uint32_t done, uint32_t total)> progress;
   // A render stops on an interrupt request (base/interrupt.h) and throws Cancelled.

@@ -150,7 +150,7 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
   request.tile_timeout = options.tile_timeout;
   request.tile_side = options.tile_side;
   if (options.progress)
-    request.progress = [&options](uint32_t done, uint32_t total) { options.progress("tiles", done, total); };
+    request.progress = [&options](uint32_t done, uint32_t total) { options.progress("pixels", done, total); };
   prepare(scene, options);  // nothing to do when prepared before
   gpu::TraceStats trace;
   RenderResult result;
