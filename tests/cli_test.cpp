@@ -246,7 +246,16 @@ TEST(CliTest, BenchPrintsJsonForEachScene) {
   for (const char* mode : {"primary", "primary_shadow"}) {
     EXPECT_GT(j[0].at(mode).at("gpu_mrays").get<double>(), 0.0);
     EXPECT_GT(j[0].at(mode).at("cpu_reference_mrays").get<double>(), 0.0);
+    EXPECT_GE(j[1].at(mode).at("readback_ms").get<double>(), 0.0);
   }
+  // Every stage of a render, each measured.
+  for (const char* stage : {"load_ms", "bvh_build_ms", "upload_ms", "write_png_ms"}) EXPECT_GT(j[1].at(stage).get<double>(), 0.0) << stage;
+  // The teapot's tree is better than one leaf of all 6322 triangles, and no better than a perfect
+  // tree could be (at least one traversal step).
+  EXPECT_GT(j[1].at("bvh_sah_cost").get<double>(), 1.0);
+  EXPECT_LT(j[1].at("bvh_sah_cost").get<double>(), 100.0);
+  // The PNG of the write stage is not left behind.
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
 TEST(CliTest, TileTimeoutExitsThreeAndWritesNothing) {

@@ -2,10 +2,13 @@
 // Embree on the same scenes and the same rays, measured alternately in one run. A benchmark, not a
 // test: it prints numbers and never fails on them.
 #include <algorithm>
+#include <filesystem>
 #include <cstdio>
 #include <iostream>
 #include <optional>
 #include <thread>
+
+#include <unistd.h>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +16,7 @@
 #include "base/errors.h"
 #include "base/timing.h"
 #include "bvh/bvh.h"
+#include "image/image.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "scene/scene.h"
@@ -53,7 +57,11 @@ struct SceneResult {
   std::string name;
   size_t triangles = 0;
   double load_ms = 0, bvh_ms = 0, embree_build_ms = 0;
+  double bvh_sah_cost = 0;          // of vkray's tree (bvh/bvh.h)
+  double upload_ms = 0;             // the scene packed for the GPU and copied to it, the BVH already built
   double gpu_frame_ms[2] = {0, 0};  // median trace time, primary / with shadows
+  double readback_ms[2] = {0, 0};   // median
+  double write_ms = 0;              // median: the camera-ray image written as PNG
   bool inline_scene = false;        // the GPU path ran the scene compiled into the shader, not the BVH
   Rates rates[2];                   // [0] camera rays only, [1] with shadow rays
 };
@@ -85,6 +93,9 @@ int run_bench(const BenchArgs& args) {
   const bool with_embree = false;
 #endif
 
+  // Where the write stage's PNG goes for a moment: the system's temporary folder, a name per process.
+  const std::filesystem::path png =
+      std::filesystem::temp_directory_path() / ("vkray-bench-" + std::to_string(::getpid()) + ".png");
   Session session(session_options(args.device));
   std::cerr << "vkray bench: device " << session.device_description() << "; CPU reference and "
             << (with_embree ? embree_name() : std::string("no Embree")) << " on " << threads << " threads; "
@@ -98,13 +109,16 @@ int run_bench(const BenchArgs& args) {
     const auto scene = std::make_shared<const Scene>(load_scene(scene_dir / (name + ".json")));
     r.load_ms = ms_since(start);
     r.triangles = scene->triangles.size();
-    const Bvh bvh = build_bvh(primitive_boxes(*scene));
-    r.bvh_ms = bvh.build_seconds * 1e3;
+    start = Clock::now();  // from the scene's triangles, as Embree's time is
+    const Bvh bvh = build_bvh(primitive_boxes(*scene), threads);
+    r.bvh_ms = ms_since(start);
+    r.bvh_sah_cost = sah_cost(bvh);
     const auto on_device = session.upload(scene, &bvh);
+    r.upload_ms = on_device.upload_seconds() * 1e3;
 #ifdef VKRAY_HAVE_EMBREE
     std::optional<bench::EmbreeTracer> embree;
     if (with_embree) {
-      embree.emplace(*scene);
+      embree.emplace(*scene, threads);
       r.embree_build_ms = embree->build_seconds() * 1e3;
     }
 #endif
@@ -119,13 +133,21 @@ int run_bench(const BenchArgs& args) {
       warm_up.shadows = shadows;
       session.render(on_device, warm_up);
     }
-    std::vector<double> frame_ms[2];
+    std::vector<double> frame_ms[2], readback_ms[2], write_ms;
     for (unsigned round = 0; round < args.repeat; ++round) {
       for (int mode = 0; mode < 2; ++mode) {
         options.shadows = mode == 1;
-        const RenderStats gpu = session.render(on_device, options).stats;
+        const RenderResult rendered = session.render(on_device, options);
+        const RenderStats& gpu = rendered.stats;
         r.rates[mode].gpu.push_back(double(gpu.rays) / gpu.trace_seconds * 1e-6);
         frame_ms[mode].push_back(gpu.trace_seconds * 1e3);
+        readback_ms[mode].push_back(gpu.readback_seconds * 1e3);
+        if (mode == 0) {
+          start = Clock::now();
+          write_image(rendered.image, png);
+          write_ms.push_back(ms_since(start));
+          std::filesystem::remove(png);
+        }
 #ifdef VKRAY_HAVE_EMBREE
         if (embree) {
           const auto e = embree->trace(args.width, args.height, options.shadows, threads);
@@ -138,7 +160,11 @@ int run_bench(const BenchArgs& args) {
         }
       }
     }
-    for (int mode = 0; mode < 2; ++mode) r.gpu_frame_ms[mode] = median(frame_ms[mode]);
+    for (int mode = 0; mode < 2; ++mode) {
+      r.gpu_frame_ms[mode] = median(frame_ms[mode]);
+      r.readback_ms[mode] = median(readback_ms[mode]);
+    }
+    r.write_ms = median(write_ms);
     std::cerr << "vkray bench: " << name << " done\n";
     results.push_back(std::move(r));
   }
@@ -150,10 +176,13 @@ int run_bench(const BenchArgs& args) {
     for (const auto& r : results) {
       nlohmann::json j = {{"scene", r.name}, {"triangles", r.triangles}, {"width", args.width}, {"height", args.height},
                           {"bvh_build_ms", r.bvh_ms}, {"device", device}, {"threads", threads},
-                          {"gpu_path", r.inline_scene ? "inline" : "bvh"}, {"vkray_version", version_string()}};
+                          {"gpu_path", r.inline_scene ? "inline" : "bvh"}, {"vkray_version", version_string()},
+                          {"load_ms", r.load_ms}, {"bvh_sah_cost", r.bvh_sah_cost}, {"upload_ms", r.upload_ms},
+                          {"write_png_ms", r.write_ms}};
       for (int mode = 0; mode < 2; ++mode) {
         const std::string key = mode == 0 ? "primary" : "primary_shadow";
-        nlohmann::json m = {{"gpu_mrays", median(r.rates[mode].gpu)}, {"gpu_trace_ms", r.gpu_frame_ms[mode]}};
+        nlohmann::json m = {{"gpu_mrays", median(r.rates[mode].gpu)}, {"gpu_trace_ms", r.gpu_frame_ms[mode]},
+                            {"readback_ms", r.readback_ms[mode]}};
         if (args.cpu_reference) m["cpu_reference_mrays"] = median(r.rates[mode].cpu);
         if (with_embree) {
           m["embree_mrays"] = median(r.rates[mode].embree);
@@ -185,6 +214,14 @@ int run_bench(const BenchArgs& args) {
   }
   if (std::any_of(results.begin(), results.end(), [](const SceneResult& r) { return r.inline_scene; }))
     std::printf("* GPU path: the scene compiled into the shader, no BVH (--inline-scene never to measure the BVH)\n");
+  // Every stage of a render, as `vkray render` names them (medians; trace and read back with shadow
+  // rays). The BVH build is part of a render's upload stage; here it is shown on its own.
+  std::printf("\n%-13s %9s %9s %9s %9s %9s %9s %9s\n", "stages, ms", "load", "BVH build", "SAH cost", "upload", "trace",
+              "read back", "write PNG");
+  for (const auto& r : results)
+    std::printf("%-13s %9s %9s %9s %9s %9s %9s %9s\n", r.name.c_str(), fixed(r.load_ms, 1).c_str(), fixed(r.bvh_ms, 1).c_str(),
+                fixed(r.bvh_sah_cost, 1).c_str(), fixed(r.upload_ms, 1).c_str(), fixed(r.gpu_frame_ms[1], 1).c_str(),
+                fixed(r.readback_ms[1], 1).c_str(), fixed(r.write_ms, 1).c_str());
   return kExitOk;
 }
 

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -24,8 +25,9 @@ struct EmbreeTracer::State {
   }
 };
 
-EmbreeTracer::EmbreeTracer(const Scene& scene) : state_(std::make_unique<State>()), scene_(scene) {
-  state_->device = rtcNewDevice(nullptr);
+EmbreeTracer::EmbreeTracer(const Scene& scene, unsigned threads) : state_(std::make_unique<State>()), scene_(scene) {
+  const std::string config = "threads=" + std::to_string(threads);  // the build's threads, as vkray's
+  state_->device = rtcNewDevice(config.c_str());
   if (!state_->device) throw DeviceError("Embree: rtcNewDevice failed");
   const auto start = std::chrono::steady_clock::now();
   state_->scene = rtcNewScene(state_->device);
