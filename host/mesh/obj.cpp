@@ -36,8 +36,11 @@ class ObjParser {
       if (line_number_ % 4096 == 0) throw_if_interrupted();
       if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
       tokens_.clear();
-      for (size_t at = line.find_first_not_of(kSpace); at != std::string_view::npos; at = line.find_first_not_of(kSpace, at)) {
-        const size_t end = std::min(line.find_first_of(kSpace, at), line.size());
+      for (size_t at = 0;;) {
+        while (at < line.size() && is_space(line[at])) ++at;
+        if (at == line.size()) break;
+        size_t end = at;
+        while (end < line.size() && !is_space(line[end])) ++end;
         tokens_.push_back(line.substr(at, end - at));
         at = end;
       }
@@ -69,13 +72,16 @@ class ObjParser {
   }
 
  private:
-  static constexpr const char* kSpace = " \t\v\f";
+  // Spaces between tokens. Tested by hand: std::string_view::find_first_of calls memchr on the set
+  // for every character, which was a fifth of loading the bunny.
+  static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
   enum { kVertex, kTexture, kNormal };
 
   // A line ends at "\n", "\r\n" or a lone "\r" (old Mac files), the same for every kind of line.
   bool next_line(std::string_view& line) {
     if (at_ >= text_.size()) return false;
-    const size_t end = std::min(text_.find_first_of("\r\n", at_), text_.size());
+    size_t end = at_;
+    while (end < text_.size() && text_[end] != '\n' && text_[end] != '\r') ++end;
     line = text_.substr(at_, end - at_);
     at_ = end + 1;
     if (end + 1 < text_.size() && text_[end] == '\r' && text_[end + 1] == '\n') ++at_;
