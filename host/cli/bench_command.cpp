@@ -114,7 +114,7 @@ int run_bench(const BenchArgs& args) {
     r.bvh_ms = ms_since(start);
     r.bvh_sah_cost = sah_cost(bvh);
     const auto on_device = session.upload(scene, &bvh);
-    r.upload_ms = on_device.upload_seconds() * 1e3;
+    r.upload_ms = (on_device.upload_seconds() - on_device.bvh_seconds()) * 1e3;
 #ifdef VKRAY_HAVE_EMBREE
     std::optional<bench::EmbreeTracer> embree;
     if (with_embree) {

@@ -5,6 +5,7 @@
 
 #include "base/errors.h"
 #include "base/timing.h"
+#include "bvh/bvh.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "cli/report.h"
@@ -48,11 +49,14 @@ int run_render(const RenderArgs& args) {
     phases = "load " + format_ms(loaded.load_ms) + " | trace " + format_ms(result.stats.trace_seconds * 1e3);
   } else {
     log(describe(*loaded.scene, image));
+    // The BVH is built while the device opens and the shaders compile, which need one thread.
+    std::future<Bvh> bvh = build_bvh_in_background(loaded.scene);
     Session session(session_options(args.device));
     log("device " + session.device_description() + (args.device.validate ? ", validation on" : ""));
     double compile_seconds = session.compile_shaders().seconds, upload_seconds = 0;
     {
-      const auto on_device = session.upload(loaded.scene);
+      const Bvh built = bvh.get();
+      const auto on_device = session.upload(loaded.scene, &built);
       upload_seconds = on_device.upload_seconds();
       // The scene's pipeline compiled now, so that the compile phase counts it (a small scene's own
       // code is compiled only now that the scene is packed).

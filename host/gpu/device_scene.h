@@ -31,7 +31,7 @@ class GpuScene {
   const std::string& inline_scene() const { return inline_scene_; }
   uint32_t primitive_count() const { return primitive_count_; }
   double bvh_seconds() const { return bvh_seconds_; }
-  double upload_seconds() const { return upload_seconds_; }  // BVH build included
+  double upload_seconds() const { return upload_seconds_; }  // BVH build included, prebuilt or not
 
   // Adds the scene's buffers at their bindings (shared/types.h).
   void bind(DescriptorWriter& writer) const;

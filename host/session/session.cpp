@@ -93,6 +93,11 @@ Session::ShaderCompile Session::compile_shaders() {
 
 const Scene& DeviceScene::scene() const { return scene_->scene(); }
 double DeviceScene::upload_seconds() const { return scene_->upload_seconds(); }
+double DeviceScene::bvh_seconds() const { return scene_->bvh_seconds(); }
+
+std::future<Bvh> build_bvh_in_background(std::shared_ptr<const Scene> scene) {
+  return std::async(std::launch::async, [scene = std::move(scene)] { return build_bvh(primitive_boxes(*scene)); });
+}
 
 DeviceScene Session::upload(std::shared_ptr<const Scene> scene, const Bvh* bvh) {
   device();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,7 +29,8 @@ class ValidationLog;
 class DeviceScene {
  public:
   const Scene& scene() const;
-  double upload_seconds() const;  // BVH build included
+  double upload_seconds() const;  // BVH build included, also when built beforehand
+  double bvh_seconds() const;
 
  private:
   friend class Session;
@@ -115,5 +117,10 @@ bool device_work_left_running();
 // Every Vulkan device the loader reports, in loader order (the index `SessionOptions::device` takes).
 using gpu::DeviceInfo;
 using gpu::list_devices;
+
+// Builds the scene's BVH on other threads and returns at once, so that a face can open the device
+// and compile the shaders meanwhile and then hand the tree to Session::upload(). Errors (LimitError,
+// Cancelled) come out of the future's get().
+std::future<Bvh> build_bvh_in_background(std::shared_ptr<const Scene> scene);
 
 }  // namespace vkray
