@@ -1,14 +1,17 @@
 // Run-time shader compilation: includes, and errors that point at the right file and line.
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "base/errors.h"
+#include "gpu/shader_cache.h"
 #include "gpu/shader_compiler.h"
 #include "shared/types.h"
 #include "support/temp_dir.h"
@@ -116,6 +119,136 @@ TEST(ShaderCompilerTest, MissingIncludeNamesTheIncludingLine) {
 TEST(ShaderCompilerTest, MissingEntryFile) {
   TempDir empty;
   EXPECT_THROW(gpu::compile_compute_shader(empty / "trace.comp", {empty.path()}), ShaderError);
+}
+
+// ---- The cache of compiled shaders (gpu/shader_cache.h) -------------------------------------------
+
+std::vector<std::filesystem::path> cache_entries(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> entries;
+  if (std::filesystem::exists(dir))
+    for (const auto& e : std::filesystem::directory_iterator(dir)) entries.push_back(e.path());
+  return entries;
+}
+
+void expect_same(const gpu::CompiledShader& a, const gpu::CompiledShader& b) {
+  EXPECT_EQ(a.spirv, b.spirv);
+  EXPECT_EQ(a.sources, b.sources);
+  ASSERT_EQ(a.bindings.size(), b.bindings.size());
+  for (size_t i = 0; i < a.bindings.size(); ++i) {
+    EXPECT_EQ(a.bindings[i].set, b.bindings[i].set);
+    EXPECT_EQ(a.bindings[i].binding, b.bindings[i].binding);
+    EXPECT_EQ(a.bindings[i].type, b.bindings[i].type);
+    EXPECT_EQ(a.bindings[i].count, b.bindings[i].count);
+    EXPECT_EQ(a.bindings[i].name, b.bindings[i].name);
+  }
+}
+
+TEST(ShaderCacheTest, ASecondCompileIsReadBackAsItWasStored) {
+  TempDir cache;
+  ShaderCopy shaders;
+  const auto entry = shaders.path() / "trace.comp";
+  const gpu::CompiledShader compiled = gpu::compile_compute_shader(entry, {shaders.path()});
+  const gpu::CompiledShader first = gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
+  expect_same(first, compiled);
+  const auto entries = cache_entries(cache.path());
+  ASSERT_EQ(entries.size(), 1u);
+  // The stored SPIR-V's last word changed: what comes back is the entry, not a new compile.
+  std::fstream file(entries[0], std::ios::in | std::ios::out | std::ios::binary);
+  file.seekp(-1, std::ios::end);
+  file.put(char(0x5a));
+  file.close();
+  const gpu::CompiledShader second = gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
+  ASSERT_EQ(second.spirv.size(), compiled.spirv.size());
+  EXPECT_NE(second.spirv.back(), compiled.spirv.back());
+  EXPECT_TRUE(std::equal(compiled.spirv.begin(), compiled.spirv.end() - 1, second.spirv.begin()));
+  EXPECT_EQ(second.sources, compiled.sources);
+}
+
+TEST(ShaderCacheTest, AnEditedIncludeOrANewFileIsCompiledAgain) {
+  TempDir cache;
+  ShaderCopy shaders;
+  const auto entry = shaders.path() / "trace.comp";
+  const gpu::CompiledShader before = gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
+  shaders.edit("shade.glsl", "const float PI = 3.14159265358979;", "const float PI = 3.0;");
+  const gpu::CompiledShader after = gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
+  EXPECT_NE(after.spirv, before.spirv);
+  expect_same(after, gpu::compile_compute_shader(entry, {shaders.path()}));
+  EXPECT_EQ(cache_entries(cache.path()).size(), 2u);
+  // A file no #include names yet may shadow one later (a search finds it first): a new key too.
+  std::ofstream(shaders.path() / "shared" / "unused.h") << "// nothing\n";
+  gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
+  EXPECT_EQ(cache_entries(cache.path()).size(), 3u);
+}
+
+TEST(ShaderCacheTest, ACorruptOrUnwritableCacheOnlyMeansCompiling) {
+  TempDir cache;
+  ShaderCopy shaders;
+  const auto entry = shaders.path() / "trace.comp";
+  const gpu::CompiledShader compiled = gpu::compile_compute_shader(entry, {shaders.path()});
+  gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
+  const auto entries = cache_entries(cache.path());
+  ASSERT_EQ(entries.size(), 1u);
+  for (const std::string& garbage : {std::string(), std::string("VKRAYSC1"), std::string(5000, '\xff')}) {
+    std::ofstream(entries[0], std::ios::binary | std::ios::trunc) << garbage;
+    expect_same(gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()}), compiled);
+  }
+  // A cache "folder" that is a file: nothing can be stored, the shader still compiles.
+  const auto not_a_folder = cache.path() / "file";
+  std::ofstream(not_a_folder) << "x";
+  expect_same(gpu::compile_compute_shader_cached(not_a_folder, entry, {shaders.path()}), compiled);
+  expect_same(gpu::compile_compute_shader_cached(not_a_folder, entry, {shaders.path()}), compiled);
+}
+
+TEST(ShaderCacheTest, ErrorsAreNeverCached) {
+  TempDir cache;
+  ShaderCopy shaders;
+  shaders.edit("shade.glsl", "const float PI", "const floot PI");
+  const auto entry = shaders.path() / "trace.comp";
+  for (int i = 0; i < 2; ++i) EXPECT_THROW(gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()}), ShaderError);
+  EXPECT_TRUE(cache_entries(cache.path()).empty());
+}
+
+// Sets an environment variable for the scope (nullptr: unset), restoring it after.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    if (value) setenv(name, value, 1); else unsetenv(name);
+  }
+  ~ScopedEnv() {
+    if (old_) setenv(name_, old_->c_str(), 1); else unsetenv(name_);
+  }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+TEST(ShaderCacheTest, TheFolderComesFromTheEnvironment) {
+  {
+    ScopedEnv off("VKRAY_SHADER_CACHE", "off");
+    EXPECT_FALSE(gpu::shader_cache_dir());
+  }
+  {
+    ScopedEnv empty("VKRAY_SHADER_CACHE", "");
+    EXPECT_FALSE(gpu::shader_cache_dir());
+  }
+  {
+    ScopedEnv set("VKRAY_SHADER_CACHE", "/somewhere/cache");
+    EXPECT_EQ(gpu::shader_cache_dir(), std::filesystem::path("/somewhere/cache"));
+  }
+  ScopedEnv unset("VKRAY_SHADER_CACHE", nullptr);
+  {
+    ScopedEnv xdg("XDG_CACHE_HOME", "/xdg");
+    EXPECT_EQ(gpu::shader_cache_dir(), std::filesystem::path("/xdg/vkray/shaders"));
+  }
+  ScopedEnv no_xdg("XDG_CACHE_HOME", nullptr);
+  {
+    ScopedEnv home("HOME", "/home/student");
+    EXPECT_EQ(gpu::shader_cache_dir(), std::filesystem::path("/home/student/.cache/vkray/shaders"));
+  }
+  ScopedEnv no_home("HOME", nullptr);
+  EXPECT_FALSE(gpu::shader_cache_dir());
 }
 
 }  // namespace

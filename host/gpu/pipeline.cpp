@@ -3,6 +3,7 @@
 #include <glslang/SPIRV/spirv.hpp>
 
 #include "base/errors.h"
+#include "gpu/shader_cache.h"
 #include "shared/types.h"
 
 namespace vkray::gpu {
@@ -40,10 +41,12 @@ bool declares(const std::vector<uint32_t>& spirv, spv::Capability capability) {
 }  // namespace
 
 TracePipeline::TracePipeline(std::shared_ptr<const Context> ctx, std::filesystem::path shader_dir,
-                             CompiledShader shader, std::shared_ptr<const vk::raii::PipelineCache> cache)
+                             CompiledShader shader, std::shared_ptr<const vk::raii::PipelineCache> cache,
+                             std::optional<std::filesystem::path> shader_cache)
     : ctx_(std::move(ctx)),
       cache_(std::move(cache)),
       shader_dir_(std::move(shader_dir)),
+      shader_cache_(std::move(shader_cache)),
       shader_(std::move(shader)),
       descriptors_(ctx_->device(), kTraceBindings) {
   check(shader_);
@@ -91,7 +94,7 @@ std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVari
   vk::raii::ShaderModule inline_module{nullptr};
   if (!variant.inline_scene.empty()) {
     const CompiledShader shader =
-        compile_compute_shader(shader_dir_ / "trace.comp", {shader_dir_}, {{"inline_scene.glsl", variant.inline_scene}});
+        compile_compute_shader_cached(shader_cache_, shader_dir_ / "trace.comp", {shader_dir_}, {{"inline_scene.glsl", variant.inline_scene}});
     check(shader);
     inline_module = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, shader.spirv));
   }

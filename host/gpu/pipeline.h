@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -38,8 +39,10 @@ class TracePipeline {
   // re-creating a pipeline from SPIR-V seen before in this process cheap. Throws ShaderError when
   // the shader declares its bindings otherwise than vkray binds them, or reads the clock on a
   // device without one (Context::has_device_clock()).
+  // `shader_cache`: where variants with a scene compiled in keep their SPIR-V (gpu/shader_cache.h).
   TracePipeline(std::shared_ptr<const Context> ctx, std::filesystem::path shader_dir, CompiledShader shader,
-                std::shared_ptr<const vk::raii::PipelineCache> cache = nullptr);
+                std::shared_ptr<const vk::raii::PipelineCache> cache = nullptr,
+                std::optional<std::filesystem::path> shader_cache = std::nullopt);
   ~TracePipeline();
 
   const DescriptorTable& descriptors() const { return descriptors_; }
@@ -64,6 +67,7 @@ class TracePipeline {
   std::shared_ptr<const Context> ctx_;  // first: destroyed last
   std::shared_ptr<const vk::raii::PipelineCache> cache_;
   std::filesystem::path shader_dir_;
+  std::optional<std::filesystem::path> shader_cache_;
   CompiledShader shader_;
   DescriptorTable descriptors_;
   vk::raii::PipelineLayout layout_{nullptr};

@@ -9,6 +9,7 @@
 #include "gpu/device_scene.h"
 #include "gpu/pipeline.h"
 #include "gpu/renderer.h"
+#include "gpu/shader_cache.h"
 #include "gpu/shader_compiler.h"
 #include "session/paths.h"
 
@@ -41,7 +42,8 @@ struct Session::Shaders {
 };
 
 Session::Session(const SessionOptions& options)
-    : shader_dir_(options.shader_dir.empty() ? default_shader_dir() : options.shader_dir) {
+    : shader_dir_(options.shader_dir.empty() ? default_shader_dir() : options.shader_dir),
+      shader_cache_(gpu::shader_cache_dir()) {
   gpu::ContextOptions context_options;
   context_options.device = options.device;
   if (options.validation) validation_log_ = std::make_shared<gpu::ValidationLog>();
@@ -74,12 +76,12 @@ std::vector<std::filesystem::path> Session::shader_sources() const {
 Session::ShaderCompile Session::compile_shaders() {
   device();
   const auto start = Clock::now();
-  gpu::CompiledShader compiled = gpu::compile_compute_shader(shader_dir_ / "trace.comp", {shader_dir_});
+  gpu::CompiledShader compiled = gpu::compile_compute_shader_cached(shader_cache_, shader_dir_ / "trace.comp", {shader_dir_});
   std::vector<std::filesystem::path> sources = compiled.sources;
   const bool changed = !has_shaders() || compiled.spirv != shaders_->pipeline->shader().spirv;
   if (changed) {
     shaders_->pipeline = on_device([&] {
-      return std::make_shared<const gpu::TracePipeline>(ctx_, shader_dir_, std::move(compiled), shaders_->cache);
+      return std::make_shared<const gpu::TracePipeline>(ctx_, shader_dir_, std::move(compiled), shaders_->cache, shader_cache_);
     });
     check_validation("shader module creation");
   } else {

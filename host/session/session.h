@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <future>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,7 @@ class Session {
   void check_validation(const char* during);
 
   std::filesystem::path shader_dir_;
+  std::optional<std::filesystem::path> shader_cache_;  // compiled shaders kept between runs (gpu/shader_cache.h)
   std::shared_ptr<gpu::ValidationLog> validation_log_;  // outlives the device, whose teardown may report
   size_t validation_seen_ = 0;
   std::shared_ptr<const gpu::Context> ctx_;
