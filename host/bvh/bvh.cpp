@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -36,6 +37,8 @@ constexpr float kIntersectionCost = 1.0f;
 constexpr uint32_t kTaskSize = 4096;
 // A range of at least two of these blocks bins its primitives block by block in parallel.
 constexpr uint32_t kBinBlock = 32768;
+// From this many primitives on, binning sets every bin up front rather than at its first primitive.
+constexpr uint32_t kDenseBinning = 64;
 
 // A primitive's box and its index in the caller's list; the builder reorders these in place.
 struct PrimRef {
@@ -137,6 +140,10 @@ struct BinBounds {
   }
   Aabb box() const { return {min.xyz(), max.xyz()}; }
   Aabb centroids() const { return {centroid_min.xyz(), centroid_max.xyz()}; }
+  static BinBounds empty() {
+    const Float4 big = Float4::splat(1e30f), small = Float4::splat(-1e30f);
+    return {big, small, big, small};
+  }
 };
 
 // Every primitive of a range counted into the bins of all three axes in one pass. Merging is exact
@@ -144,8 +151,10 @@ struct BinBounds {
 struct Bins {
   std::array<std::array<BinBounds, kBins>, 3> bounds;  // left unset: most bins of a small range stay empty
   std::array<std::array<uint32_t, kBins>, 3> count{};
+  bool dense = false;  // every bin's bounds set, empty ones to BinBounds::empty()
 
   void add(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map) {
+    if (end - begin >= kDenseBinning) return add_dense(refs, begin, end, map);
     const Float4 lo = Float4::load(&map.lo.x), scale = Float4::load(&map.scale.x), half = Float4::splat(0.5f);
     for (uint32_t i = begin; i < end; ++i) {
       // Lane 3 of each load is the next member (box.max.x, index): read, never used.
@@ -154,10 +163,31 @@ struct Bins {
       const std::array<int32_t, 4> bin = ((centroid - lo) * scale).bins();
       for (size_t a = 0; a < 3; ++a) {
         const size_t b = size_t(bin[a]);
-        if (count[a][b]++ == 0)
+        if (count[a][b]++ == 0 && !dense)
           bounds[a][b].set(box_min, box_max, centroid);
         else
           bounds[a][b].grow(box_min, box_max, centroid, centroid);
+      }
+    }
+  }
+  // Many primitives: every bin's bounds set to empty first (a union with them changes nothing), so
+  // that the loop grows them without a branch.
+  void add_dense(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map) {
+    if (!dense) {
+      for (size_t a = 0; a < 3; ++a)
+        for (size_t b = 0; b < kBins; ++b)
+          if (count[a][b] == 0) bounds[a][b] = BinBounds::empty();
+      dense = true;
+    }
+    const Float4 lo = Float4::load(&map.lo.x), scale = Float4::load(&map.scale.x), half = Float4::splat(0.5f);
+    for (uint32_t i = begin; i < end; ++i) {
+      const Float4 box_min = Float4::load(&refs[i].box.min.x), box_max = Float4::load(&refs[i].box.max.x);
+      const Float4 centroid = half * (box_min + box_max);
+      const std::array<int32_t, 4> bin = ((centroid - lo) * scale).bins();
+      for (size_t a = 0; a < 3; ++a) {
+        const size_t b = size_t(bin[a]);
+        ++count[a][b];
+        bounds[a][b].grow(box_min, box_max, centroid, centroid);
       }
     }
   }
@@ -182,7 +212,12 @@ struct SweepBox {
     min = min4(min, b.min);
     max = max4(max, b.max);
   }
-  float half_area() const { return Aabb{min.xyz(), max.xyz()}.half_area(); }
+  // Aabb::half_area()'s sum in the same order (a side of -0 where glm's max keeps -0 gives +0
+  // here, which changes no sum's value).
+  float half_area() const {
+    const glm::vec3 d = max4(max - min, Float4::splat(0.0f)).xyz();
+    return d.x * d.y + d.y * d.z + d.z * d.x;
+  }
 };
 
 // Fills `bins` (which the caller keeps, to spare a copy of a few kB a node).
@@ -212,6 +247,43 @@ void bound(const PrimRef* refs, Range& range) {
   }
 }
 
+// Bit b set for each bin b that holds something.
+uint32_t filled_bins(const std::array<uint32_t, kBins>& counts) {
+#if defined(__SSE2__)
+  uint32_t filled = 0;
+  for (int q = 0; q < kBins / 4; ++q) {
+    const __m128i four = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&counts[size_t(4 * q)]));
+    const __m128i empty = _mm_cmpeq_epi32(four, _mm_setzero_si128());
+    filled |= uint32_t(~_mm_movemask_ps(_mm_castsi128_ps(empty)) & 0xf) << (4 * q);
+  }
+  return filled;
+#else
+  uint32_t filled = 0;
+  for (int b = 0; b < kBins; ++b) filled |= uint32_t(counts[size_t(b)] > 0) << b;
+  return filled;
+#endif
+}
+
+// Puts the primitives whose centroid falls in bins [0, last_left] of `axis` first, as std::partition
+// does (the same order as before the builder was rewritten); returns where the right side begins.
+// The axis is a template argument so that reading a centroid's coordinate compiles to a load.
+template <int kAxis>
+uint32_t partition_on(PrimRef* refs, const Range& range, const BinMap& map, int last_left) {
+  const float lo = map.lo[kAxis], scale = map.scale[kAxis];
+  return uint32_t(std::partition(refs + range.begin, refs + range.end, [&](const PrimRef& p) {
+                    return bin_of(0.5f * (p.box.min[kAxis] + p.box.max[kAxis]), lo, scale) <= last_left;
+                  }) -
+                  refs);
+}
+
+uint32_t partition(PrimRef* refs, const Range& range, const BinMap& map, int axis, int last_left) {
+  switch (axis) {
+    case 0: return partition_on<0>(refs, range, map, last_left);
+    case 1: return partition_on<1>(refs, range, map, last_left);
+    default: return partition_on<2>(refs, range, map, last_left);
+  }
+}
+
 // Splits a range in two, by binned SAH over all three axes or, past kSahDepth or where SAH finds
 // no split cheaper than a leaf too large for the leaf encoding, at the median. Returns false where
 // the range becomes a leaf.
@@ -230,30 +302,31 @@ bool split(PrimRef* refs, const Range& range, uint32_t depth, Range& left, Range
       const auto& bounds = bins.bounds[size_t(axis)];
       const auto& counts = bins.count[size_t(axis)];
       // Sweep from the right, then from the left, to cost every plane between bins. A plane after
-      // an empty bin costs what the plane before it did, so it never wins and is not costed.
-      std::array<float, kBins> right_area{};
-      std::array<uint32_t, kBins> right_count{};
+      // an empty bin costs what the plane before it did, so it never wins: only the bins that hold
+      // something are visited, as the bits of `filled`.
+      const uint32_t filled = filled_bins(counts);
+      std::array<float, kBins> right_area;     // of bins b.. for a filled bin b > 0
+      std::array<uint32_t, kBins> right_count;
       SweepBox acc;
       uint32_t n = 0;
-      float area = 0.0f;
-      for (int b = kBins - 1; b > 0; --b) {
-        if (counts[size_t(b)] > 0) {
-          acc.grow(bounds[size_t(b)]);
-          n += counts[size_t(b)];
-          area = acc.half_area();
-        }
-        right_area[size_t(b)] = area;
+      for (uint32_t m = filled & ~1u; m != 0;) {
+        const int b = 31 - std::countl_zero(m);
+        m &= ~(1u << b);
+        acc.grow(bounds[size_t(b)]);
+        n += counts[size_t(b)];
+        right_area[size_t(b)] = acc.half_area();
         right_count[size_t(b)] = n;
       }
       acc = SweepBox();
       n = 0;
-      for (int b = 0; b < kBins - 1; ++b) {
-        if (counts[size_t(b)] == 0) continue;
+      for (uint32_t m = filled; m != 0;) {
+        const int b = std::countr_zero(m);
+        m &= m - 1;
+        if (m == 0) break;  // the last filled bin: nothing to its right
+        const size_t next = size_t(std::countr_zero(m));
         acc.grow(bounds[size_t(b)]);
         n += counts[size_t(b)];
-        if (right_count[size_t(b + 1)] == 0) break;
-        const float cost = kTraversalCost + kIntersectionCost *
-                                                (acc.half_area() * float(n) + right_area[size_t(b + 1)] * float(right_count[size_t(b + 1)])) /
+        const float cost = kTraversalCost + kIntersectionCost * (acc.half_area() * float(n) + right_area[next] * float(right_count[next])) /
                                                 parent_area;
         if (cost < best_cost) {
           best_cost = cost;
@@ -263,18 +336,26 @@ bool split(PrimRef* refs, const Range& range, uint32_t depth, Range& left, Range
       }
     }
     if (best_axis >= 0) {
-      const uint32_t mid = uint32_t(std::partition(refs + range.begin, refs + range.end,
-                                                   [&](const PrimRef& p) { return map.bin(p.centroid(), best_axis) <= best_bin; }) -
-                                    refs);
+      const uint32_t mid = partition(refs, range, map, best_axis, best_bin);
       if (mid != range.begin && mid != range.end) {
         left = {range.begin, mid, {}, {}};
         right = {mid, range.end, {}, {}};
-        for (int b = 0; b < kBins; ++b) {
-          if (bins.count[size_t(best_axis)][size_t(b)] == 0) continue;
-          Range& side = b <= best_bin ? left : right;
-          side.box.grow(bins.bounds[size_t(best_axis)][size_t(b)].box());
-          side.centroids.grow(bins.bounds[size_t(best_axis)][size_t(b)].centroids());
+        BinBounds sides[2];  // the union of the bins on each side, set by the first
+        bool empty[2] = {true, true};
+        for (uint32_t m = filled_bins(bins.count[size_t(best_axis)]); m != 0; m &= m - 1) {
+          const int b = std::countr_zero(m);
+          const BinBounds& bin = bins.bounds[size_t(best_axis)][size_t(b)];
+          const int side = b <= best_bin ? 0 : 1;
+          if (empty[side])
+            sides[side] = bin;
+          else
+            sides[side].grow(bin.min, bin.max, bin.centroid_min, bin.centroid_max);
+          empty[side] = false;
         }
+        left.box = sides[0].box();
+        left.centroids = sides[0].centroids();
+        right.box = sides[1].box();
+        right.centroids = sides[1].centroids();
         return true;
       }
     }
