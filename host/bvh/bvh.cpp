@@ -154,7 +154,19 @@ struct Bins {
   bool dense = false;  // every bin's bounds set, empty ones to BinBounds::empty()
 
   void add(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map) {
-    if (end - begin >= kDenseBinning) return add_dense(refs, begin, end, map);
+    if (end - begin < kDenseBinning && !dense) return add<false>(refs, begin, end, map);
+    // Many primitives: every bin's bounds set to empty first (a union with them changes nothing), so
+    // that the loop grows them without a branch.
+    if (!dense) {
+      for (size_t a = 0; a < 3; ++a)
+        for (size_t b = 0; b < kBins; ++b)
+          if (count[a][b] == 0) bounds[a][b] = BinBounds::empty();
+      dense = true;
+    }
+    add<true>(refs, begin, end, map);
+  }
+  template <bool kDense>
+  void add(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map) {
     const Float4 lo = Float4::load(&map.lo.x), scale = Float4::load(&map.scale.x), half = Float4::splat(0.5f);
     for (uint32_t i = begin; i < end; ++i) {
       // Lane 3 of each load is the next member (box.max.x, index): read, never used.
@@ -163,31 +175,10 @@ struct Bins {
       const std::array<int32_t, 4> bin = ((centroid - lo) * scale).bins();
       for (size_t a = 0; a < 3; ++a) {
         const size_t b = size_t(bin[a]);
-        if (count[a][b]++ == 0 && !dense)
+        if (count[a][b]++ == 0 && !kDense)
           bounds[a][b].set(box_min, box_max, centroid);
         else
           bounds[a][b].grow(box_min, box_max, centroid, centroid);
-      }
-    }
-  }
-  // Many primitives: every bin's bounds set to empty first (a union with them changes nothing), so
-  // that the loop grows them without a branch.
-  void add_dense(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map) {
-    if (!dense) {
-      for (size_t a = 0; a < 3; ++a)
-        for (size_t b = 0; b < kBins; ++b)
-          if (count[a][b] == 0) bounds[a][b] = BinBounds::empty();
-      dense = true;
-    }
-    const Float4 lo = Float4::load(&map.lo.x), scale = Float4::load(&map.scale.x), half = Float4::splat(0.5f);
-    for (uint32_t i = begin; i < end; ++i) {
-      const Float4 box_min = Float4::load(&refs[i].box.min.x), box_max = Float4::load(&refs[i].box.max.x);
-      const Float4 centroid = half * (box_min + box_max);
-      const std::array<int32_t, 4> bin = ((centroid - lo) * scale).bins();
-      for (size_t a = 0; a < 3; ++a) {
-        const size_t b = size_t(bin[a]);
-        ++count[a][b];
-        bounds[a][b].grow(box_min, box_max, centroid, centroid);
       }
     }
   }
