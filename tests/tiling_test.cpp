@@ -102,6 +102,10 @@ TEST(TilingTest, TheSizerAimsAtTheTargetTimeAndChangesBoundedly) {
 TEST(TilingTest, TheFirstSizeIsKeptWithinTheBounds) {
   EXPECT_EQ(SubmissionSizer(10, 100, 1000, 0.1).next(), 100u);
   EXPECT_EQ(SubmissionSizer(5000, 100, 1000, 0.1).next(), 1000u);
+  SubmissionSizer slot_first(5000, 2000, 1000, 0.1);  // a least past the slot: the slot wins
+  EXPECT_EQ(slot_first.next(), 1000u);
+  slot_first.finished(1000, 100.0);
+  EXPECT_EQ(slot_first.next(), 1000u);
 }
 
 }  // namespace

@@ -32,7 +32,9 @@ TileRect TileCursor::next(uint64_t pixels) {
 TileRect TileCursor::next_square(uint32_t side) { return take(side, side); }
 
 SubmissionSizer::SubmissionSizer(uint64_t first, uint64_t least, uint64_t most, double target_seconds)
-    : next_(std::clamp(first, least, most)), least_(least), most_(std::max(least, most)), target_seconds_(target_seconds) {}
+    : least_(std::min(least, most)), most_(most), target_seconds_(target_seconds) {  // `most` is the slot: it wins
+  next_ = std::clamp(first, least_, most_);
+}
 
 void SubmissionSizer::finished(uint64_t pixels, double seconds) {
   const double pixels_at_rate = seconds > 0 ? double(pixels) / seconds * target_seconds_ : double(pixels) * 8.0;

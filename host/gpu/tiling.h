@@ -40,7 +40,8 @@ class TileCursor {
 
 // The pixels of the next submission. Each finished submission gives a rate (pixels a second), and
 // the next one is sized to last about `target_seconds` at that rate; it grows at most 8x and
-// shrinks at most 4x from the last measured one, and stays within [least, most].
+// shrinks at most 4x from the last measured one, and stays within [least, most] (most, an output
+// slot's size, wins where least is larger).
 class SubmissionSizer {
  public:
   SubmissionSizer(uint64_t first, uint64_t least, uint64_t most, double target_seconds);
@@ -50,7 +51,7 @@ class SubmissionSizer {
   void finished(uint64_t pixels, double seconds);
 
  private:
-  uint64_t next_, least_, most_;
+  uint64_t least_, most_, next_ = 0;
   double target_seconds_;
 };
 
