@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -40,6 +41,12 @@ constexpr uint32_t kBinBlock = 32768;
 // From this many primitives on, binning sets every bin up front rather than at its first primitive.
 constexpr uint32_t kDenseBinning = 64;
 
+// Throws Cancelled on an interrupt request or when the caller's `stop` is set.
+void check_stop(const std::atomic<bool>* stop) {
+  throw_if_interrupted();
+  if (stop && stop->load(std::memory_order_relaxed)) throw Cancelled();
+}
+
 // A primitive's box and its index in the caller's list; the builder reorders these in place.
 struct PrimRef {
   Aabb box;
@@ -68,6 +75,11 @@ int bin_of(float coordinate, float lo, float scale) {
 struct Float4 {
   __m128 v;
   static Float4 load(const float* p) { return {_mm_loadu_ps(p)}; }  // reads p[0..3]
+  // x, y, z of a vec3 that is followed by 4 more bytes of its struct (read, then zeroed: an index's
+  // bits there would be a denormal float, slow in every operation on some CPUs).
+  static Float4 load3(const glm::vec3& v) {
+    return {_mm_and_ps(_mm_loadu_ps(&v.x), _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1)))};
+  }
   static Float4 splat(float x) { return {_mm_set1_ps(x)}; }
   friend Float4 operator+(Float4 a, Float4 b) { return {_mm_add_ps(a.v, b.v)}; }
   friend Float4 operator-(Float4 a, Float4 b) { return {_mm_sub_ps(a.v, b.v)}; }
@@ -91,6 +103,7 @@ struct Float4 {
 struct Float4 {
   std::array<float, 4> v;
   static Float4 load(const float* p) { return {{p[0], p[1], p[2], p[3]}}; }
+  static Float4 load3(const glm::vec3& v) { return {{v.x, v.y, v.z, 0.0f}}; }
   static Float4 splat(float x) { return {{x, x, x, x}}; }
   template <typename Op>
   static Float4 each(Float4 a, Float4 b, Op op) {
@@ -169,8 +182,7 @@ struct Bins {
   void add(const PrimRef* refs, uint32_t begin, uint32_t end, const BinMap& map) {
     const Float4 lo = Float4::load(&map.lo.x), scale = Float4::load(&map.scale.x), half = Float4::splat(0.5f);
     for (uint32_t i = begin; i < end; ++i) {
-      // Lane 3 of each load is the next member (box.max.x, index): read, never used.
-      const Float4 box_min = Float4::load(&refs[i].box.min.x), box_max = Float4::load(&refs[i].box.max.x);
+      const Float4 box_min = Float4::load3(refs[i].box.min), box_max = Float4::load3(refs[i].box.max);
       const Float4 centroid = half * (box_min + box_max);
       const std::array<int32_t, 4> bin = ((centroid - lo) * scale).bins();
       for (size_t a = 0; a < 3; ++a) {
@@ -369,11 +381,11 @@ bool split(PrimRef* refs, const Range& range, uint32_t depth, Range& left, Range
 // parent before children and left before right.
 class SubtreeBuilder {
  public:
-  explicit SubtreeBuilder(PrimRef* refs) : refs_(refs) {}
+  SubtreeBuilder(PrimRef* refs, const std::atomic<bool>* stop) : refs_(refs), stop_(stop) {}
 
   // Returns the subtree's link: a leaf, or 0 for nodes()[0].
   uint32_t build(const Range& range, uint32_t depth) {
-    throw_if_interrupted();  // one relaxed load a node: a large build stops within milliseconds
+    check_stop(stop_);  // two relaxed loads a node: a large build stops within milliseconds
     // The GPU's traversal stack is sized for kMaxDepth levels (VKRAY_TRAVERSAL_STACK): deeper would
     // lose nodes silently there.
     VKRAY_CHECK(depth < kMaxDepth, "the BVH grew deeper than the GPU's traversal stack holds");
@@ -394,6 +406,7 @@ class SubtreeBuilder {
 
  private:
   PrimRef* refs_;
+  const std::atomic<bool>* stop_;
   std::vector<BvhNode> nodes_;
   uint32_t depth_ = 0;
 };
@@ -405,7 +418,7 @@ class SubtreeBuilder {
 // have built, node for node, whatever the number of threads.
 class ParallelBuilder {
  public:
-  explicit ParallelBuilder(PrimRef* refs) : refs_(refs) {}
+  ParallelBuilder(PrimRef* refs, const std::atomic<bool>* stop) : refs_(refs), stop_(stop) {}
 
   Bvh build(const Range& all) {
     Bvh bvh;
@@ -453,14 +466,14 @@ class ParallelBuilder {
     Part p;
     p.box = range.box;
     if (range.count() < kTaskSize) {
-      SubtreeBuilder subtree(refs_);
+      SubtreeBuilder subtree(refs_, stop_);
       p.link = subtree.build(range, depth);
       p.nodes = std::move(subtree.nodes());
       p.depth = subtree.depth();
       p.node_count = uint32_t(p.nodes.size());
       return p;
     }
-    throw_if_interrupted();
+    check_stop(stop_);
     VKRAY_CHECK(depth < kMaxDepth, "the BVH grew deeper than the GPU's traversal stack holds");
     Range left, right;
     // kTaskSize > kMaxLeafSize: a range this large always splits.
@@ -490,11 +503,12 @@ class ParallelBuilder {
   }
 
   PrimRef* refs_;
+  const std::atomic<bool>* stop_;
 };
 
 }  // namespace
 
-Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads) {
+Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads, const std::atomic<bool>* stop) {
   if (boxes.size() > kMaxScenePrimitives)
     throw LimitError("too many primitives for the BVH: " + std::to_string(boxes.size()) + " (at most " +
                      std::to_string(kMaxScenePrimitives) + ")");
@@ -523,10 +537,12 @@ Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads) {
     };
     const auto build = [&] {
       for_each_block([&](uint32_t begin, uint32_t end) {
-        for (uint32_t i = begin; i < end; ++i) refs[i] = {boxes[i], i};
+        // + 0.0f turns -0 into +0: SSE's min and max pick between zeros of either sign by operand
+        // order, so without it a node box's zero could take either sign, whatever the thread count.
+        for (uint32_t i = begin; i < end; ++i) refs[i] = {{boxes[i].min + 0.0f, boxes[i].max + 0.0f}, i};
       });
       bound(refs.data(), all);
-      bvh = ParallelBuilder(refs.data()).build(all);
+      bvh = ParallelBuilder(refs.data(), stop).build(all);
       bvh.order.resize(count);
       for_each_block([&](uint32_t begin, uint32_t end) {
         for (uint32_t i = begin; i < end; ++i) bvh.order[i] = refs[i].index;

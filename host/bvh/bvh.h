@@ -3,6 +3,7 @@
 // path reads a 4-wide, quantized copy of it (packing/scene_packing.h).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -57,8 +58,9 @@ struct Bvh {
 
 // Builds over primitives given by their bounding boxes, on `threads` threads (0: one per hardware
 // thread). The tree is the same for any number of threads. Throws LimitError beyond
-// kMaxScenePrimitives.
-Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads = 0);
+// kMaxScenePrimitives, and Cancelled on an interrupt request (base/interrupt.h) or once `stop` is
+// set, within milliseconds.
+Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads = 0, const std::atomic<bool>* stop = nullptr);
 
 // The tree's SAH cost: the expected cost of a ray through it, in primitive tests (a traversal step
 // costs as much as one), by surface area: every inner node weighted by its area, every leaf by its
