@@ -50,7 +50,7 @@ int run_render(const RenderArgs& args) {
   } else {
     log(describe(*loaded.scene, image));
     // The BVH is built while the device opens and the shaders compile, which need one thread.
-    std::future<Bvh> bvh = build_bvh_in_background(loaded.scene);
+    BackgroundBvh bvh(loaded.scene);
     Session session(session_options(args.device));
     log("device " + session.device_description() + (args.device.validate ? ", validation on" : ""));
     double compile_seconds = session.compile_shaders().seconds, upload_seconds = 0;

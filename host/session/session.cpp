@@ -97,12 +97,24 @@ const Scene& DeviceScene::scene() const { return scene_->scene(); }
 double DeviceScene::upload_seconds() const { return scene_->upload_seconds(); }
 double DeviceScene::bvh_seconds() const { return scene_->bvh_seconds(); }
 
-std::future<Bvh> build_bvh_in_background(std::shared_ptr<const Scene> scene) {
-  return std::async(std::launch::async, [scene = std::move(scene)] { return build_bvh(primitive_boxes(*scene)); });
+BackgroundBvh::BackgroundBvh(std::shared_ptr<const Scene> scene) : stop_(std::make_shared<std::atomic<bool>>(false)) {
+  build_ = std::async(std::launch::async,
+                      [scene = std::move(scene), stop = stop_] { return build_bvh(primitive_boxes(*scene), 0, stop.get()); });
 }
+
+BackgroundBvh::~BackgroundBvh() {
+  stop_->store(true, std::memory_order_relaxed);
+  if (build_.valid()) build_.wait();  // milliseconds: the build checks the flag at every node
+}
+
+Bvh BackgroundBvh::get() { return build_.get(); }
 
 DeviceScene Session::upload(std::shared_ptr<const Scene> scene, const Bvh* bvh) {
   device();
+  // A tree built for another scene would send the packing past the primitives' ends.
+  if (bvh && bvh->order.size() != scene->triangles.size() + scene->spheres.size())
+    throw UsageError("a BVH over " + std::to_string(bvh->order.size()) + " primitives for a scene of " +
+                     std::to_string(scene->triangles.size() + scene->spheres.size()));
   // An upload may go through the queue, behind a tile that timed out and still runs: refuse at
   // once rather than wait behind it.
   if (renderer_->busy(std::chrono::milliseconds(0)))

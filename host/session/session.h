@@ -4,6 +4,7 @@
 // validation log, checks the log after every step, and keeps the timeout policy (gpu/renderer.h).
 #pragma once
 
+#include <atomic>
 #include <filesystem>
 #include <future>
 #include <memory>
@@ -11,11 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "bvh/bvh.h"
 #include "gpu/device_info.h"
 #include "session/options.h"
 
 namespace vkray {
-struct Bvh;
 namespace gpu {
 class Context;
 class GpuScene;
@@ -120,9 +121,22 @@ bool device_work_left_running();
 using gpu::DeviceInfo;
 using gpu::list_devices;
 
-// Builds the scene's BVH on other threads and returns at once, so that a face can open the device
-// and compile the shaders meanwhile and then hand the tree to Session::upload(). Errors (LimitError,
-// Cancelled) come out of the future's get().
-std::future<Bvh> build_bvh_in_background(std::shared_ptr<const Scene> scene);
+// A scene's BVH built on other threads while a face opens the device and compiles the shaders, then
+// handed to Session::upload(). Left unfetched (an error elsewhere), it stops the build and waits
+// only the milliseconds that takes, so that the error is reported at once.
+class BackgroundBvh {
+ public:
+  explicit BackgroundBvh(std::shared_ptr<const Scene> scene);
+  ~BackgroundBvh();
+  BackgroundBvh(const BackgroundBvh&) = delete;
+  BackgroundBvh& operator=(const BackgroundBvh&) = delete;
+
+  // Waits for the tree. Throws what the build threw (LimitError, Cancelled).
+  Bvh get();
+
+ private:
+  std::shared_ptr<std::atomic<bool>> stop_;  // shared with the building thread, which may outlive a moved-from future
+  std::future<Bvh> build_;
+};
 
 }  // namespace vkray
