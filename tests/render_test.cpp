@@ -7,6 +7,8 @@
 #include <numbers>
 #include <string>
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
@@ -146,6 +148,37 @@ TEST_F(RenderTest, TilesCoverTheImageExactly) {
   const Image tiled = render(scene, {100, 76, 2}, options);
   ASSERT_EQ(whole.pixels.size(), tiled.pixels.size());
   for (size_t i = 0; i < whole.pixels.size(); ++i) ASSERT_EQ(whole.pixels[i], tiled.pixels[i]) << "pixel " << i;
+}
+
+// Submissions sized by time (gpu/tiling.h): at 256 spp the first one is 64x64 pixels' worth (the
+// cost model), a band of 32 rows of this 128x96 image, and the sizer takes the rest in bands of its
+// choosing, through both output slots. Whatever it chose, the image is the one traced in one square.
+TEST_F(RenderTest, SubmissionsSizedByTimeGiveTheImageOfOneSubmission) {
+  const auto scene = std::make_shared<const Scene>(load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json"));
+  const DeviceScene on_device = session().upload(scene);
+  RenderOptions options;
+  options.width = 128;
+  options.height = 96;
+  options.samples_per_pixel = 256;
+  options.inline_scene = InlineScene::never;
+  std::vector<uint32_t> progress;
+  options.progress = [&](const char* unit, uint32_t done, uint32_t total) {
+    EXPECT_STREQ(unit, "pixels");
+    EXPECT_EQ(total, 128u * 96u);
+    progress.push_back(done);
+  };
+  const RenderResult sized = session().render(on_device, options);
+  EXPECT_GE(sized.stats.tiles, 2u);
+  ASSERT_EQ(progress.size(), sized.stats.tiles);
+  EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
+  EXPECT_EQ(progress.back(), 128u * 96u);
+  options.progress = nullptr;
+  options.tile_side = 128;  // one square: the whole image
+  const RenderResult one = session().render(on_device, options);
+  EXPECT_EQ(one.stats.tiles, 1u);
+  EXPECT_EQ(sized.stats.rays, one.stats.rays);
+  ASSERT_EQ(sized.image.pixels.size(), one.image.pixels.size());
+  for (size_t i = 0; i < one.image.pixels.size(); ++i) ASSERT_EQ(sized.image.pixels[i], one.image.pixels[i]) << "pixel " << i;
 }
 
 // ---- A small scene compiled into the shader (InlineScene) --------------------------------------------

@@ -1,6 +1,7 @@
 #include "gpu/renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 
@@ -113,11 +114,13 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   uint32_t side = request.tile_side;
   const auto square_pixels = [&] { return uint64_t(std::min(side, image.width)) * std::min(side, image.height); };
   while (fixed_tiles && side > kGranule && square_pixels() > slot_limit) side -= kGranule;
+  // The least a slot must hold: the square asked for, or the smallest piece a submission may be.
+  const uint64_t needed = fixed_tiles ? square_pixels() : std::min<uint64_t>(image_pixels, kGranule * kGranule);
+  if (needed > slot_limit)
+    throw DeviceError("a render tile does not fit " + ctx_->device_name() + ": " + std::to_string(kSlots * needed * sizeof(glm::vec4)) +
+                      " bytes of output, maxStorageBufferRange is " + std::to_string(ctx_->limits().maxStorageBufferRange));
   const uint64_t slot_pixels =
-      fixed_tiles ? square_pixels() : std::min({kMostSlotPixels, slot_limit, std::max<uint64_t>(image_pixels, kGranule * kGranule)});
-  if (slot_pixels > slot_limit || slot_pixels < std::min<uint64_t>(image_pixels, kGranule * kGranule))
-    throw DeviceError("a render tile does not fit " + ctx_->device_name() + ": " + std::to_string(kSlots * kGranule * kGranule * sizeof(glm::vec4)) +
-                      " bytes of output at least, maxStorageBufferRange is " + std::to_string(ctx_->limits().maxStorageBufferRange));
+      fixed_tiles ? needed : std::min({kMostSlotPixels, slot_limit, std::max<uint64_t>(image_pixels, kGranule * kGranule)});
   const vk::DeviceSize output_bytes = kSlots * slot_pixels * sizeof(glm::vec4);
   Image result(image.width, image.height);  // the host's copy, filled tile by tile
   auto frame = std::make_unique<Frame>();
@@ -149,16 +152,19 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   // The first submission is the size the cost model gives (a bounded number of ray-primitive
   // tests); the sizer takes over from the time it took.
   const uint64_t first = uint64_t(first_tile_side(frame->scene->scene(), image)) * first_tile_side(frame->scene->scene(), image);
-  SubmissionSizer sizer(first, std::max<uint64_t>(kGranule * kGranule, first / 64), slot_pixels, kSubmissionSeconds);
+  // A tenth of --tile-timeout at most, so that growing 8x from a cheap submission stays within it.
+  const double target_seconds = std::min(kSubmissionSeconds, 0.1 * std::chrono::duration<double>(request.tile_timeout).count());
+  SubmissionSizer sizer(first, std::max<uint64_t>(kGranule * kGranule, first / 64), slot_pixels, target_seconds);
   struct Submitted {
     TileRect rect;
     Clock::time_point at;
   };
-  std::vector<Submitted> submitted;
+  std::array<Submitted, kSlots> slots;  // submission i is in slots[i % kSlots] until finished
+  uint32_t submitted = 0;
   Clock::time_point last_finished = start;
   uint64_t pixels_done = 0;
   const auto tile_constants = [&](uint32_t index) {
-    const TileRect& rect = submitted[index].rect;
+    const TileRect& rect = slots[index % kSlots].rect;
     TileConstants tile{};
     tile.x0 = rect.x0;
     tile.y0 = rect.y0;
@@ -169,8 +175,8 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     return tile;
   };
   const auto submit = [&] {
-    const uint32_t index = uint32_t(submitted.size());
-    submitted.push_back({fixed_tiles ? cursor.next_square(side) : cursor.next(sizer.next()), Clock::now()});
+    const uint32_t index = submitted++;
+    slots[index % kSlots] = {fixed_tiles ? cursor.next_square(side) : cursor.next(sizer.next()), Clock::now()};
     TileConstants tile = tile_constants(index);
     const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
     const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
@@ -207,8 +213,10 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     ctx_->wait(fence, request.tile_timeout, "a render tile");
     const auto read_start = Clock::now();
     // The device ran it from when it was submitted or, queued behind the one before, from when
-    // that one finished.
-    sizer.finished(submitted[index].rect.pixels(), seconds_between(std::max(submitted[index].at, last_finished), read_start));
+    // that one finished. The first one's time also holds the driver's compile (lavapipe compiles
+    // at the first dispatch): not a rate to go by.
+    const Submitted& done = slots[index % kSlots];
+    if (index > 0) sizer.finished(done.rect.pixels(), seconds_between(std::max(done.at, last_finished), read_start));
     last_finished = read_start;
     std::erase(frame->in_flight, *fence);
     device.resetFences(*fence);
@@ -221,13 +229,13 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
         result.at(tile.x0 + x, tile.y0 + y) = glm::vec3(texel);
         stats.rays += std::bit_cast<uint32_t>(texel.w);
       }
-    pixels_done += submitted[index].rect.pixels();
+    pixels_done += done.rect.pixels();
     readback_seconds += seconds_since(read_start);
     if (request.progress) request.progress(uint32_t(pixels_done), uint32_t(image_pixels));
   };
   try {
     submit();
-    for (uint32_t finished = 0; finished < submitted.size(); ++finished) {
+    for (uint32_t finished = 0; finished < submitted; ++finished) {
       if (!cursor.done()) submit();  // queued behind the one waited for below: the device never idles
       finish(finished);
       if (!cursor.done() && interrupt_requested()) throw Cancelled();
@@ -242,7 +250,7 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   // read back its own part of it.
   stats.trace_seconds = seconds_since(start);
   stats.readback_seconds = readback_seconds;
-  stats.tiles = uint32_t(submitted.size());
+  stats.tiles = submitted;
   if (stats_out) *stats_out = stats;
   return result;
 }
