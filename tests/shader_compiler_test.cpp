@@ -1,5 +1,6 @@
 // Run-time shader compilation: includes, and errors that point at the right file and line.
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -7,6 +8,8 @@
 #include <map>
 #include <optional>
 #include <string>
+
+#include <sys/stat.h>
 
 #include <gtest/gtest.h>
 
@@ -143,25 +146,37 @@ void expect_same(const gpu::CompiledShader& a, const gpu::CompiledShader& b) {
   }
 }
 
-TEST(ShaderCacheTest, ASecondCompileIsReadBackAsItWasStored) {
+// The inode of a file: a cache hit keeps the entry (refreshing its time), a compile writes a new one
+// and renames it into place.
+ino_t inode(const std::filesystem::path& file) {
+  struct stat st {};
+  EXPECT_EQ(stat(file.c_str(), &st), 0) << file;
+  return st.st_ino;
+}
+
+TEST(ShaderCacheTest, ASecondCompileIsReadBackAndADamagedEntryIsNot) {
   TempDir cache;
   ShaderCopy shaders;
   const auto entry = shaders.path() / "trace.comp";
   const gpu::CompiledShader compiled = gpu::compile_compute_shader(entry, {shaders.path()});
-  const gpu::CompiledShader first = gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
-  expect_same(first, compiled);
+  expect_same(gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()}), compiled);
   const auto entries = cache_entries(cache.path());
   ASSERT_EQ(entries.size(), 1u);
-  // The stored SPIR-V's last word changed: what comes back is the entry, not a new compile.
-  std::fstream file(entries[0], std::ios::in | std::ios::out | std::ios::binary);
-  file.seekp(-1, std::ios::end);
-  file.put(char(0x5a));
-  file.close();
-  const gpu::CompiledShader second = gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
-  ASSERT_EQ(second.spirv.size(), compiled.spirv.size());
-  EXPECT_NE(second.spirv.back(), compiled.spirv.back());
-  EXPECT_TRUE(std::equal(compiled.spirv.begin(), compiled.spirv.end() - 1, second.spirv.begin()));
-  EXPECT_EQ(second.sources, compiled.sources);
+  const ino_t stored = inode(entries[0]);
+  const auto old_time = std::filesystem::file_time_type::clock::now() - std::chrono::hours(1);
+  std::filesystem::last_write_time(entries[0], old_time);
+  expect_same(gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()}), compiled);
+  EXPECT_EQ(inode(entries[0]), stored) << "compiled again instead of read back";
+  EXPECT_GT(std::filesystem::last_write_time(entries[0]), old_time) << "a hit refreshes the entry's time";
+  // One byte of the stored SPIR-V changed: the entry is refused and the shader compiled again,
+  // never handed to the driver.
+  {
+    std::fstream file(entries[0], std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(-1, std::ios::end);
+    file.put(char(0x5a));
+  }
+  expect_same(gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()}), compiled);
+  EXPECT_NE(inode(entries[0]), stored);
 }
 
 TEST(ShaderCacheTest, AnEditedIncludeOrANewFileIsCompiledAgain) {
@@ -178,6 +193,19 @@ TEST(ShaderCacheTest, AnEditedIncludeOrANewFileIsCompiledAgain) {
   std::ofstream(shaders.path() / "shared" / "unused.h") << "// nothing\n";
   gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
   EXPECT_EQ(cache_entries(cache.path()).size(), 3u);
+}
+
+TEST(ShaderCacheTest, ACacheKeptAmongTheShadersStillHits) {
+  ShaderCopy shaders;
+  const auto cache = shaders.path() / "cache";  // its own entries must not change the key
+  const auto entry = shaders.path() / "trace.comp";
+  gpu::compile_compute_shader_cached(cache, entry, {shaders.path()});
+  const auto entries = cache_entries(cache);
+  ASSERT_EQ(entries.size(), 1u);
+  const ino_t stored = inode(entries[0]);
+  gpu::compile_compute_shader_cached(cache, entry, {shaders.path()});
+  EXPECT_EQ(cache_entries(cache).size(), 1u);
+  EXPECT_EQ(inode(entries[0]), stored);
 }
 
 TEST(ShaderCacheTest, ACorruptOrUnwritableCacheOnlyMeansCompiling) {

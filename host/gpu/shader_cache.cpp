@@ -60,7 +60,7 @@ std::optional<uint64_t> content_hash(const fs::path& file) {
 
 // Everything but the included files' own contents that decides the compile's result, or none when
 // that cannot be told (then nothing is cached).
-std::optional<uint64_t> cache_key(const fs::path& entry, const std::vector<fs::path>& include_dirs,
+std::optional<uint64_t> cache_key(const fs::path& cache_dir, const fs::path& entry, const std::vector<fs::path>& include_dirs,
                                   const std::vector<GeneratedInclude>& generated) {
   Hasher h;
   std::error_code error;
@@ -77,13 +77,21 @@ std::optional<uint64_t> cache_key(const fs::path& entry, const std::vector<fs::p
   for (const GeneratedInclude& g : generated) h.text(g.name).text(g.text);
   // Every file where an #include could find something: a file that appears there may shadow one
   // that was included from further along the search.
-  std::vector<fs::path> dirs = include_dirs;
+  std::vector<fs::path> dirs;
+  for (const fs::path& dir : include_dirs) dirs.push_back(dir.lexically_normal());
   dirs.push_back(entry.lexically_normal().parent_path());
+  std::sort(dirs.begin(), dirs.end());
+  dirs.erase(std::unique(dirs.begin(), dirs.end()), dirs.end());
+  const fs::path cache = fs::weakly_canonical(cache_dir, error);
   for (const fs::path& dir : dirs) {
     h.text(dir.string());
     std::vector<fs::path> files;
     for (fs::recursive_directory_iterator it(dir.empty() ? fs::path(".") : dir, error), end; !error && it != end;
          it.increment(error)) {
+      if (it->is_directory(error) && fs::weakly_canonical(it->path(), error) == cache) {
+        it.disable_recursion_pending();  // a cache kept among the shaders: its own writes would change the key
+        continue;
+      }
       if (it->is_regular_file(error)) files.push_back(it->path());
       if (files.size() > kMostFiles) return std::nullopt;
     }
@@ -137,10 +145,9 @@ class Reader {
   size_t at_ = 0;
 };
 
+// The magic, the key, a hash of the rest (a damaged entry must never reach the driver), the rest.
 std::string serialize(uint64_t key, const CompiledShader& shader, const std::vector<uint64_t>& source_hashes) {
   Writer w;
-  w.bytes().append(kMagic, sizeof kMagic);
-  w.number(key);
   w.number(shader.sources.size());
   for (size_t i = 0; i < shader.sources.size(); ++i) {
     w.text(shader.sources[i].string());
@@ -155,16 +162,25 @@ std::string serialize(uint64_t key, const CompiledShader& shader, const std::vec
     w.text(b.name);
   }
   w.text(std::string_view(reinterpret_cast<const char*>(shader.spirv.data()), shader.spirv.size() * sizeof(uint32_t)));
-  return std::move(w.bytes());
+  Writer head;
+  head.bytes().append(kMagic, sizeof kMagic);
+  head.number(key);
+  head.number(Hasher().text(w.bytes()).value());
+  return head.bytes() + w.bytes();
 }
 
 // The entry's shader if it is whole, has `key` and every source it names is as it was.
 std::optional<CompiledShader> deserialize(std::string_view bytes, uint64_t key) {
   if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) return std::nullopt;
-  Reader r(bytes.substr(sizeof kMagic));
+  Reader head(bytes.substr(sizeof kMagic, 2 * sizeof(uint64_t)));
+  uint64_t stored_key = 0, checksum = 0;
+  if (!head.number(stored_key) || stored_key != key || !head.number(checksum)) return std::nullopt;
+  const std::string_view rest = bytes.substr(std::min(bytes.size(), sizeof kMagic + 2 * sizeof(uint64_t)));
+  if (Hasher().text(rest).value() != checksum) return std::nullopt;  // damaged
+  Reader r(rest);
   CompiledShader shader;
-  uint64_t stored_key = 0, count = 0;
-  if (!r.number(stored_key) || stored_key != key || !r.number(count) || count > kMostFiles) return std::nullopt;
+  uint64_t count = 0;
+  if (!r.number(count) || count > kMostFiles) return std::nullopt;
   for (uint64_t i = 0; i < count; ++i) {
     std::string path;
     uint64_t hash = 0;
@@ -216,7 +232,7 @@ std::optional<fs::path> shader_cache_dir() {
 CompiledShader compile_compute_shader_cached(const std::optional<fs::path>& cache_dir, const fs::path& entry,
                                              const std::vector<fs::path>& include_dirs,
                                              const std::vector<GeneratedInclude>& generated) {
-  const std::optional<uint64_t> key = cache_dir ? cache_key(entry, include_dirs, generated) : std::nullopt;
+  const std::optional<uint64_t> key = cache_dir ? cache_key(*cache_dir, entry, include_dirs, generated) : std::nullopt;
   if (!key) return compile_compute_shader(entry, include_dirs, generated);
   char name[32];
   std::snprintf(name, sizeof name, "%016llx.spvc", static_cast<unsigned long long>(*key));
