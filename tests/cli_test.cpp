@@ -233,8 +233,10 @@ TEST(CliTest, ParityCatchesAPerturbedShader) {
 
 TEST(CliTest, BenchPrintsJsonForEachScene) {
   // A benchmark is not a test: this checks the command runs and reports, never how fast.
-  TempDir dir;
-  const Result run = vkray("bench --scenes cornell,teapot --width 32 --height 32 --repeat 1 --json", dir.path());
+  TempDir dir, temp;
+  // TMPDIR: where the write stage's PNG goes for a moment (checked below to be gone).
+  const Result run = run_vkray("bench --scenes cornell,teapot --width 32 --height 32 --repeat 1 --json", dir.path(),
+                               "export TMPDIR='" + temp.path().string() + "'");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto j = nlohmann::json::parse(run.out);
   ASSERT_EQ(j.size(), 2u);
@@ -254,7 +256,8 @@ TEST(CliTest, BenchPrintsJsonForEachScene) {
   // tree could be (at least one traversal step).
   EXPECT_GT(j[1].at("bvh_sah_cost").get<double>(), 1.0);
   EXPECT_LT(j[1].at("bvh_sah_cost").get<double>(), 100.0);
-  // The PNG of the write stage is not left behind.
+  // The PNG of the write stage is not left behind, nor anything else.
+  EXPECT_TRUE(std::filesystem::is_empty(temp.path()));
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 

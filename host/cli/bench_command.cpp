@@ -7,11 +7,10 @@
 #include <iostream>
 #include <optional>
 #include <thread>
-
-#include <unistd.h>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include "base/errors.h"
 #include "base/timing.h"
@@ -93,9 +92,13 @@ int run_bench(const BenchArgs& args) {
   const bool with_embree = false;
 #endif
 
-  // Where the write stage's PNG goes for a moment: the system's temporary folder, a name per process.
-  const std::filesystem::path png =
-      std::filesystem::temp_directory_path() / ("vkray-bench-" + std::to_string(::getpid()) + ".png");
+  // Where the write stage's PNG goes for a moment: the system's temporary folder ($TMPDIR), a name
+  // per process.
+  std::error_code no_temp;
+  const std::filesystem::path temp = std::filesystem::temp_directory_path(no_temp);
+  if (no_temp)
+    throw OutputError("no temporary folder for the write stage's PNG ($TMPDIR or /tmp): " + no_temp.message());
+  const std::filesystem::path png = temp / ("vkray-bench-" + std::to_string(::getpid()) + ".png");
   Session session(session_options(args.device));
   std::cerr << "vkray bench: device " << session.device_description() << "; CPU reference and "
             << (with_embree ? embree_name() : std::string("no Embree")) << " on " << threads << " threads; "
@@ -249,7 +252,8 @@ Command add_bench_command(CLI::App& app) {
   command->add_option("--width", args->width, "Image width")->check(CLI::Range(8u, kMaxImageSide));
   command->add_option("--height", args->height, "Image height")->check(CLI::Range(8u, kMaxImageSide));
   command->add_option("--repeat", args->repeat, "Rounds per scene; the median is reported")->check(CLI::Range(1, 100));
-  add_cpu_flags(*command, args->cpu, "Threads for the CPU reference and Embree (default: one per hardware thread)");
+  add_cpu_flags(*command, args->cpu,
+                "Threads for the CPU reference, Embree and both BVH builds (default: one per hardware thread)");
   add_device_flags(*command, args->device, /*validate=*/false);
   add_gpu_flags(*command, args->gpu);
   command->add_flag("!--no-cpu-reference", args->cpu_reference, "Leave the CPU reference out");
