@@ -211,7 +211,7 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
 
   Bvh built;
   if (options.use_bvh && !options.bvh) {
-    built = build_bvh(primitive_boxes(scene));
+    built = build_bvh(primitive_boxes(scene), options.threads);  // --threads holds for the build too
     result.bvh_seconds = built.build_seconds;
   }
   const Bvh* bvh = options.use_bvh ? (options.bvh ? options.bvh : &built) : nullptr;
