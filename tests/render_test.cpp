@@ -148,6 +148,11 @@ TEST_F(RenderTest, TilesCoverTheImageExactly) {
   const Image tiled = render(scene, {100, 76, 2}, options);
   ASSERT_EQ(whole.pixels.size(), tiled.pixels.size());
   for (size_t i = 0; i < whole.pixels.size(); ++i) ASSERT_EQ(whole.pixels[i], tiled.pixels[i]) << "pixel " << i;
+  // Tiles smaller than a workgroup: 5 x 3 of them, 4 pixels a side.
+  options.tile_side = 4;
+  const Image small_whole = render(scene, {20, 12, 1});
+  const Image small_tiled = render(scene, {20, 12, 1}, options);
+  EXPECT_EQ(small_whole.pixels, small_tiled.pixels);
 }
 
 // Submissions sized by time (gpu/tiling.h): at 256 spp the first one is 64x64 pixels' worth (the
