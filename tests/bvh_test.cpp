@@ -59,8 +59,13 @@ std::vector<Aabb> random_boxes(size_t n, unsigned seed) {
   std::uniform_real_distribution<float> pos(-100, 100), size(0, 2);
   std::vector<Aabb> boxes(n);
   for (auto& b : boxes) {
-    const glm::vec3 p(pos(rng), pos(rng), pos(rng));
-    b = {p, p + glm::vec3(size(rng), size(rng), size(rng))};
+    // One draw a statement: the order of a call's arguments is the compiler's choice (GCC goes
+    // right to left, clang left to right), and the boxes must not depend on it. This is GCC's order,
+    // in which the hash in TheTreeIsTheOneTheEarlierBuilderBuilt was taken.
+    const float pz = pos(rng), py = pos(rng), px = pos(rng);
+    const float sz = size(rng), sy = size(rng), sx = size(rng);
+    const glm::vec3 p(px, py, pz);
+    b = {p, p + glm::vec3(sx, sy, sz)};
   }
   return boxes;
 }
