@@ -133,7 +133,6 @@ struct BinMap {
       if (extent > 0.0f) scale[axis] = float(kBins) / extent;
     }
   }
-  int bin(const glm::vec3& centroid, int axis) const { return bin_of(centroid[axis], lo[axis], scale[axis]); }
 };
 
 // A bin's bounds, of the boxes and of the centroids, in Float4 lanes x, y, z. Set by the first

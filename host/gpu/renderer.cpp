@@ -28,6 +28,17 @@ double tests_per_sample(const Scene& scene) {
   return (8.0 + 4.0 * std::log2(primitives)) * (1.0 + double(scene.lights.size()));
 }
 
+// The first submission's pixels: a square (its side a multiple of the workgroup's, at most the
+// image's longer side rounded up) whose ray-primitive tests stay near kTestsPerTile whatever the
+// scene size and sample count.
+uint64_t first_submission_pixels(const Scene& scene, const ImageSettings& image) {
+  const double pixels = kTestsPerTile / (tests_per_sample(scene) * image.samples_per_pixel);
+  const uint32_t side = static_cast<uint32_t>(std::sqrt(pixels)) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
+  const uint32_t largest = (std::max(image.width, image.height) + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
+  const uint64_t clamped = std::clamp<uint32_t>(side, VKRAY_WORKGROUP_X, largest);
+  return clamped * clamped;
+}
+
 // The most samples of a pixel one dispatch traces. llvmpipe ends every loop of an invocation once
 // the invocation has made 65535 loop iterations in all (Mesa 22.3's loop limiter), without a word:
 // at 16 x 16 pixels of the Cornell box, 2048 spp in one dispatch gave an image 29% too dark (1024 did
@@ -149,9 +160,9 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   const vk::PipelineLayout layout = *frame->trace_pipeline->layout();
   const uint32_t samples_per_dispatch = samples_in_one_dispatch(frame->scene->scene());
   TileCursor cursor(image.width, image.height, kGranule);
-  // The first submission is the size the cost model gives (a bounded number of ray-primitive
-  // tests); the sizer takes over from the time it took.
-  const uint64_t first = uint64_t(first_tile_side(frame->scene->scene(), image)) * first_tile_side(frame->scene->scene(), image);
+  // The first submission is the size the cost model gives; the sizer takes over from the second's
+  // time on.
+  const uint64_t first = first_submission_pixels(frame->scene->scene(), image);
   // A tenth of --tile-timeout at most, so that growing 8x from a cheap submission stays within it.
   const double target_seconds = std::min(kSubmissionSeconds, 0.1 * std::chrono::duration<double>(request.tile_timeout).count());
   SubmissionSizer sizer(first, std::max<uint64_t>(kGranule * kGranule, first / 64), slot_pixels, target_seconds);
@@ -253,13 +264,6 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   stats.tiles = submitted;
   if (stats_out) *stats_out = stats;
   return result;
-}
-
-uint32_t first_tile_side(const Scene& scene, const ImageSettings& image) {
-  const double pixels = kTestsPerTile / (tests_per_sample(scene) * image.samples_per_pixel);
-  const uint32_t side = static_cast<uint32_t>(std::sqrt(pixels)) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
-  const uint32_t largest = (std::max(image.width, image.height) + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X * VKRAY_WORKGROUP_X;
-  return std::clamp<uint32_t>(side, VKRAY_WORKGROUP_X, largest);
 }
 
 }  // namespace vkray::gpu

@@ -64,8 +64,4 @@ class Renderer {
   std::vector<std::unique_ptr<Frame>> abandoned_;  // frames whose last tile timed out
 };
 
-// The side in pixels (a multiple of the workgroup size) of a square whose ray-primitive tests stay
-// near a fixed budget whatever the scene size and sample count: the first submission's size.
-uint32_t first_tile_side(const Scene& scene, const ImageSettings& image);
-
 }  // namespace vkray::gpu

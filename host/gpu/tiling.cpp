@@ -16,7 +16,6 @@ TileRect TileCursor::take(uint32_t band_rows, uint32_t piece_width) {
     x_ = 0;
     y_ += band_rows_;
   }
-  handed_out_ += rect.pixels();
   return rect;
 }
 

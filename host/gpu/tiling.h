@@ -27,15 +27,12 @@ class TileCursor {
   TileRect next(uint64_t pixels);
   // The next side x side square (cut short at the image's edges), in bands `side` rows high.
   TileRect next_square(uint32_t side);
-  // Pixels in the rectangles handed out so far.
-  uint64_t pixels_handed_out() const { return handed_out_; }
 
  private:
   TileRect take(uint32_t band_rows, uint32_t piece_width);
 
   uint32_t width_, height_, granule_;
   uint32_t x_ = 0, y_ = 0, band_rows_ = 0;
-  uint64_t handed_out_ = 0;
 };
 
 // The pixels of the next submission. Each finished submission gives a rate (pixels a second), and
