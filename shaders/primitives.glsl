@@ -15,9 +15,12 @@ float intersect_primitive(Ray ray, RayShear shear, vec4 a, vec4 b, vec4 c, float
 
 // ---- The surface at a hit -------------------------------------------------------------------------------
 struct Surface {
-  vec3 geometric_normal;  // unit, not yet oriented toward the ray
+  vec3 geometric_normal;  // unit, not yet oriented toward the ray: the side it faces emits
   vec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal
-  vec3 albedo;
+  vec3 albedo;            // or a mirror's reflectance
+  uint material_type;     // VKRAY_MATERIAL_*
+  vec3 emission;
+  float ior;
 };
 
 Surface hit_surface(Hit hit, vec3 position) {
@@ -25,9 +28,19 @@ Surface hit_surface(Hit hit, vec3 position) {
   vec4 a = texelFetch(primitives, base);
   uint flags = primitive_flags(a);
   Surface s;
-  s.albedo = texelFetch(materials, material_texel(flags)).rgb;
+  vec4 color = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_COLOR);
+  s.albedo = color.rgb;
+  s.material_type = floatBitsToUint(color.w);
+  s.emission = vec3(0.0);
+  s.ior = 1.0;
+  if (SCENE_HAS_EMITTERS || SCENE_HAS_SPECULAR) {
+    vec4 emission = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION);
+    s.emission = emission.rgb;
+    s.ior = emission.w;
+  }
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     s.geometric_normal = (position - a.xyz) / sphere_radius(texelFetch(primitives, base + 1));
+    if ((flags & VKRAY_PRIM_INWARD) != 0u) s.geometric_normal = -s.geometric_normal;
     s.shading_normal = s.geometric_normal;
     return s;
   }

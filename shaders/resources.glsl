@@ -13,6 +13,7 @@ layout(set = 0, binding = VKRAY_BINDING_NORMALS) uniform samplerBuffer normals;
 layout(set = 0, binding = VKRAY_BINDING_NODES) uniform usamplerBuffer nodes;
 layout(set = 0, binding = VKRAY_BINDING_MATERIALS) uniform samplerBuffer materials;
 layout(set = 0, binding = VKRAY_BINDING_LIGHTS) uniform samplerBuffer lights;
+layout(set = 0, binding = VKRAY_BINDING_EMITTERS) uniform samplerBuffer emitters;
 
 // The frame's constants as every function reads them: a private copy of the uniform block, made
 // by load_frame() before anything else in main. llvmpipe reads a uniform block lane by lane at
@@ -26,5 +27,8 @@ void load_frame() { frame = frame_block; }
 // no lane takes it.
 layout(constant_id = VKRAY_SPEC_SPHERES) const bool SCENE_HAS_SPHERES = true;
 layout(constant_id = VKRAY_SPEC_SHADOWS) const bool SHADOW_RAYS = true;
+layout(constant_id = VKRAY_SPEC_PATH) const bool PATH_TRACING = false;
+layout(constant_id = VKRAY_SPEC_EMITTERS) const bool SCENE_HAS_EMITTERS = false;
+layout(constant_id = VKRAY_SPEC_SPECULAR) const bool SCENE_HAS_SPECULAR = false;
 
 #endif

@@ -1,31 +1,49 @@
 // Direct Lambertian shading from point lights plus an ambient term, exactly the scene contract:
-//   L = albedo * (A + sum_lights V * I * (n . w) / (pi r^2))
+//   L = albedo * (A + sum_lights V * I * (n . w) / (pi r^2) + one area-light sample)
 // with n the normal facing the incoming ray (the interpolated vertex normal for smooth meshes, the
 // geometric normal otherwise), w the unit vector to the light, r its distance, and V = 0 when the
 // light is at most epsilon above the plane of n at x (n . (light - x) <= epsilon) or a shadow ray
-// finds anything closer than the light.
+// finds anything closer than the light. The path integrator (path.glsl) uses the same light terms.
 #ifndef VKRAY_SHADE_GLSL
 #define VKRAY_SHADE_GLSL
 
+#include "emitters.glsl"
 #include "primitives.glsl"
 #include "resources.glsl"
 #include "traversal.glsl"
+#include "warp.glsl"
 
-const float PI = 3.14159265358979;
+// One area-light sample as a point x sees it (n faces the incoming ray; shadow rays leave from
+// shadow_origin). Draws three numbers from the stream.
+struct AreaLightSample {
+  vec3 radiance;  // 0 when the point is behind x's side, faces away, or is hidden
+  float cos_x;    // at x, to the point
+  float pdf;      // per unit solid angle at x
+};
 
-// Returns the radiance leaving the hit point toward the ray's origin; adds the shadow rays it casts
-// to `rays`.
-vec3 shade(Ray ray, Hit hit, inout uint rays) {
-  vec3 x = ray_at(ray, hit.t);
-  Surface surface = hit_surface(hit, x);
-  // Both normals face the incoming ray, decided by the geometric one.
-  bool flip = dot(surface.geometric_normal, ray.dir) > 0.0;
-  vec3 n_geometric = flip ? -surface.geometric_normal : surface.geometric_normal;
-  vec3 n = flip ? -surface.shading_normal : surface.shading_normal;
+AreaLightSample sample_area_light_from(vec3 x, vec3 n, vec3 shadow_origin, inout uint stream, inout uint rays) {
+  LightPoint light = sample_area_light(stream);
+  vec3 to_light = light.position - x;
+  float r2 = dot(to_light, to_light);
+  vec3 w = to_light * inversesqrt(r2);
+  float cos_l = -dot(light.normal, w);
+  AreaLightSample s = AreaLightSample(vec3(0.0), dot(n, w), 0.0);
+  if (!(s.cos_x > 0.0 && cos_l > 0.0)) return s;
+  if (SHADOW_RAYS) {
+    vec3 shadow_dir = light.position - shadow_origin;
+    float shadow_dist = length(shadow_dir);
+    rays += 1u;
+    // Stop epsilon short of the light: the surface the point lies on is not in the way.
+    if (trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon)) return s;
+  }
+  s.radiance = light.radiance;
+  s.pdf = light.pdf_area * r2 / cos_l;
+  return s;
+}
 
-  // Shadow rays start a little off the surface, on the side the ray came from.
-  vec3 shadow_origin = x + frame.epsilon * n_geometric;
-  vec3 irradiance = frame.ambient.rgb;
+// Adds V I (n . w) / (pi r^2) for every point light to `irradiance` (n faces the incoming ray); adds
+// the shadow rays it casts to `rays`.
+void add_point_lights(vec3 x, vec3 n, vec3 shadow_origin, inout vec3 irradiance, inout uint rays) {
   // A do-while without `continue`, as the sample loop in trace.comp: a loop that tests first costs
   // a masked pass more, and so does one with a `continue` (the compiler moves the test to the top
   // of the next pass, for every lane).
@@ -48,6 +66,24 @@ vec3 shade(Ray ray, Hit hit, inout uint rays) {
     }
     if (lit) irradiance += texelFetch(lights, base + VKRAY_LIGHT_INTENSITY).rgb * (cos_theta / (PI * r2));
   } while (++i < frame.light_count);
+}
+
+// Returns the radiance a diffuse surface at x reflects toward the ray's origin; draws from the
+// stream for an area light, and adds the shadow rays it casts to `rays`.
+vec3 shade(Ray ray, vec3 x, Surface surface, inout uint stream, inout uint rays) {
+  // Both normals face the incoming ray, decided by the geometric one.
+  bool flip = dot(surface.geometric_normal, ray.dir) > 0.0;
+  vec3 n_geometric = flip ? -surface.geometric_normal : surface.geometric_normal;
+  vec3 n = flip ? -surface.shading_normal : surface.shading_normal;
+
+  // Shadow rays start a little off the surface, on the side the ray came from.
+  vec3 shadow_origin = x + frame.epsilon * n_geometric;
+  vec3 irradiance = frame.ambient.rgb;
+  add_point_lights(x, n, shadow_origin, irradiance, rays);
+  if (SCENE_HAS_EMITTERS) {  // its light over pi, as the contract's other terms: Le cos_x / (pi pdf)
+    AreaLightSample light = sample_area_light_from(x, n, shadow_origin, stream, rays);
+    if (light.pdf > 0.0) irradiance += light.radiance * (light.cos_x / (PI * light.pdf));
+  }
   return surface.albedo * irradiance;
 }
 

@@ -1,5 +1,5 @@
-// vkray's tracer: one invocation per pixel of the current tile. For each sample: primary ray ->
-// closest hit -> shade (with shadow rays) -> average -> store linear radiance.
+// vkray's tracer: one invocation per pixel of the current tile. For each sample: camera ray ->
+// radiance (the direct model, direct.glsl, or paths, path.glsl) -> average -> store linear radiance.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -7,7 +7,8 @@
 #include "shared/types.h"
 #include "camera.glsl"
 #include "resources.glsl"
-#include "shade.glsl"
+#include "direct.glsl"
+#include "path.glsl"
 #include "traversal.glsl"
 
 layout(local_size_x = VKRAY_WORKGROUP_X, local_size_y = VKRAY_WORKGROUP_Y, local_size_z = 1) in;
@@ -38,14 +39,28 @@ void main() {
   }
   uint k = tile.sample_begin;
   do {
-    vec2 xi = sample_offset(pixel_index, k, frame.samples_per_pixel, frame.strata_x, frame.inv_strata_x,
-                            frame.inv_strata_y);
+    // Paths jitter even a single sample: at the pixel centre it would sharpen the image.
+    vec2 xi = PATH_TRACING ? jittered_offset(pixel_index, frame.seed_key, k, frame.strata_x, frame.inv_strata_x, frame.inv_strata_y)
+                           : sample_offset(pixel_index, frame.seed_key, k, frame.samples_per_pixel, frame.strata_x,
+                                           frame.inv_strata_x, frame.inv_strata_y);
     Ray ray = camera_ray(pixel, xi);
+    uint stream = sample_stream(pixel_index, frame.seed_key, k);
+    if (frame.aperture_radius > 0.0) ray = lens_ray(ray, vec2(next_random(stream), next_random(stream)));
     rays += 1u;
-    Hit hit = trace_closest(ray, frame.epsilon, FAR);
-    sum += (hit.prim == NO_HIT) ? frame.background.rgb : shade(ray, hit, rays);
+    sum += PATH_TRACING ? path_radiance(ray, stream, rays) : direct_radiance(ray, stream, rays);
+    // llvmpipe ends every loop of an invocation early, without a word, once the loops inside its
+    // outermost one have made 65535 iterations in all (host/gpu/renderer.cpp). A loop that must run
+    // twice tells: past the limit it runs once. (Its count comes from the host, so that the compiler
+    // cannot unroll it.) If the limit ends this loop instead, k falls short of sample_end.
+    uint probe = 0u;
+    do {
+      ++probe;
+    } while (probe < tile.probe_iterations);
+    if (probe < tile.probe_iterations) rays |= VKRAY_LOOPS_CUT_SHORT;
   } while (++k < tile.sample_end);
-  // Alpha carries the number of rays traced for this pixel (bit pattern of a uint) for the rays/s figure.
+  if (k < tile.sample_end) rays |= VKRAY_LOOPS_CUT_SHORT;
+  // Alpha carries the number of rays traced for this pixel (bit pattern of a uint) for the rays/s
+  // figure, and VKRAY_LOOPS_CUT_SHORT.
   vec3 stored = tile.sample_end == frame.samples_per_pixel ? sum * frame.inv_samples_per_pixel : sum;
   radiance[index] = vec4(stored, uintBitsToFloat(rays));
 }

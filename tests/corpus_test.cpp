@@ -99,7 +99,7 @@ TEST_P(OddInputTest, RendersWithAWarningWhereOneHelps) {
 INSTANTIATE_TEST_SUITE_P(OddInputs, OddInputTest,
                          ::testing::Values(OddCase{"unknown-keys.json", "/camera/fov_typo: unknown key"},
                                            OddCase{"empty-scene.json", ""},
-                                           OddCase{"no-lights.json", "no lights and no ambient"}),
+                                           OddCase{"no-lights.json", "no lights, no emission and no ambient"}),
                          [](const ::testing::TestParamInfo<OddCase>& param) {
                            return std::string(param.param.file == "unknown-keys.json" ? "UnknownKeys"
                                               : param.param.file == "empty-scene.json" ? "EmptyScene"

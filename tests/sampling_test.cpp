@@ -1,5 +1,7 @@
 // The sample pattern shared by both renderers (shaders/shared/sampling.h compiled as C++).
+#include <cmath>
 #include <set>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -20,7 +22,7 @@ TEST(SamplingTest, StrataCoverTheSampleCount) {
 }
 
 TEST(SamplingTest, OneSampleIsThePixelCentre) {
-  EXPECT_EQ(gpu::sample_offset(12345, 0, 1, 1, 1.0f, 1.0f), glm::vec2(0.5f, 0.5f));
+  EXPECT_EQ(gpu::sample_offset(12345, 0, 0, 1, 1, 1.0f, 1.0f), glm::vec2(0.5f, 0.5f));
 }
 
 TEST(SamplingTest, EachSampleLiesInItsOwnStratum) {
@@ -29,7 +31,7 @@ TEST(SamplingTest, EachSampleLiesInItsOwnStratum) {
     for (uint32_t pixel : {0u, 1u, 999u, 4000000u}) {
       std::set<std::pair<int, int>> cells;
       for (uint32_t k = 0; k < spp; ++k) {
-        const glm::vec2 xi = gpu::sample_offset(pixel, k, spp, s.x, s.inv_x, s.inv_y);
+        const glm::vec2 xi = gpu::sample_offset(pixel, 0, k, spp, s.x, s.inv_x, s.inv_y);
         ASSERT_GE(xi.x, 0.0f);
         ASSERT_LT(xi.x, 1.0f);
         ASSERT_GE(xi.y, 0.0f);
@@ -45,8 +47,53 @@ TEST(SamplingTest, EachSampleLiesInItsOwnStratum) {
 
 TEST(SamplingTest, PatternDependsOnlyOnPixelAndSample) {
   const SampleStrata s = sample_strata(16);
-  EXPECT_EQ(gpu::sample_offset(77, 5, 16, s.x, s.inv_x, s.inv_y), gpu::sample_offset(77, 5, 16, s.x, s.inv_x, s.inv_y));
-  EXPECT_NE(gpu::sample_offset(77, 5, 16, s.x, s.inv_x, s.inv_y), gpu::sample_offset(78, 5, 16, s.x, s.inv_x, s.inv_y));
+  EXPECT_EQ(gpu::sample_offset(77, 0, 5, 16, s.x, s.inv_x, s.inv_y), gpu::sample_offset(77, 0, 5, 16, s.x, s.inv_x, s.inv_y));
+  EXPECT_NE(gpu::sample_offset(77, 0, 5, 16, s.x, s.inv_x, s.inv_y), gpu::sample_offset(78, 0, 5, 16, s.x, s.inv_x, s.inv_y));
+}
+
+TEST(SamplingTest, SeedZeroKeepsThePatternAndOtherSeedsChangeIt) {
+  const SampleStrata s = sample_strata(16);
+  EXPECT_EQ(gpu::seed_key(0), 0u);
+  EXPECT_NE(gpu::seed_key(1), gpu::seed_key(2));
+  // Another seed moves the sample within the same stratum.
+  const glm::vec2 a = gpu::sample_offset(77, gpu::seed_key(0), 5, 16, s.x, s.inv_x, s.inv_y);
+  const glm::vec2 b = gpu::sample_offset(77, gpu::seed_key(7), 5, 16, s.x, s.inv_x, s.inv_y);
+  EXPECT_NE(a, b);
+  EXPECT_EQ(uint32_t(a.x * 4), uint32_t(b.x * 4));
+  EXPECT_EQ(uint32_t(a.y * 4), uint32_t(b.y * 4));
+  EXPECT_NE(gpu::sample_stream(77, gpu::seed_key(0), 5), gpu::sample_stream(77, gpu::seed_key(7), 5));
+  EXPECT_NE(gpu::sample_stream(77, 0, 5), gpu::sample_stream(77, 0, 6));
+}
+
+TEST(SamplingTest, AJitteredSingleSampleIsNotTheCentre) {
+  const glm::vec2 xi = gpu::jittered_offset(12345, 0, 0, 1, 1.0f, 1.0f);
+  EXPECT_NE(xi, glm::vec2(0.5f, 0.5f));
+  EXPECT_GE(std::min(xi.x, xi.y), 0.0f);
+  EXPECT_LT(std::max(xi.x, xi.y), 1.0f);
+}
+
+TEST(SamplingTest, StreamsAreUniformAndIndependentOfEachOther) {
+  // 64 streams of 4096 numbers: each in [0, 1), means near 1/2, and neighbouring draws uncorrelated.
+  double sum = 0, sum_product = 0;
+  size_t n = 0;
+  std::vector<uint32_t> bins(16, 0);
+  for (uint32_t k = 0; k < 64; ++k) {
+    uint32_t state = gpu::sample_stream(1000 + k, 0, k);
+    float previous = gpu::next_random(state);
+    for (int i = 0; i < 4096; ++i, ++n) {
+      const float u = gpu::next_random(state);
+      ASSERT_GE(u, 0.0f);
+      ASSERT_LT(u, 1.0f);
+      sum += u;
+      sum_product += double(u) * previous;
+      ++bins[size_t(u * 16)];
+      previous = u;
+    }
+  }
+  // Standard errors: of the mean 0.29 / sqrt(n) = 0.0011; of E[u u'] about 0.0009.
+  EXPECT_NEAR(sum / double(n), 0.5, 0.006);
+  EXPECT_NEAR(sum_product / double(n), 0.25, 0.005);
+  for (const uint32_t b : bins) EXPECT_NEAR(double(b), double(n) / 16, 6 * std::sqrt(double(n) / 16));
 }
 
 TEST(SamplingTest, PcgHashKnownValues) {

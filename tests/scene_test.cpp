@@ -112,7 +112,87 @@ TEST(SceneTest, NoLightsAndNoAmbientWarns) {
     "objects": [{"type": "triangles", "material": "m", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [[0, 1, 2]]}])"),
                                   "t.json");
   ASSERT_EQ(scene.warnings.size(), 1u);
-  EXPECT_NE(scene.warnings[0].find("no lights and no ambient"), std::string::npos) << scene.warnings[0];
+  EXPECT_NE(scene.warnings[0].find("no lights, no emission and no ambient"), std::string::npos) << scene.warnings[0];
+}
+
+// ---- The rendering equation's keys (integrator, materials, emission, the lens, the seed) ----------------
+TEST(SceneTest, IntegratorMaterialsLensAndSeed) {
+  const Scene scene = parse_scene(R"({
+    "camera": {"position": [0, 0, 0], "look_at": [0, 0, 4], "focal_length": 1, "aperture_radius": 0.1},
+    "integrator": {"type": "path", "max_depth": 6, "rr_depth": 3},
+    "seed": 4000000000,
+    "materials": {"d": {"albedo": [0.5, 0.5, 0.5], "emission": [1, 2, 3]}, "m": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]},
+                  "g": {"type": "glass", "ior": 1.33}, "g2": {"type": "glass"}},
+    "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1, "material": "g", "flip_normals": true},
+                {"type": "triangles", "material": "d", "positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [[0, 1, 2]], "flip_normals": true}]})",
+                                  "t.json");
+  EXPECT_EQ(scene.integrator.type, Integrator::Type::path);
+  EXPECT_EQ(scene.integrator.max_depth, 6);
+  EXPECT_EQ(scene.integrator.rr_depth, 3u);
+  EXPECT_EQ(scene.image.seed, 4000000000u);
+  EXPECT_FLOAT_EQ(scene.camera.aperture_radius, 0.1f);
+  EXPECT_FLOAT_EQ(scene.camera.focus_distance, 4.0f);  // the distance to look_at
+  ASSERT_EQ(scene.materials.size(), 4u);
+  const auto material = [&](const char* name) {
+    for (const Material& m : scene.materials)
+      if (m.name == name) return m;
+    ADD_FAILURE() << "no material " << name;
+    return Material{};
+  };
+  EXPECT_EQ(material("d").type, MaterialType::diffuse);
+  EXPECT_EQ(material("d").emission, glm::vec3(1, 2, 3));
+  EXPECT_TRUE(material("d").emissive());
+  EXPECT_FALSE(material("m").emissive());
+  EXPECT_EQ(material("m").type, MaterialType::mirror);
+  EXPECT_EQ(material("m").albedo, glm::vec3(0.9f, 0.8f, 0.7f));
+  EXPECT_EQ(material("g").type, MaterialType::glass);
+  EXPECT_FLOAT_EQ(material("g").ior, 1.33f);
+  EXPECT_FLOAT_EQ(material("g2").ior, 1.5f);  // the default: Mitsuba's dielectric
+  EXPECT_TRUE(scene.spheres[0].inward);
+  EXPECT_EQ(scene.triangles[0].v[1], glm::vec3(0, 1, 0));  // wound the other way
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+}
+
+TEST(SceneTest, TheDirectModelIsTheDefault) {
+  const Scene scene = parse_scene(with_camera(""), "t.json");
+  EXPECT_EQ(scene.integrator.type, Integrator::Type::direct);
+  EXPECT_EQ(scene.integrator.max_depth, -1);
+  EXPECT_EQ(scene.integrator.rr_depth, 5u);
+  EXPECT_EQ(scene.image.seed, 0u);
+  EXPECT_EQ(scene.camera.aperture_radius, 0.0f);
+}
+
+TEST(SceneTest, AmbientIsIgnoredUnderPathsWithAWarning) {
+  const Scene scene = parse_scene(with_camera(R"("integrator": {"type": "path"}, "ambient": [0.1, 0.1, 0.1], "background": [1, 1, 1])"), "t.json");
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  EXPECT_NE(scene.warnings[0].find("/ambient"), std::string::npos) << scene.warnings[0];
+  EXPECT_NE(scene.warnings[0].find("ignored"), std::string::npos) << scene.warnings[0];
+}
+
+TEST(SceneTest, IntegratorMaterialAndLensErrors) {
+  expect_error(with_camera(R"("integrator": {"type": "bidirectional"})"), "/integrator/type", "unknown integrator");
+  expect_error(with_camera(R"("integrator": {})"), "/integrator", "missing required key \"type\"");
+  expect_error(with_camera(R"("integrator": {"type": "path", "max_depth": 0})"), "/integrator/max_depth", "renders nothing");
+  expect_error(with_camera(R"("integrator": {"type": "path", "max_depth": -2})"), "/integrator/max_depth", "from -1 to 1024");
+  expect_error(with_camera(R"("integrator": {"type": "path", "max_depth": 2.5})"), "/integrator/max_depth", "integer");
+  expect_error(with_camera(R"("integrator": {"type": "path", "rr_depth": 0})"), "/integrator/rr_depth", "from 1 to 1024");
+  expect_error(with_camera(R"("seed": -1)"), "/seed", "from 0 to 4294967295");
+  expect_error(with_camera(R"("seed": 4294967296)"), "/seed", "from 0 to 4294967295");
+  expect_error(with_camera(R"("materials": {"g": {"type": "glass", "ior": 0}})"), "/materials/g/ior", "> 0");
+  expect_error(with_camera(R"("materials": {"g": {"type": "glass", "ior": -1.5}})"), "/materials/g/ior", "> 0");
+  expect_error(with_camera(R"("materials": {"g": {"type": "glass", "ior": 1e300}})"), "/materials/g/ior", "out of range");
+  expect_error(with_camera(R"("materials": {"m": {"type": "mirror"}})"), "/materials/m", "\"reflectance\"");
+  expect_error(with_camera(R"("materials": {"m": {"type": "metal", "albedo": [1, 1, 1]}})"), "/materials/m/type", "unknown material type");
+  expect_error(with_camera(R"("materials": {"e": {"albedo": [1, 1, 1], "emission": [1, -1, 1]}})"), "/materials/e/emission", "non-negative");
+  expect_error(with_camera(R"("materials": {"e": {"albedo": [1, 1, 1], "emission": [1, 1e39, 1]}})"), "/materials/e/emission", "out of range");
+  expect_error(with_camera(R"("objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "x", "flip_normals": 1}])"),
+               "/objects/0/flip_normals", "true or false");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "focal_length": 1, "aperture_radius": 0.1}})", "/camera",
+               "\"focus_distance\"");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "focal_length": 1, "aperture_radius": -0.1}})",
+               "/camera/aperture_radius", "from 0 to 1e9");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "focal_length": 1, "focus_distance": 0}})",
+               "/camera/focus_distance", "> 0");
 }
 
 TEST(SceneTest, CommentsAreAllowed) {

@@ -62,7 +62,8 @@ TEST(ShaderCompilerTest, CompilesTheTracerAndListsEveryIncludedFile) {
   const char* files[] = {"trace.comp",     "shared/glsl_cpp.h", "shared/types.h",  "shared/scene_layout.h",
                          "shared/sampling.h", "camera.glsl",     "ray.glsl",        "resources.glsl",
                          "shade.glsl",      "primitives.glsl",   "intersect.glsl",  "traversal.glsl",
-                         "inline_scene.glsl"};
+                         "inline_scene.glsl", "warp.glsl",        "emitters.glsl",   "bsdf.glsl",
+                         "direct.glsl",     "path.glsl"};
   for (const char* file : files) {
     const auto expected = (dir / file).lexically_normal();
     EXPECT_NE(std::find(shader.sources.begin(), shader.sources.end(), expected), shader.sources.end()) << file;
@@ -88,6 +89,7 @@ TEST(ShaderCompilerTest, ReflectsTheBindingsTheShaderDeclares) {
       {VKRAY_BINDING_MATERIALS, {"materials", D::eUniformTexelBuffer}},
       {VKRAY_BINDING_LIGHTS, {"lights", D::eUniformTexelBuffer}},
       {VKRAY_BINDING_OUTPUT, {"Output", D::eStorageBuffer}},
+      {VKRAY_BINDING_EMITTERS, {"emitters", D::eUniformTexelBuffer}},
   };
   EXPECT_EQ(found, expected);
 }
@@ -184,7 +186,7 @@ TEST(ShaderCacheTest, AnEditedIncludeOrANewFileIsCompiledAgain) {
   ShaderCopy shaders;
   const auto entry = shaders.path() / "trace.comp";
   const gpu::CompiledShader before = gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
-  shaders.edit("shade.glsl", "const float PI = 3.14159265358979;", "const float PI = 3.0;");
+  shaders.edit("warp.glsl", "const float PI = 3.14159265358979;", "const float PI = 3.0;");
   const gpu::CompiledShader after = gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()});
   EXPECT_NE(after.spirv, before.spirv);
   expect_same(after, gpu::compile_compute_shader(entry, {shaders.path()}));
@@ -230,7 +232,7 @@ TEST(ShaderCacheTest, ACorruptOrUnwritableCacheOnlyMeansCompiling) {
 TEST(ShaderCacheTest, ErrorsAreNeverCached) {
   TempDir cache;
   ShaderCopy shaders;
-  shaders.edit("shade.glsl", "const float PI", "const floot PI");
+  shaders.edit("warp.glsl", "const float PI", "const floot PI");
   const auto entry = shaders.path() / "trace.comp";
   for (int i = 0; i < 2; ++i) EXPECT_THROW(gpu::compile_compute_shader_cached(cache.path(), entry, {shaders.path()}), ShaderError);
   EXPECT_TRUE(cache_entries(cache.path()).empty());

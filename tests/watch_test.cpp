@@ -130,7 +130,7 @@ TEST_F(WatchTest, AnIncludeCycleIsAnErrorOfItsReloadAndWatchingGoesOn) {
   save_in_place("shaders/loop.glsl", "// includes itself, with no include guard\n#include \"loop.glsl\"\n");
   start();
   expect_shader_error_survived("shaders/shade.glsl", read_text(dir_ / "shaders/shade.glsl") + "#include \"loop.glsl\"\n",
-                               "shaders/loop.glsl:2: error: #include cycle: trace.comp -> shade.glsl -> loop.glsl -> loop.glsl");
+                               "shaders/loop.glsl:2: error: #include cycle: trace.comp -> direct.glsl -> shade.glsl -> loop.glsl -> loop.glsl");
 }
 
 TEST_F(WatchTest, SceneEditsRerenderAndABrokenSceneIsSurvived) {

@@ -30,6 +30,13 @@
 namespace vkray::cli {
 namespace {
 
+// The tolerance of renders that make random decisions (session/parity.h).
+ParityTolerance stochastic_tolerance() {
+  ParityTolerance t;
+  t.stochastic = true;
+  return t;
+}
+
 struct CheckArgs {
   DeviceFlags device;
   GpuFlags gpu;
@@ -115,7 +122,8 @@ class CheckReport {
     std::printf("device %u: %s (%s), driver %s, Vulkan %s\n", device_.index, device_.name.c_str(), device_.type.c_str(),
                 device_.driver.c_str(), device_.api_version.c_str());
     if (!loader_environment().empty()) std::printf("loader: %s\n", loader_environment().c_str());
-    std::printf("%s; tolerance: %s\n", describe_plan(options_).c_str(), describe_tolerance({}).c_str());
+    std::printf("%s; tolerance: %s; for scenes with random decisions (paths, area lights, glass, a lens): %s\n",
+                describe_plan(options_).c_str(), describe_tolerance({}).c_str(), describe_tolerance(stochastic_tolerance()).c_str());
     std::fflush(stdout);
   }
 
@@ -176,7 +184,8 @@ class CheckReport {
             {"vulkan_version", device_.api_version},
             {"loader_environment", loader_environment()},
             {"image", std::to_string(options_.width) + "x" + std::to_string(options_.height)},
-            {"tolerance", describe_tolerance({})}};
+            {"tolerance", describe_tolerance({})},
+            {"tolerance_stochastic", describe_tolerance(stochastic_tolerance())}};
   }
 
   // JUnit's names of a case (or, before any case ran, of the device).

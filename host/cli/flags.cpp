@@ -25,6 +25,9 @@ void add_scene_flags(CLI::App& command, SceneFlags& flags) {
   command.add_option("--width", flags.width, "Image width in pixels (overrides the scene)")->check(CLI::Range(1u, kMaxImageSide));
   command.add_option("--height", flags.height, "Image height in pixels (overrides the scene)")->check(CLI::Range(1u, kMaxImageSide));
   command.add_option("--spp", flags.spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1u, kMaxSamplesPerPixel));
+  command.add_option("--seed", flags.seed,
+                     "Seed of the sample streams (overrides the scene's; default 0): renders with different seeds are "
+                     "independent and can be averaged");
 }
 
 void add_device_flags(CLI::App& command, DeviceFlags& flags, bool validate) {
@@ -94,6 +97,7 @@ RenderOptions render_options(const SceneFlags* scene, const GpuFlags* gpu, const
     options.width = scene->width;
     options.height = scene->height;
     options.samples_per_pixel = scene->spp;
+    options.seed = scene->seed;
   }
   if (gpu) {
     options.tile_timeout = std::chrono::milliseconds(gpu->tile_timeout_ms);

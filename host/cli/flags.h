@@ -13,10 +13,10 @@
 
 namespace vkray::cli {
 
-// SCENE [--width W] [--height H] [--spp N]
+// SCENE [--width W] [--height H] [--spp N] [--seed S]
 struct SceneFlags {
   std::filesystem::path scene;  // empty: the default scene
-  std::optional<uint32_t> width, height, spp;
+  std::optional<uint32_t> width, height, spp, seed;
 };
 // [--device D] [--validate] [--shader-dir DIR]
 struct DeviceFlags {

@@ -2,8 +2,10 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <string>
 
 #include "base/errors.h"
 #include "image/image.h"
@@ -55,8 +57,17 @@ void Progress::update(uint32_t done, uint32_t total, const char* unit) {
   if (!tty_ && elapsed - last_ < 1000.0 && done != total) return;
   last_ = elapsed;
   shown_ = true;
+  // The time left at the rate so far (the first units hold start-up costs, so it errs long).
+  std::string left;
+  if (done > 0 && done < total) {
+    const double seconds = elapsed / 1000.0 * double(total - done) / double(done);
+    char text[64];
+    if (seconds < 90) std::snprintf(text, sizeof text, ", about %.0f s left", std::max(1.0, seconds));
+    else std::snprintf(text, sizeof text, ", about %.0f min left", seconds / 60.0);
+    left = text;
+  }
   std::cerr << (tty_ ? "\r" : "") << "vkray: " << what_ << " " << (100 * uint64_t(done) / total) << "% (" << done << "/"
-            << total << " " << unit << ")" << (tty_ ? "" : "\n") << std::flush;
+            << total << " " << unit << left << ")" << (tty_ ? "\033[K" : "\n") << std::flush;
 }
 
 }  // namespace vkray::cli

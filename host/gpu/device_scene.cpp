@@ -43,7 +43,7 @@ TexelBuffer make_texel_buffer(const Context& ctx, const std::vector<Texel>& texe
 // Refuses, before allocating anything, a scene whose buffers cannot fit the device's memory.
 void check_memory(const Context& ctx, const PackedScene& packed) {
   uint64_t texels = packed.nodes.size();
-  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.materials, &packed.lights})
+  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.materials, &packed.lights, &packed.emitters})
     texels = checked_add(texels, buffer->size(), "scene buffers");
   const uint64_t bytes = checked_mul(texels, sizeof(glm::vec4), "scene buffers");
   const auto memory = ctx.physical_device().getMemoryProperties();
@@ -59,7 +59,7 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
 }  // namespace
 
 struct GpuScene::Buffers {
-  TexelBuffer primitives, normals, nodes, materials, lights;
+  TexelBuffer primitives, normals, nodes, materials, lights, emitters;
 };
 
 GpuScene::GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* prebuilt)
@@ -77,7 +77,9 @@ GpuScene::GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Sce
                                                make_texel_buffer(*ctx_, packed.normals, "normal"),
                                                make_texel_buffer(*ctx_, packed.nodes, "BVH node"),
                                                make_texel_buffer(*ctx_, packed.materials, "material"),
-                                               make_texel_buffer(*ctx_, packed.lights, "light")});
+                                               make_texel_buffer(*ctx_, packed.lights, "light"),
+                                               make_texel_buffer(*ctx_, packed.emitters, "area light")});
+  emitters_ = packed.emitter_frame;
   // A BVH built beforehand (perhaps while the shaders compiled) still counts: the upload stage
   // reports the build's own time.
   upload_seconds_ = seconds_since(start) + (prebuilt ? prebuilt->build_seconds : 0.0);
@@ -90,7 +92,8 @@ void GpuScene::bind(DescriptorWriter& writer) const {
       .texel_buffer(VKRAY_BINDING_NORMALS, *buffers_->normals.view)
       .texel_buffer(VKRAY_BINDING_NODES, *buffers_->nodes.view)
       .texel_buffer(VKRAY_BINDING_MATERIALS, *buffers_->materials.view)
-      .texel_buffer(VKRAY_BINDING_LIGHTS, *buffers_->lights.view);
+      .texel_buffer(VKRAY_BINDING_LIGHTS, *buffers_->lights.view)
+      .texel_buffer(VKRAY_BINDING_EMITTERS, *buffers_->emitters.view);
 }
 
 }  // namespace vkray::gpu

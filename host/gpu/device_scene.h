@@ -9,6 +9,7 @@
 
 #include "gpu/context.h"
 #include "gpu/descriptors.h"
+#include "packing/scene_packing.h"
 #include "scene/scene.h"
 
 namespace vkray {
@@ -32,6 +33,7 @@ class GpuScene {
   uint32_t primitive_count() const { return primitive_count_; }
   double bvh_seconds() const { return bvh_seconds_; }
   double upload_seconds() const { return upload_seconds_; }  // BVH build included, prebuilt or not
+  const EmitterFrame& emitters() const { return emitters_; }
 
   // Adds the scene's buffers at their bindings (shared/types.h).
   void bind(DescriptorWriter& writer) const;
@@ -43,6 +45,7 @@ class GpuScene {
   std::unique_ptr<Buffers> buffers_;
   uint32_t primitive_count_ = 0;
   std::string inline_scene_;
+  EmitterFrame emitters_;
   double bvh_seconds_ = 0, upload_seconds_ = 0;
 };
 

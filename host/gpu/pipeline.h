@@ -27,6 +27,9 @@ namespace vkray::gpu {
 struct ShaderVariant {
   bool spheres = true;       // VKRAY_SPEC_SPHERES
   bool shadows = true;       // VKRAY_SPEC_SHADOWS
+  bool path = false;         // VKRAY_SPEC_PATH
+  bool emitters = false;     // VKRAY_SPEC_EMITTERS
+  bool specular = false;     // VKRAY_SPEC_SPECULAR
   std::string inline_scene;  // served as shaders/inline_scene.glsl; empty: that file, and the BVH is walked
 
   auto operator<=>(const ShaderVariant&) const = default;

@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <optional>
 
 #include "base/checked.h"
 #include "base/errors.h"
@@ -22,10 +23,16 @@ namespace {
 constexpr double kTestsPerTile = double(1 << 26);
 
 // Ray-primitive tests one sample costs, roughly: a ray visits on the order of log2(N) nodes and a few
-// leaves, for the camera ray and each light's shadow ray.
+// leaves, for the camera ray and each light's shadow ray; a path does so at each of its vertices, with
+// a shadow ray to an area light and one to the background besides.
 double tests_per_sample(const Scene& scene) {
   const double primitives = double(scene.triangles.size() + scene.spheres.size()) + 1.0;
-  return (8.0 + 4.0 * std::log2(primitives)) * (1.0 + double(scene.lights.size()));
+  const double per_ray = 8.0 + 4.0 * std::log2(primitives);
+  if (scene.integrator.type == Integrator::Type::direct) return per_ray * (1.0 + double(scene.lights.size()));
+  // Past rr_depth a path goes on with probability at most 0.95: 20 more vertices on average at most.
+  const double rr_vertices = double(scene.integrator.rr_depth) + 20.0;
+  const double vertices = scene.integrator.max_depth > 0 ? std::min(double(scene.integrator.max_depth), rr_vertices) : rr_vertices;
+  return per_ray * (3.0 + double(scene.lights.size())) * vertices;
 }
 
 // The first submission's pixels: a square (its side a multiple of the workgroup's, at most the
@@ -44,6 +51,8 @@ uint64_t first_submission_pixels(const Scene& scene, const ImageSettings& image)
 // at 16 x 16 pixels of the Cornell box, 2048 spp in one dispatch gave an image 29% too dark (1024 did
 // not). A sample's loop iterations (the sample loop, the light loop, each ray's BVH walk) are bounded
 // by its estimated tests; a dispatch gets at most half the limit of them, and at most 64 samples.
+// That is an estimate (a path's length is random): the shader says when its loops were cut short
+// (VKRAY_LOOPS_CUT_SHORT), and the tile is traced again with half as many samples a dispatch.
 uint32_t samples_in_one_dispatch(const Scene& scene) {
   return uint32_t(std::clamp(32768.0 / tests_per_sample(scene), 1.0, 64.0));
 }
@@ -137,7 +146,7 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   auto frame = std::make_unique<Frame>();
   frame->trace_pipeline = std::move(trace_pipeline);
   frame->scene = std::move(scene);
-  const FrameUniforms uniforms = pack_frame(frame->scene->scene(), frame->scene->primitive_count(), image);
+  const FrameUniforms uniforms = pack_frame(frame->scene->scene(), frame->scene->primitive_count(), frame->scene->emitters(), image);
   frame->uniforms = upload_buffer(*ctx_, &uniforms, sizeof(uniforms), vk::BufferUsageFlagBits::eUniformBuffer);
   using M = vk::MemoryPropertyFlagBits;
   frame->output = create_buffer(*ctx_, output_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
@@ -158,7 +167,7 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   frame->in_flight.reserve(kSlots);  // so that recording a submission cannot fail after it is made
   abandoned_.reserve(abandoned_.size() + 1);  // nor keeping the frame when the device still runs it
   const vk::PipelineLayout layout = *frame->trace_pipeline->layout();
-  const uint32_t samples_per_dispatch = samples_in_one_dispatch(frame->scene->scene());
+  uint32_t samples_per_dispatch = samples_in_one_dispatch(frame->scene->scene());
   TileCursor cursor(image.width, image.height, kGranule);
   // The first submission is the size the cost model gives; the sizer takes over from the second's
   // time on.
@@ -183,11 +192,14 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     tile.height = rect.height;
     tile.row_stride = row_stride((tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y);
     tile.output_offset = uint32_t((index % kSlots) * slot_pixels);
+    tile.probe_iterations = 2;
     return tile;
   };
-  const auto submit = [&] {
+  // Submits the next tile, or `again` (one whose loops were cut short).
+  const auto submit = [&](std::optional<TileRect> again = std::nullopt) {
     const uint32_t index = submitted++;
-    slots[index % kSlots] = {fixed_tiles ? cursor.next_square(side) : cursor.next(sizer.next()), Clock::now()};
+    const TileRect rect = again ? *again : fixed_tiles ? cursor.next_square(side) : cursor.next(sizer.next());
+    slots[index % kSlots] = {rect, Clock::now()};
     TileConstants tile = tile_constants(index);
     const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
     const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
@@ -218,7 +230,8 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     ctx_->queue().submit(vk::SubmitInfo({}, {}, raw), fence);
     frame->in_flight.push_back(fence);  // reserved: cannot throw
   };
-  // Waits for a submission, gives the sizer its time, copies its pixels into the image and frees its slot.
+  // Waits for a submission, gives the sizer its time, copies its pixels into the image and frees its
+  // slot. Returns false, having copied nothing, when the driver cut its loops short.
   const auto finish = [&](uint32_t index) {
     const vk::raii::Fence& fence = frame->fences[index % kSlots];
     ctx_->wait(fence, request.tile_timeout, "a render tile");
@@ -235,6 +248,12 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     const TileConstants tile = tile_constants(index);
     const auto* texels = static_cast<const glm::vec4*>(frame->output.mapped) + tile.output_offset;
     for (uint32_t y = 0; y < tile.height; ++y)
+      for (uint32_t x = 0; x < tile.width; ++x)
+        if (std::bit_cast<uint32_t>(texels[size_t(y) * tile.width + x].w) & VKRAY_LOOPS_CUT_SHORT) {
+          readback_seconds += seconds_since(read_start);
+          return false;
+        }
+    for (uint32_t y = 0; y < tile.height; ++y)
       for (uint32_t x = 0; x < tile.width; ++x) {
         const glm::vec4& texel = texels[size_t(y) * tile.width + x];
         result.at(tile.x0 + x, tile.y0 + y) = glm::vec3(texel);
@@ -243,12 +262,19 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     pixels_done += done.rect.pixels();
     readback_seconds += seconds_since(read_start);
     if (request.progress) request.progress(uint32_t(pixels_done), uint32_t(image_pixels));
+    return true;
   };
   try {
     submit();
     for (uint32_t finished = 0; finished < submitted; ++finished) {
       if (!cursor.done()) submit();  // queued behind the one waited for below: the device never idles
-      finish(finished);
+      if (!finish(finished)) {
+        if (samples_per_dispatch == 1)
+          throw DeviceError(ctx_->device_name() + " cut the shader's loops short within one sample of a pixel (llvmpipe "
+                            "stops an invocation after 65535 loop iterations): the scene needs more than that");
+        samples_per_dispatch = std::max(1u, samples_per_dispatch / 2);  // the rest of the render too
+        submit(slots[finished % kSlots].rect);
+      }
       if (!cursor.done() && interrupt_requested()) throw Cancelled();
     }
   } catch (...) {

@@ -37,9 +37,13 @@ ParityMetrics compare_images(const Image& gpu, const Image& reference, const std
   m.width = reference.width;
   m.height = reference.height;
   double sum_abs = 0, sum_sq = 0;
+  glm::dvec3 sum_gpu(0.0), sum_reference(0.0);
   for (uint32_t y = 0; y < m.height; ++y) {
     for (uint32_t x = 0; x < m.width; ++x) {
       const glm::vec3 a = gpu.at(x, y), b = reference.at(x, y);
+      m.non_finite += !(std::isfinite(a.r) && std::isfinite(a.g) && std::isfinite(a.b));
+      sum_gpu += glm::dvec3(a);
+      sum_reference += glm::dvec3(b);
       for (int c = 0; c < 3; ++c) {
         const double d = std::abs(double(a[c]) - double(b[c]));
         if (d > m.max_abs || std::isnan(d)) {
@@ -65,7 +69,16 @@ ParityMetrics compare_images(const Image& gpu, const Image& reference, const std
   m.mean_abs = sum_abs / samples;
   const double mse = sum_sq / samples;
   m.psnr = mse > 0 ? 10.0 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
-  m.pass = m.edge_share_over_1() <= tolerance.max_edge_share_over_1 && m.interior_over_1 <= tolerance.max_interior_over_1;
+  for (int c = 0; c < 3; ++c) {
+    const double difference = std::abs(sum_gpu[c] - sum_reference[c]);
+    if (difference > 0) m.mean_relative = std::max(m.mean_relative, difference / std::abs(sum_reference[c]));
+  }
+  if (m.non_finite > 0) m.mean_relative = std::numeric_limits<double>::infinity();
+  if (tolerance.stochastic)
+    m.pass = m.share_over_1() <= tolerance.max_share_over_1 && m.mean_relative <= tolerance.max_mean_relative;
+  else
+    m.pass = m.edge_share_over_1() <= tolerance.max_edge_share_over_1 && m.interior_over_1 <= tolerance.max_interior_over_1;
+  m.pass = m.pass && m.non_finite == 0;
   return m;
 }
 
@@ -96,6 +109,13 @@ Image absolute_difference(const Image& a, const Image& b) {
 
 std::string describe_tolerance(const ParityTolerance& t) {
   char text[200];
+  if (t.stochastic) {
+    std::snprintf(text, sizeof text,
+                  "8-bit sRGB values differ by more than 1 on at most %.3g%% of the pixels, and the image means by at "
+                  "most %.3g%% in each channel",
+                  t.max_share_over_1 * 100.0, t.max_mean_relative * 100.0);
+    return text;
+  }
   std::snprintf(text, sizeof text,
                 "8-bit sRGB values differ by more than 1 on at most %llu pixels away from silhouette and shadow edges, "
                 "and on at most %.3g%% of the pixels on them",
@@ -104,14 +124,16 @@ std::string describe_tolerance(const ParityTolerance& t) {
 }
 
 std::string describe_metrics(const ParityMetrics& m) {
-  char text[300];
+  char text[400];
   std::snprintf(text, sizeof text,
                 "> 1 step on %llu pixels away from edges and on %llu of %llu edge pixels; > 2 steps on %llu; "
-                "max |diff| %.3g at (%u, %u)",
+                "max |diff| %.3g at (%u, %u); means differ by %.2g%%",
                 static_cast<unsigned long long>(m.interior_over_1), static_cast<unsigned long long>(m.edge_over_1),
                 static_cast<unsigned long long>(m.edge_pixels), static_cast<unsigned long long>(m.over_2), m.max_abs,
-                m.worst_x, m.worst_y);
-  return text;
+                m.worst_x, m.worst_y, m.mean_relative * 100.0);
+  std::string result = text;
+  if (m.non_finite > 0) result += "; " + std::to_string(m.non_finite) + " GPU pixels are NaN or infinite";
+  return result;
 }
 
 }  // namespace vkray

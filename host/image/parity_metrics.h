@@ -15,9 +15,18 @@ namespace vkray {
 // Everywhere else the two agree to float precision, i.e. to within one step of 8-bit sRGB. The
 // edge allowance is a share of edge pixels, not of all pixels: edges are lines, so their share of
 // an image shrinks as its resolution grows, while the share of edge pixels that flip does not.
+//
+// A render that makes random decisions (paths, area lights, glass, a lens: `stochastic`) traces the
+// same samples on both, since the two draw the same random numbers; a sample whose path the two
+// renderers' rounding sends different ways differs by a whole sample's worth of noise, wherever it
+// is. Its tolerance is a share of all pixels instead, and the mean of the image, which such
+// samples hardly move but any error in the light transport does (README, "Parity for noisy images").
 struct ParityTolerance {
+  bool stochastic = false;
   double max_edge_share_over_1 = 0.02;  // edge pixels whose 8-bit sRGB values differ by more than 1
   uint64_t max_interior_over_1 = 0;     // such pixels away from edges
+  double max_share_over_1 = 0.005;      // stochastic: pixels differing by more than 1 step, of all
+  double max_mean_relative = 0.002;     // stochastic: |mean GPU - mean CPU| / mean CPU, per channel
 };
 
 struct ParityMetrics {
@@ -31,6 +40,8 @@ struct ParityMetrics {
   uint64_t interior_over_1 = 0, interior_over_2 = 0;  // over_1 / over_2 away from edges
   uint64_t edge_over_1 = 0;                            // over_1 on edges
   uint32_t worst_x = 0, worst_y = 0;                   // where max_abs is
+  double mean_relative = 0;  // largest over channels of |mean GPU - mean CPU| / mean CPU (0 when both are 0)
+  uint64_t non_finite = 0;   // GPU pixels with a NaN or infinite channel: never within any tolerance
   bool pass = false;
 
   uint64_t pixels() const { return uint64_t(width) * height; }

@@ -11,6 +11,8 @@
 #include "base/check.h"
 #include "base/interrupt.h"
 #include "scene/camera.h"
+#include "scene/emitters.h"
+#include "shared/sampling.h"
 
 namespace vkray::gpu {
 namespace {
@@ -161,7 +163,7 @@ uint32_t row_stride(uint32_t rows) {
   return stride;
 }
 
-FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const ImageSettings& image) {
+FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const EmitterFrame& emitters, const ImageSettings& image) {
   FrameUniforms f{};
   const CameraBasis cam = camera_basis(scene.camera, image.height);
   f.origin = glm::vec4(cam.origin, 0.0f);
@@ -182,6 +184,13 @@ FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const Ima
   f.inv_strata_y = strata.inv_y;
   f.inv_samples_per_pixel = 1.0f / static_cast<float>(image.samples_per_pixel);
   f.epsilon = scene.epsilon();
+  f.seed_key = seed_key(image.seed);
+  f.aperture_radius = scene.camera.aperture_radius;
+  f.focus_distance = scene.camera.focus_distance;
+  f.max_depth = scene.integrator.max_depth;
+  f.rr_depth = scene.integrator.rr_depth;
+  f.emitter_count = emitters.count;
+  f.inv_emitter_weight = emitters.inv_weight;
   return f;
 }
 
@@ -203,7 +212,7 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
           for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
       } else {
         const Sphere& sphere = scene.spheres[p - triangle_count];
-        texels = sphere_texels(sphere.center, sphere.radius, sphere.material, p);
+        texels = sphere_texels(sphere.center, sphere.radius, sphere.material | (sphere.inward ? VKRAY_PRIM_INWARD : 0u), p);
       }
       glm::vec4* out = &packed.primitives[slot * VKRAY_TEXELS_PER_PRIMITIVE];
       out[0] = texels.a;
@@ -213,8 +222,20 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
   });
   packed.nodes = pack_nodes(bvh);
   packed.materials.resize(scene.materials.size() * VKRAY_TEXELS_PER_MATERIAL);
-  for (size_t i = 0; i < scene.materials.size(); ++i)
-    packed.materials[i * VKRAY_TEXELS_PER_MATERIAL] = glm::vec4(scene.materials[i].albedo, 0.0f);
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    packed.materials[i * VKRAY_TEXELS_PER_MATERIAL + VKRAY_MATERIAL_COLOR] = glm::vec4(m.albedo, uintBitsToFloat(uint32_t(m.type)));
+    packed.materials[i * VKRAY_TEXELS_PER_MATERIAL + VKRAY_MATERIAL_EMISSION] = glm::vec4(m.emission, m.ior);
+  }
+  // The area lights, their primitives as slots in the primitive buffer.
+  const EmitterTable table = build_emitter_table(scene);
+  if (!table.entries.empty()) {
+    std::vector<uint32_t> slot_of(bvh.order.size());
+    for (size_t slot = 0; slot < bvh.order.size(); ++slot) slot_of[bvh.order[slot]] = uint32_t(slot);
+    for (const EmitterTable::Entry& e : table.entries)
+      packed.emitters.push_back(glm::vec4(e.probability, uintBitsToFloat(e.alias), uintBitsToFloat(slot_of[e.primitive]), 0.0f));
+    packed.emitter_frame = {uint32_t(table.entries.size()), float(1.0 / table.total_weight)};
+  }
   packed.lights.resize(scene.lights.size() * VKRAY_TEXELS_PER_LIGHT);
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     packed.lights[i * VKRAY_TEXELS_PER_LIGHT + VKRAY_LIGHT_POSITION] = glm::vec4(scene.lights[i].position, 0.0f);

@@ -14,6 +14,12 @@
 
 namespace vkray::gpu {
 
+// What the frame uniforms say of the area lights (FrameUniforms::emitter_count, inv_emitter_weight).
+struct EmitterFrame {
+  uint32_t count = 0;
+  float inv_weight = 0.0f;
+};
+
 // The scene's buffers; the per-frame uniforms come from pack_frame().
 struct PackedScene {
   std::vector<glm::vec4> primitives;  // PrimitiveTexels (shared/scene_layout.h) each, in BVH leaf order
@@ -21,6 +27,8 @@ struct PackedScene {
   std::vector<glm::uvec4> nodes;      // VKRAY_TEXELS_PER_NODE texels each (pack_nodes)
   std::vector<glm::vec4> materials;   // VKRAY_TEXELS_PER_MATERIAL texels each
   std::vector<glm::vec4> lights;      // VKRAY_TEXELS_PER_LIGHT texels each
+  std::vector<glm::vec4> emitters;    // VKRAY_TEXELS_PER_EMITTER texels each (scene/emitters.h)
+  EmitterFrame emitter_frame;
 };
 
 PackedScene pack_scene(const Scene& scene, const Bvh& bvh);
@@ -35,7 +43,7 @@ Aabb unpack_child_box(const glm::uvec4* node, int c);
 
 // The per-frame uniforms (camera, image, counts). `image` is the resolution actually rendered (the
 // scene's, or the command line's).
-FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const ImageSettings& image);
+FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const EmitterFrame& emitters, const ImageSettings& image);
 
 // TileConstants::row_stride for a dispatch of `rows` workgroup rows: the integer nearest
 // rows / golden ratio that is coprime with rows (so r -> r * stride mod rows is a permutation, and

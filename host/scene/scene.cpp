@@ -28,6 +28,9 @@ using json = nlohmann::json;
 // direction (F * H, x, y) is normalized: F * H (at most 1.6e10) squared stays far inside a float.
 constexpr float kMaxFocalLength = 1e6f;
 
+// The largest index of refraction: past every real material (diamond is 2.4), so that a typo shows.
+constexpr float kMaxIor = 100.0f;
+
 
 // A JSON value together with its JSON-pointer path, so every message can say where it is.
 struct Value {
@@ -113,7 +116,12 @@ class SceneParser {
   // ---- sections ----------------------------------------------------------------------------------
   void parse_image(const Value& v);
   void parse_camera(const Value& v);
+  void parse_integrator(const Value& v);
   void parse_materials(const Value& v);
+  // Fails unless the JSON value is an integer from `min` to `max`.
+  int64_t integer(const Value& v, int64_t min, int64_t max) const;
+  // "flip_normals": true turns an object's normals around (for emission and glass).
+  bool flip_normals(const Value& v) const;
   void parse_light(const Value& v);
   void parse_object(const Value& v);
   glm::mat4 parse_transform(const Value& v);
@@ -135,10 +143,13 @@ class SceneParser {
 void SceneParser::parse(const json& root_json) {
   const Value root{root_json, ""};
   expect_object(root);
-  check_keys(root, {"description", "image", "camera", "background", "ambient", "materials", "lights", "objects"});
+  check_keys(root, {"description", "image", "camera", "integrator", "seed", "background", "ambient", "materials", "lights",
+                    "objects"});
   if (root.has("description")) scene_.description = printable(string(root["description"]), 1000);
   if (root.has("image")) parse_image(root["image"]);
+  if (root.has("seed")) scene_.image.seed = static_cast<uint32_t>(integer(root["seed"], 0, UINT32_MAX));
   parse_camera(require(root, "camera"));
+  if (root.has("integrator")) parse_integrator(root["integrator"]);
   if (root.has("background")) scene_.background = color(root["background"]);
   if (root.has("ambient")) scene_.ambient = color(root["ambient"]);
   if (root.has("materials")) parse_materials(root["materials"]);
@@ -152,8 +163,15 @@ void SceneParser::parse(const json& root_json) {
     expect_array(objects);
     for (size_t i = 0; i < objects.j.size(); ++i) parse_object(objects[i]);
   }
-  if (scene_.lights.empty() && scene_.ambient == glm::vec3(0.0f) && !scene_.triangles.empty())
-    warn(root, "no lights and no ambient: every surface renders black");
+  const bool path = scene_.integrator.type == Integrator::Type::path;
+  if (path && scene_.ambient != glm::vec3(0.0f))
+    warn(root["ambient"], "the path integrator carries indirect light itself: ambient is the direct model's stand-in for it, "
+                          "and is ignored");
+  const bool emitters = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const Material& m) { return m.emissive(); });
+  const bool lit = !scene_.lights.empty() || emitters || (path ? scene_.background : scene_.ambient) != glm::vec3(0.0f);
+  if (!lit && !scene_.triangles.empty())
+    warn(root, path ? "no lights, no emission and no background: every surface renders black"
+                    : "no lights, no emission and no ambient: every surface renders black");
 }
 
 void SceneParser::parse_image(const Value& v) {
@@ -167,7 +185,7 @@ void SceneParser::parse_image(const Value& v) {
 
 void SceneParser::parse_camera(const Value& v) {
   expect_object(v);
-  check_keys(v, {"position", "look_at", "direction", "up", "vertical_fov", "focal_length"});
+  check_keys(v, {"position", "look_at", "direction", "up", "vertical_fov", "focal_length", "aperture_radius", "focus_distance"});
   Camera& cam = scene_.camera;
   cam.position = vec3(require(v, "position"));
   check_coordinates(v["position"], cam.position, "the camera");
@@ -212,6 +230,58 @@ void SceneParser::parse_camera(const Value& v) {
     if (!(cam.focal_length <= kMaxFocalLength))
       fail(v["focal_length"], "expected at most 1e6 (image heights), got " + brief(v["focal_length"].j));
   }
+
+  // The thin lens. The focus distance defaults to the target's, when the camera has one.
+  if (v.has("aperture_radius")) {
+    cam.aperture_radius = number(v["aperture_radius"]);
+    if (!(cam.aperture_radius >= 0.0f && cam.aperture_radius <= kMaxCoordinate))
+      fail(v["aperture_radius"], "expected a radius from 0 to 1e9, got " + brief(v["aperture_radius"].j));
+  }
+  if (v.has("focus_distance")) {
+    cam.focus_distance = positive(v["focus_distance"]);
+    if (!(cam.focus_distance <= 2.0f * kMaxCoordinate))
+      fail(v["focus_distance"], "expected a distance up to 2e9, got " + brief(v["focus_distance"].j));
+  } else if (cam.aperture_radius > 0.0f) {
+    if (!by_target) fail(v, "a camera with an aperture_radius needs a \"focus_distance\" (or a \"look_at\" to focus on)");
+    cam.focus_distance = glm::length(vec3(aim) - cam.position);
+  }
+  if (v.has("focus_distance") && cam.aperture_radius == 0.0f)
+    warn(v["focus_distance"], "a pinhole camera (aperture_radius 0) is sharp everywhere: focus_distance has no effect");
+}
+
+void SceneParser::parse_integrator(const Value& v) {
+  expect_object(v);
+  const std::string type = string(require(v, "type"));
+  Integrator& integrator = scene_.integrator;
+  if (type == "direct") {
+    check_keys(v, {"type"});
+    integrator.type = Integrator::Type::direct;
+  } else if (type == "path") {
+    check_keys(v, {"type", "max_depth", "rr_depth"});
+    integrator.type = Integrator::Type::path;
+    if (v.has("max_depth")) {
+      integrator.max_depth = static_cast<int32_t>(integer(v["max_depth"], -1, kMaxPathDepth));
+      if (integrator.max_depth == 0) fail(v["max_depth"], "max_depth 0 renders nothing: give -1 (no limit) or at least 1");
+    }
+    if (v.has("rr_depth")) integrator.rr_depth = static_cast<uint32_t>(integer(v["rr_depth"], 1, kMaxPathDepth));
+  } else {
+    fail(v["type"], "unknown integrator \"" + printable(type) + "\" (expected \"direct\" or \"path\")");
+  }
+}
+
+int64_t SceneParser::integer(const Value& v, int64_t min, int64_t max) const {
+  // JSON reads a non-negative integer as unsigned, which may pass int64_t's range.
+  const bool in_range = v.j.is_number_unsigned() ? v.j.get<uint64_t>() <= uint64_t(max) && int64_t(v.j.get<uint64_t>()) >= min
+                        : v.j.is_number_integer() ? v.j.get<int64_t>() >= min && v.j.get<int64_t>() <= max
+                                                  : false;
+  if (!in_range) fail(v, "expected an integer from " + std::to_string(min) + " to " + std::to_string(max) + ", got " + brief(v.j));
+  return v.j.is_number_unsigned() ? int64_t(v.j.get<uint64_t>()) : v.j.get<int64_t>();
+}
+
+bool SceneParser::flip_normals(const Value& v) const {
+  if (!v.has("flip_normals")) return false;
+  if (!v["flip_normals"].j.is_boolean()) fail(v["flip_normals"], std::string("expected true or false, got ") + v["flip_normals"].j.type_name());
+  return v["flip_normals"].j.get<bool>();
 }
 
 void SceneParser::parse_materials(const Value& v) {
@@ -219,12 +289,35 @@ void SceneParser::parse_materials(const Value& v) {
   for (const auto& [name, unused] : v.j.items()) {
     const Value m = v[name];
     expect_object(m);
-    check_keys(m, {"albedo"});
-    const glm::vec3 albedo = color(require(m, "albedo"));
-    if (albedo.r > 1.0f || albedo.g > 1.0f || albedo.b > 1.0f)
-      warn(m["albedo"], "albedo above 1 reflects more light than arrives");
+    Material material;
+    material.name = name;
+    const std::string type = m.has("type") ? string(m["type"]) : "diffuse";
+    // A colour in [0, 1]: more would reflect more light than arrives.
+    const auto reflectance = [&](const Value& c) {
+      const glm::vec3 rgb = color(c);
+      if (rgb.r > 1.0f || rgb.g > 1.0f || rgb.b > 1.0f) warn(c, "a value above 1 reflects more light than arrives");
+      return rgb;
+    };
+    if (type == "diffuse") {
+      check_keys(m, {"type", "albedo", "emission"});
+      material.albedo = reflectance(require(m, "albedo"));
+    } else if (type == "mirror") {
+      check_keys(m, {"type", "reflectance", "emission"});
+      material.type = MaterialType::mirror;
+      material.albedo = reflectance(require(m, "reflectance"));
+    } else if (type == "glass") {
+      check_keys(m, {"type", "ior", "emission"});
+      material.type = MaterialType::glass;
+      if (m.has("ior")) {
+        material.ior = positive(m["ior"]);
+        if (!(material.ior <= kMaxIor)) fail(m["ior"], "expected an index of refraction up to 100, got " + brief(m["ior"].j));
+      }
+    } else {
+      fail(m["type"], "unknown material type \"" + printable(type) + "\" (expected \"diffuse\", \"mirror\" or \"glass\")");
+    }
+    if (m.has("emission")) material.emission = color(m["emission"]);
     material_index_[name] = static_cast<uint32_t>(scene_.materials.size());
-    scene_.materials.push_back({name, albedo});
+    scene_.materials.push_back(material);
   }
 }
 
@@ -286,8 +379,9 @@ void SceneParser::parse_object(const Value& v) {
   const glm::mat4 transform = v.has("transform") ? parse_transform(v["transform"]) : glm::mat4(1.0f);
 
   if (type == "sphere") {
-    check_keys(v, {"type", "center", "radius", "material", "transform"});
+    check_keys(v, {"type", "center", "radius", "material", "transform", "flip_normals"});
     Sphere sphere;
+    sphere.inward = flip_normals(v);
     sphere.center = vec3(require(v, "center"));
     sphere.radius = positive(require(v, "radius"));
     sphere.material = material_ref(require(v, "material"));
@@ -302,13 +396,14 @@ void SceneParser::parse_object(const Value& v) {
     check_primitive_count(v, 1);
     scene_.spheres.push_back(sphere);
   } else if (type == "triangles") {
-    check_keys(v, {"type", "positions", "indices", "material", "transform"});
+    check_keys(v, {"type", "positions", "indices", "material", "transform", "flip_normals"});
     const Value positions = require(v, "positions");
     expect_array(positions);
     std::vector<glm::vec3> points;
     points.reserve(positions.j.size());
     for (size_t i = 0; i < positions.j.size(); ++i) points.push_back(transform_point(transform, vec3(positions[i])));
     const uint32_t material = material_ref(require(v, "material"));
+    const bool flip = flip_normals(v);
     const Value indices = require(v, "indices");
     expect_array(indices);
     std::vector<Triangle> triangles;
@@ -326,11 +421,12 @@ void SceneParser::parse_object(const Value& v) {
                         std::to_string(points.size()) + " positions)");
         t.v[k] = points[idx.j.get<size_t>()];
       }
+      if (flip) std::swap(t.v[1], t.v[2]);  // the other winding: the normal turned around
       triangles.push_back(t);
     }
     add_triangles(indices, triangles);
   } else if (type == "mesh") {
-    check_keys(v, {"type", "file", "material", "transform", "smooth"});
+    check_keys(v, {"type", "file", "material", "transform", "smooth", "flip_normals"});
     parse_mesh(v, transform);
   } else {
     fail(type_value, "unknown object type \"" + printable(type) + "\" (expected \"sphere\", \"triangles\" or \"mesh\")");
@@ -424,6 +520,12 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
         if (!std::isfinite(n.x) || glm::length(n) < 0.5f) t.smooth = false;
     }
   }
+  if (flip_normals(v))
+    for (Triangle& t : triangles) {  // the other winding, and the vertex normals turned with it
+      std::swap(t.v[1], t.v[2]);
+      std::swap(t.normals[1], t.normals[2]);
+      for (glm::vec3& n : t.normals) n = -n;
+    }
   add_triangles(file_value, triangles);
 }
 

@@ -19,6 +19,8 @@ namespace vkray {
 // device's own limits are checked again before anything is allocated.
 constexpr uint32_t kMaxImageSide = 16384;
 constexpr uint32_t kMaxSamplesPerPixel = 65536;
+// The largest max_depth and rr_depth a path integrator takes (-1, no limit, is allowed too).
+constexpr int32_t kMaxPathDepth = 1024;
 
 // Every world-space coordinate (after transforms) lies within +-kMaxCoordinate, and so do the
 // camera, its target and the lights. The GPU's float math raises coordinate differences d (at
@@ -37,6 +39,10 @@ struct ImageSettings {
   uint32_t width = 512;
   uint32_t height = 512;
   uint32_t samples_per_pixel = 1;
+  // Picks the sample streams (the scene's "seed", --seed): renders with the same seed are the same,
+  // and different seeds give independent streams, so that renders can be averaged. 0 gives the
+  // streams vkray always had.
+  uint32_t seed = 0;
 };
 
 struct Camera {
@@ -44,11 +50,32 @@ struct Camera {
   glm::vec3 forward{0.0f, 0.0f, 1.0f};  // unit view direction
   glm::vec3 up{0.0f, 1.0f, 0.0f};       // never parallel to forward; its squared length is finite
   float focal_length = 1.0f;            // in units of the image height
+  // The thin lens (Mitsuba's `thinlens`): rays leave a disk of this radius around the position,
+  // aimed so that the plane focus_distance ahead is sharp. 0: the pinhole.
+  float aperture_radius = 0.0f;
+  float focus_distance = 1.0f;
 };
+
+// The values are the shader's (VKRAY_MATERIAL_* in shaders/shared/scene_layout.h).
+enum class MaterialType : uint32_t { diffuse = 0, mirror = 1, glass = 2 };
 
 struct Material {
   std::string name;
-  glm::vec3 albedo{0.0f};
+  MaterialType type = MaterialType::diffuse;
+  glm::vec3 albedo{0.0f};    // diffuse: the albedo; mirror: the reflectance; glass: unused
+  float ior = 1.5f;          // glass: the index of refraction inside (outside: 1, vacuum)
+  glm::vec3 emission{0.0f};  // radiance emitted on the side the geometric normal faces
+
+  bool emissive() const { return emission != glm::vec3(0.0f); }
+  bool specular() const { return type != MaterialType::diffuse; }  // a delta BSDF
+};
+
+// How light is carried to the camera (Mitsuba's integrators).
+struct Integrator {
+  enum class Type { direct, path };
+  Type type = Type::direct;  // direct: the lecture's model; path: the rendering equation
+  int32_t max_depth = -1;    // path: Mitsuba's max_depth (1: emitters seen directly; -1: no limit)
+  uint32_t rr_depth = 5;     // path: Russian roulette from this depth on
 };
 
 struct PointLight {
@@ -60,6 +87,7 @@ struct Sphere {
   glm::vec3 center{0.0f};
   float radius = 0.0f;
   uint32_t material = 0;
+  bool inward = false;  // "flip_normals": the normal points to the centre (for emission and glass)
 };
 
 struct Triangle {
@@ -75,6 +103,7 @@ struct Scene {
   std::string description;     // what the scene is for, in a sentence: free text, never rendered
   ImageSettings image;
   Camera camera;
+  Integrator integrator;
   glm::vec3 background{0.0f};
   glm::vec3 ambient{0.0f};
   std::vector<Material> materials;

@@ -73,7 +73,8 @@ void run_check(Session& session, const CheckOptions& options) {
         const auto start = Clock::now();
         render.inline_scene = path;
         CheckResult result{c, scene->description, {}, 0};
-        result.parity = judge_parity(image_settings(*scene, render), session.render(on_device, render), cpu, signatures);
+        result.parity = judge_parity(image_settings(*scene, render), session.render(on_device, render), cpu, signatures,
+                                     parity_tolerance(*scene));
         if (result.parity.gpu.stats.inline_scene != (path == InlineScene::always))
           throw InternalError(case_name(c) + ": the render did not take the path it was asked for");
         result.seconds = since(start) + shared_seconds;

@@ -17,7 +17,8 @@ uint32_t in_range(const std::optional<uint32_t>& value, uint32_t fallback, uint3
 ImageSettings image_settings(const Scene& scene, const RenderOptions& options) {
   return {in_range(options.width, scene.image.width, kMaxImageSide, "width"),
           in_range(options.height, scene.image.height, kMaxImageSide, "height"),
-          in_range(options.samples_per_pixel, scene.image.samples_per_pixel, kMaxSamplesPerPixel, "samples per pixel")};
+          in_range(options.samples_per_pixel, scene.image.samples_per_pixel, kMaxSamplesPerPixel, "samples per pixel"),
+          options.seed.value_or(scene.image.seed)};
 }
 
 }  // namespace vkray

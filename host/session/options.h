@@ -30,7 +30,7 @@ enum class InlineScene {
 
 struct RenderOptions {
   // Overrides of the scene file's image settings.
-  std::optional<uint32_t> width, height, samples_per_pixel;
+  std::optional<uint32_t> width, height, samples_per_pixel, seed;
   // false: no shadow rays, every light counts as visible (benchmarks of camera rays alone).
   bool shadows = true;
   // GPU: how a small scene is traced; the longest one submission (a tile) may run; square tiles of

@@ -1,5 +1,7 @@
 #include "session/parity.h"
 
+#include <algorithm>
+
 #include "bvh/bvh.h"
 #include "session/cpu_render.h"
 
@@ -15,11 +17,21 @@ ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scen
   }
   std::vector<uint64_t> signatures;
   RenderResult cpu = render_on_cpu(*scene, options, &bvh, &signatures);
-  return judge_parity(image, std::move(gpu), std::move(cpu), std::move(signatures));
+  return judge_parity(image, std::move(gpu), std::move(cpu), std::move(signatures), parity_tolerance(*scene));
 }
 
-ParityResult judge_parity(const ImageSettings& image, RenderResult gpu, RenderResult cpu, std::vector<uint64_t> signatures) {
+ParityTolerance parity_tolerance(const Scene& scene) {
+  ParityTolerance tolerance;
+  const bool glass = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.type == MaterialType::glass; });
+  const bool emitters = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissive(); });
+  tolerance.stochastic = scene.integrator.type == Integrator::Type::path || glass || emitters || scene.camera.aperture_radius > 0;
+  return tolerance;
+}
+
+ParityResult judge_parity(const ImageSettings& image, RenderResult gpu, RenderResult cpu, std::vector<uint64_t> signatures,
+                          const ParityTolerance& tolerance) {
   ParityResult result;
+  result.tolerance = tolerance;
   result.image = image;
   result.gpu = std::move(gpu);
   result.cpu = std::move(cpu);

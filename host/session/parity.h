@@ -22,9 +22,13 @@ struct ParityResult {
   ParityMetrics metrics;
 };
 
+// The tolerance a render of `scene` is judged by: the stochastic one when it makes random decisions.
+ParityTolerance parity_tolerance(const Scene& scene);
+
 ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scene> scene, const RenderOptions& options);
 
 // The comparison alone, of a GPU render and a reference rendered with `signatures`, both of `image`.
-ParityResult judge_parity(const ImageSettings& image, RenderResult gpu, RenderResult cpu, std::vector<uint64_t> signatures);
+ParityResult judge_parity(const ImageSettings& image, RenderResult gpu, RenderResult cpu, std::vector<uint64_t> signatures,
+                          const ParityTolerance& tolerance);
 
 }  // namespace vkray

@@ -1,5 +1,6 @@
 #include "session/session.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "base/errors.h"
@@ -137,6 +138,10 @@ gpu::ShaderVariant shader_variant(const gpu::GpuScene& scene, const RenderOption
   gpu::ShaderVariant variant;
   variant.spheres = !scene.scene().spheres.empty();
   variant.shadows = options.shadows;
+  const Scene& s = scene.scene();
+  variant.path = s.integrator.type == Integrator::Type::path;
+  variant.emitters = scene.emitters().count > 0;
+  variant.specular = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.specular(); });
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))
     variant.inline_scene = scene.inline_scene();
   return variant;

@@ -17,14 +17,17 @@ using glm::vec3;
 using glm::vec4;
 using glm::floatBitsToUint;
 using glm::uintBitsToFloat;
+using glm::min;
 }  // namespace vkray::gpu
 #define VKRAY_SHARED_BEGIN namespace vkray::gpu {
 #define VKRAY_SHARED_END }
 #define VKRAY_INLINE inline
+#define VKRAY_INOUT(type) type&
 #else
 #define VKRAY_SHARED_BEGIN
 #define VKRAY_SHARED_END
 #define VKRAY_INLINE
+#define VKRAY_INOUT(type) inout type
 #endif
 
 #endif  // VKRAY_SHARED_GLSL_CPP_H

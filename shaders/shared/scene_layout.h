@@ -11,12 +11,13 @@ VKRAY_SHARED_BEGIN
 // ---- Primitives: VKRAY_TEXELS_PER_PRIMITIVE RGBA32F texels each, in BVH leaf order ---------------------
 // A triangle is its vertices rather than its edges (every triangle sharing a vertex must see bitwise
 // the same coordinates for the watertight test); a sphere is its centre and radius. Each carries its
-// flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH) and its place in the scene, which
+// flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH | VKRAY_PRIM_INWARD) and its place in the scene, which
 // decides ties (VKRAY_TIE), as the bits of a float.
 #define VKRAY_TEXELS_PER_PRIMITIVE 3
 #define VKRAY_PRIM_SPHERE 0x80000000u
 #define VKRAY_PRIM_SMOOTH 0x40000000u  // a triangle with vertex normals in the normals buffer
-#define VKRAY_PRIM_MATERIAL_MASK 0x3fffffffu
+#define VKRAY_PRIM_INWARD 0x20000000u  // a sphere whose normal points to its centre ("flip_normals")
+#define VKRAY_PRIM_MATERIAL_MASK 0x1fffffffu
 
 struct PrimitiveTexels {
   vec4 a;  // triangle: (v0, flags);          sphere: (centre, flags)
@@ -47,11 +48,37 @@ VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 // Vertex normals of smooth triangles: a second buffer in the same slots as the primitives, one
 // texel per vertex (xyz), present only when some triangle is smooth.
 
-// ---- Materials: VKRAY_TEXELS_PER_MATERIAL RGBA32F texels each, (albedo, 0) -----------------------------
-#define VKRAY_TEXELS_PER_MATERIAL 1
+// ---- Materials: VKRAY_TEXELS_PER_MATERIAL RGBA32F texels each -----------------------------------------
+//   VKRAY_MATERIAL_COLOR:     (albedo or reflectance, type as uint bits)
+//   VKRAY_MATERIAL_EMISSION:  (emitted radiance, index of refraction)
+#define VKRAY_TEXELS_PER_MATERIAL 2
+#define VKRAY_MATERIAL_COLOR 0
+#define VKRAY_MATERIAL_EMISSION 1
+// The types, as vkray::MaterialType numbers them.
+#define VKRAY_MATERIAL_DIFFUSE 0u
+#define VKRAY_MATERIAL_MIRROR 1u
+#define VKRAY_MATERIAL_GLASS 2u
 
 // The first texel of the material a primitive's flags name.
 VKRAY_INLINE int material_texel(uint flags) { return int(flags & VKRAY_PRIM_MATERIAL_MASK) * VKRAY_TEXELS_PER_MATERIAL; }
+
+// ---- Emissive primitives: the area lights, one RGBA32F texel each ------------------------------------
+// An alias table (Walker 1977) over the primitives whose material emits, each weighted by its power
+// (area times the luminance of its emission): entry i is (probability, alias as uint bits, primitive
+// as uint bits, 0). The primitive is a slot in the primitive buffer on the GPU and the scene's
+// numbering on the CPU. One uniform u picks an entry with alias_pick; both renderers compute it in
+// float, so they pick the same light for the same u.
+#define VKRAY_TEXELS_PER_EMITTER 1
+
+// The entry u lands in, and where in it: u * count splits into the entry (integer part) and the
+// uniform that decides between it and its alias (fraction).
+VKRAY_INLINE uint alias_entry(float u, uint count) { return min(uint(u * float(count)), count - 1u); }
+VKRAY_INLINE bool alias_keeps_entry(float u, uint count, uint entry, float probability) {
+  return u * float(count) - float(entry) < probability;
+}
+
+// The luminance (Rec. 709) that weighs an emission: the power of an area light is its area times it.
+VKRAY_INLINE float emission_luminance(vec3 e) { return 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z; }
 
 // ---- Point lights: VKRAY_TEXELS_PER_LIGHT RGBA32F texels each ---------------------------------------
 #define VKRAY_TEXELS_PER_LIGHT 2

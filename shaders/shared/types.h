@@ -17,9 +17,10 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BINDING_PRIMITIVES 1  // uniform texel buffer, RGBA32F: PrimitiveTexels, in BVH leaf order
 #define VKRAY_BINDING_NORMALS 2     // uniform texel buffer, RGBA32F: vertex normals of smooth triangles
 #define VKRAY_BINDING_NODES 3       // uniform texel buffer, RGBA32UI: 4-wide BVH nodes
-#define VKRAY_BINDING_MATERIALS 4   // uniform texel buffer, RGBA32F: albedos
+#define VKRAY_BINDING_MATERIALS 4   // uniform texel buffer, RGBA32F: materials
 #define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F: point lights
 #define VKRAY_BINDING_OUTPUT 6      // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
+#define VKRAY_BINDING_EMITTERS 7    // uniform texel buffer, RGBA32F: the area lights' alias table
 
 // ---- Specialization constants ------------------------------------------------------------------
 // false when the scene has no spheres: the pipeline for it has no sphere test (gpu::ShaderVariant).
@@ -27,12 +28,29 @@ VKRAY_SHARED_BEGIN
 // false for a render without shadow rays (every light counts as visible: camera rays alone, for
 // `vkray bench`): the pipeline has no shadow-ray code, which would cost every lane, masked.
 #define VKRAY_SPEC_SHADOWS 1
+// true for the path integrator, false for the direct model (Scene::integrator).
+#define VKRAY_SPEC_PATH 2
+// false when no material emits: no area-light code.
+#define VKRAY_SPEC_EMITTERS 3
+// false when every material is diffuse: no code for mirrors and glass.
+#define VKRAY_SPEC_SPECULAR 4
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
 // precision: a ray along the line where two walls meet, coplanar surfaces); the primitive that
 // comes first in the scene wins, so the result does not depend on traversal order.
 #define VKRAY_TIE 1e-5
+
+// ---- The output's alpha --------------------------------------------------------------------------
+// The bits of a uint: the rays traced for the pixel, and this bit when the driver cut the shader's
+// loops short (llvmpipe's loop limiter; the host traces the tile again in smaller dispatches). A
+// pixel's rays in one submission stay far below 2^31 (65536 samples of a few hundred rays each).
+#define VKRAY_LOOPS_CUT_SHORT 0x80000000u
+
+// ---- The direct model's mirrors and glass -----------------------------------------------------
+// A camera ray passes through at most this many mirror or glass surfaces before it must meet a
+// diffuse one (past it, the ray brings nothing): enough for a glass sphere seen in a mirror.
+#define VKRAY_SPECULAR_BOUNCES 8u
 
 // ---- Workgroup ---------------------------------------------------------------------------------
 #define VKRAY_WORKGROUP_X 8
@@ -58,7 +76,17 @@ struct FrameUniforms {
   float inv_strata_y;
   float inv_samples_per_pixel;
   float epsilon;    // self-intersection offset, scaled to the scene's extent
-  uint unused;      // std140 rounds the struct up to a multiple of 16 bytes; the buffer holds all of it
+  uint seed_key;    // seed_key(seed) (shared/sampling.h)
+  float aperture_radius;  // the thin lens; 0: the pinhole
+  float focus_distance;
+  int max_depth;          // the path integrator's; -1: no limit
+  uint rr_depth;
+  uint emitter_count;     // entries of the area lights' alias table
+  // 1 / the table's total weight (the sum of area times luminance): an area light's point is
+  // picked with density emission_luminance(emission) * inv_emitter_weight per unit area.
+  float inv_emitter_weight;
+  uint unused0;     // std140 rounds the struct up to a multiple of 16 bytes; the buffer holds all of it
+  uint unused1;
 };
 #ifdef __cplusplus
 static_assert(offsetof(FrameUniforms, origin) == 0);
@@ -78,8 +106,16 @@ static_assert(offsetof(FrameUniforms, inv_strata_x) == 124);
 static_assert(offsetof(FrameUniforms, inv_strata_y) == 128);
 static_assert(offsetof(FrameUniforms, inv_samples_per_pixel) == 132);
 static_assert(offsetof(FrameUniforms, epsilon) == 136);
-static_assert(offsetof(FrameUniforms, unused) == 140);
-static_assert(sizeof(FrameUniforms) == 144);
+static_assert(offsetof(FrameUniforms, seed_key) == 140);
+static_assert(offsetof(FrameUniforms, aperture_radius) == 144);
+static_assert(offsetof(FrameUniforms, focus_distance) == 148);
+static_assert(offsetof(FrameUniforms, max_depth) == 152);
+static_assert(offsetof(FrameUniforms, rr_depth) == 156);
+static_assert(offsetof(FrameUniforms, emitter_count) == 160);
+static_assert(offsetof(FrameUniforms, inv_emitter_weight) == 164);
+static_assert(offsetof(FrameUniforms, unused0) == 168);
+static_assert(offsetof(FrameUniforms, unused1) == 172);
+static_assert(sizeof(FrameUniforms) == 176);
 #endif
 
 // ---- Push constants: the tile this dispatch covers ---------------------------------------------
@@ -101,6 +137,9 @@ struct TileConstants {
   // Where the tile's pixels start in the output, which holds a tile or two, not the image (any
   // image size fits a device's maxStorageBufferRange): row-major in the tile, width pixels a row.
   uint output_offset;
+  // 2, from the host so that the compiler cannot unroll the loop that counts to it: the shader's
+  // probe of llvmpipe's loop limiter (trace.comp).
+  uint probe_iterations;
 };
 #ifdef __cplusplus
 static_assert(offsetof(TileConstants, x0) == 0);
@@ -111,7 +150,8 @@ static_assert(offsetof(TileConstants, row_stride) == 16);
 static_assert(offsetof(TileConstants, sample_begin) == 20);
 static_assert(offsetof(TileConstants, sample_end) == 24);
 static_assert(offsetof(TileConstants, output_offset) == 28);
-static_assert(sizeof(TileConstants) == 32);
+static_assert(offsetof(TileConstants, probe_iterations) == 32);
+static_assert(sizeof(TileConstants) == 36);
 #endif
 
 VKRAY_SHARED_END

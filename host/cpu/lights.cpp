@@ -1,0 +1,94 @@
+#include "cpu/lights.h"
+
+#include <cmath>
+#include <numbers>
+
+#include "cpu/warp.h"
+#include "shared/sampling.h"
+#include "shared/scene_layout.h"
+
+namespace vkray::cpu {
+
+Lights::Lights(const Tracer& tracer, bool shadows)
+    : tracer_(tracer), shadows_(shadows), epsilon_(tracer.epsilon()), table_(build_emitter_table(tracer.scene())) {
+  if (!table_.entries.empty()) inv_weight_ = 1 / table_.total_weight;
+}
+
+void Lights::add_point_lights(const dvec3& x, const dvec3& n, const dvec3& shadow_origin, dvec3& irradiance,
+                              uint64_t* signature, uint64_t& rays) const {
+  const Scene& scene = tracer_.scene();
+  for (size_t l = 0; l < scene.lights.size(); ++l) {
+    const dvec3 light(scene.lights[l].position);
+    const dvec3 to_light = light - x;
+    const double r2 = glm::dot(to_light, to_light);
+    const double cos_theta = glm::dot(n, to_light / std::sqrt(r2));
+    // The light must stand more than epsilon above the plane of the normal: one on the surface
+    // (or at x) lights nothing there.
+    if (!(glm::dot(n, to_light) > epsilon_)) continue;
+    if (shadows_) {
+      ++rays;
+      const dvec3 shadow = light - shadow_origin;
+      const double distance = glm::length(shadow);
+      if (tracer_.occluded({shadow_origin, shadow / distance}, epsilon_, distance - epsilon_)) continue;
+    }
+    if (signature) mix(*signature, 0x8000000000000000ull | l);
+    irradiance += dvec3(scene.lights[l].intensity) * (cos_theta / (std::numbers::pi * r2));
+  }
+}
+
+AreaLightSample Lights::sample_area_light_from(const dvec3& x, const dvec3& n, const dvec3& origin, uint32_t& stream,
+                                               uint64_t& rays) const {
+  const LightPoint light = sample_area_light(stream);
+  const dvec3 to_light = light.position - x;
+  const double r2 = glm::dot(to_light, to_light);
+  const dvec3 w = to_light / std::sqrt(r2);
+  AreaLightSample s;
+  s.cos_x = glm::dot(n, w);
+  const double cos_l = -glm::dot(light.normal, w);
+  if (!(s.cos_x > 0 && cos_l > 0)) return s;
+  if (shadows_) {
+    ++rays;
+    const dvec3 d = light.position - origin;
+    const double distance = glm::length(d);
+    // Stopped epsilon short of the light: the surface the point lies on is not in the way.
+    if (tracer_.occluded({origin, d / distance}, epsilon_, distance - epsilon_)) return s;
+  }
+  s.radiance = light.radiance;
+  s.pdf = light.pdf_area * r2 / cos_l;
+  return s;
+}
+
+LightPoint Lights::sample_area_light(uint32_t& stream) const {
+  const Scene& scene = tracer_.scene();
+  const float u_pick = gpu::next_random(stream);
+  const double u1 = gpu::next_random(stream), u2 = gpu::next_random(stream);
+  const uint32_t count = uint32_t(table_.entries.size());
+  const uint32_t entry = gpu::alias_entry(u_pick, count);
+  const EmitterTable::Entry& e = table_.entries[entry];
+  const uint32_t p = table_.entries[gpu::alias_keeps_entry(u_pick, count, entry, e.probability) ? entry : e.alias].primitive;
+
+  LightPoint light;
+  uint32_t material;
+  if (p < scene.triangles.size()) {
+    const Triangle& t = scene.triangles[p];
+    const dvec3 b = uniform_triangle(u1, u2);
+    light.position = b.x * dvec3(t.v[0]) + b.y * dvec3(t.v[1]) + b.z * dvec3(t.v[2]);
+    light.normal = glm::normalize(glm::cross(dvec3(t.v[1]) - dvec3(t.v[0]), dvec3(t.v[2]) - dvec3(t.v[0])));
+    material = t.material;
+  } else {
+    const Sphere& s = scene.spheres[p - scene.triangles.size()];
+    const dvec3 d = uniform_sphere(u1, u2);
+    light.position = dvec3(s.center) + double(s.radius) * d;
+    light.normal = s.inward ? -d : d;
+    material = s.material;
+  }
+  light.radiance = dvec3(scene.materials[material].emission);
+  light.pdf_area = area_pdf(scene.materials[material].emission);
+  return light;
+}
+
+double Lights::area_pdf(const glm::vec3& emission) const {
+  return (0.2126 * emission.r + 0.7152 * emission.g + 0.0722 * emission.b) * inv_weight_;
+}
+
+}  // namespace vkray::cpu

@@ -1,0 +1,60 @@
+// The CPU reference's light sampling: every point light (the scene contract's term, with its height
+// rule and shadow ray), and one point on an area light picked from the emitter table
+// (scene/emitters.h) with the same numbers the shader draws (shaders/emitters.glsl).
+#pragma once
+
+#include <cstdint>
+
+#include "cpu/tracer.h"
+#include "scene/emitters.h"
+
+namespace vkray::cpu {
+
+// FNV-1a over the 8 bytes of v: what a sample saw, hashed into a pixel's signature.
+inline void mix(uint64_t& h, uint64_t v) {
+  for (int i = 0; i < 8; ++i) h = (h ^ ((v >> (8 * i)) & 0xff)) * 0x100000001b3ull;
+}
+
+struct LightPoint {
+  dvec3 position;
+  dvec3 normal;       // unit, the side that emits
+  dvec3 radiance;
+  double pdf_area;    // density per unit area
+};
+
+// One area-light sample as a point x sees it.
+struct AreaLightSample {
+  dvec3 radiance{0.0};  // 0 when the point is behind x's side, faces away, or is hidden
+  double cos_x = 0;     // at x, to the point
+  double pdf = 0;       // per unit solid angle at x
+};
+
+class Lights {
+ public:
+  // shadows false: every light counts as visible (benchmarks).
+  Lights(const Tracer& tracer, bool shadows);
+
+  // Adds V I (n . w) / (pi r^2) of every point light to `irradiance`, n facing the incoming ray;
+  // counts shadow rays in `rays`; mixes each light that lights x into `signature` when given.
+  void add_point_lights(const dvec3& x, const dvec3& n, const dvec3& shadow_origin, dvec3& irradiance, uint64_t* signature,
+                        uint64_t& rays) const;
+
+  bool has_area_lights() const { return !table_.entries.empty(); }
+  // Draws three numbers: the light, then the point on it.
+  LightPoint sample_area_light(uint32_t& stream) const;
+  // The density per unit area with which sample_area_light finds a point emitting `emission`.
+  double area_pdf(const glm::vec3& emission) const;
+  // A point on the area lights (three numbers) as x sees it: n faces the incoming ray, and shadow
+  // rays leave from `origin`.
+  AreaLightSample sample_area_light_from(const dvec3& x, const dvec3& n, const dvec3& origin, uint32_t& stream,
+                                         uint64_t& rays) const;
+
+ private:
+  const Tracer& tracer_;
+  bool shadows_;
+  double epsilon_;
+  EmitterTable table_;
+  double inv_weight_ = 0;
+};
+
+}  // namespace vkray::cpu

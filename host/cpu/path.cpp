@@ -1,0 +1,100 @@
+// Path tracing, as the shader's path.glsl: next-event estimation at diffuse vertices (every point
+// light, one area-light sample, one background sample) weighed by the power heuristic against BSDF
+// sampling; Mitsuba's max_depth; Russian roulette from rr_depth.
+#include <algorithm>
+#include <limits>
+
+#include "cpu/bsdf.h"
+#include "cpu/integrators.h"
+#include "cpu/warp.h"
+#include "shared/sampling.h"
+
+namespace vkray::cpu {
+namespace {
+
+constexpr double kBackgroundPdf = 1 / (4 * kPi);  // uniform over the sphere
+
+double power_heuristic(double a, double b) { return (a * a) / (a * a + b * b); }
+
+}  // namespace
+
+dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camera_ray, SampleState& state) {
+  const Scene& scene = tracer.scene();
+  const double epsilon = tracer.epsilon();
+  constexpr double kFar = std::numeric_limits<double>::infinity();
+  const dvec3 background(scene.background);
+  const bool background_sampled = scene.background != glm::vec3(0.0f);
+  Ray ray = camera_ray;
+  dvec3 radiance(0.0), throughput(1.0);
+  bool after_delta = true;  // the camera, a mirror or glass: nothing to weigh a hit against
+  double bsdf_pdf = 0;
+  double eta_product = 1;
+  // max_depth -1 is no limit; a path of max_depth vertices ends.
+  const uint32_t max_depth = uint32_t(scene.integrator.max_depth);
+  for (uint32_t depth = 0;;) {
+    const Hit hit = tracer.closest(ray, epsilon, kFar);
+    if (depth == 0) mix(state.signature, uint64_t(int64_t(hit.primitive)));
+    if (hit.primitive < 0) {
+      radiance += throughput * background * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, kBackgroundPdf));
+      break;
+    }
+    const SurfacePoint s = tracer.surface(ray, hit);
+    const Material& material = scene.materials[s.material];
+    const double cos_hit = -glm::dot(s.geometric_normal, ray.dir);
+    const bool front = cos_hit > 0;
+    if (front && material.emissive()) {
+      const double light_pdf = lights.area_pdf(material.emission) * hit.t * hit.t / cos_hit;
+      radiance += throughput * dvec3(material.emission) * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, light_pdf));
+    }
+    if (++depth >= max_depth) break;
+
+    const dvec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
+    const dvec3 n = front ? s.shading_normal : -s.shading_normal;
+    const dvec3 x = s.position;
+    const dvec3 origin = x + epsilon * n_geometric;
+    if (!material.specular()) {
+      const dvec3 albedo(material.albedo);
+      dvec3 irradiance(0.0);
+      lights.add_point_lights(x, n, origin, irradiance, depth == 1 ? &state.signature : nullptr, state.rays);
+      radiance += throughput * albedo * irradiance;
+      if (lights.has_area_lights()) {
+        const AreaLightSample light = lights.sample_area_light_from(x, n, origin, state.stream, state.rays);
+        if (light.pdf > 0)
+          radiance += throughput * albedo * light.radiance *
+                      (light.cos_x / (kPi * light.pdf) * power_heuristic(light.pdf, light.cos_x / kPi));
+      }
+      if (background_sampled) {
+        const double u1 = gpu::next_random(state.stream), u2 = gpu::next_random(state.stream);
+        const dvec3 w = uniform_sphere(u1, u2);
+        const double cos_x = glm::dot(n, w);
+        if (cos_x > 0) {
+          ++state.rays;
+          if (!tracer.occluded({origin, w}, epsilon, kFar))
+            radiance += throughput * albedo * background *
+                        (cos_x / (kPi * kBackgroundPdf) * power_heuristic(kBackgroundPdf, cos_x / kPi));
+        }
+      }
+    }
+
+    // The next direction.
+    const BsdfSample b = sample_bsdf(material, -ray.dir, n, front, state.stream);
+    if ((glm::dot(b.dir, n_geometric) > 0) == b.transmitted) break;  // the wrong side of the surface
+    throughput *= b.weight;
+    if (std::max({throughput.r, throughput.g, throughput.b}) == 0) break;
+    after_delta = b.delta;
+    bsdf_pdf = b.pdf;
+    eta_product *= b.eta;
+    ray = {b.transmitted ? x - epsilon * n_geometric : origin, b.dir};
+    ++state.rays;
+
+    // Russian roulette: survive with probability q, weighted 1 / q.
+    if (depth >= scene.integrator.rr_depth) {
+      const double q = std::min(std::max({throughput.r, throughput.g, throughput.b}) * eta_product * eta_product, 0.95);
+      if (!(gpu::next_random(state.stream) < q)) break;
+      throughput /= q;
+    }
+  }
+  return radiance;
+}
+
+}  // namespace vkray::cpu

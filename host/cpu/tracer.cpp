@@ -1,0 +1,136 @@
+#include "cpu/tracer.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "bvh/bvh.h"
+#include "shared/types.h"
+
+namespace vkray::cpu {
+namespace {
+
+// Determinant of the 3x3 matrix with columns a, b, c.
+double det3(dvec3 a, dvec3 b, dvec3 c) {
+  return a.x * (b.y * c.z - b.z * c.y) - b.x * (a.y * c.z - a.z * c.y) + c.x * (a.y * b.z - a.z * b.y);
+}
+
+// The largest t still worth testing: up to a tie with the best hit so far (VKRAY_TIE).
+double limit(const Hit& best, double t_max) { return best.primitive < 0 ? t_max : best.t * (1 + VKRAY_TIE); }
+
+// Tests primitive p (in the scene's numbering) and keeps it in `best` if it is nearer, or ties
+// Whether the ray enters `box` before `t_max`, and where. Exit distances are padded by 1e-12
+// relative, so a flat box (an axis-aligned wall's) is never lost to rounding.
+bool enters(const Aabb& box, const Ray& ray, const dvec3& inv, double t_min, double t_max, double& t_enter) {
+  double enter = t_min, exit = t_max;
+  for (int a = 0; a < 3; ++a) {
+    double t0 = (double(box.min[a]) - ray.origin[a]) * inv[a];
+    double t1 = (double(box.max[a]) - ray.origin[a]) * inv[a];
+    if (t0 > t1) std::swap(t0, t1);
+    enter = std::max(enter, t0);
+    exit = std::min(exit, t1 * (1 + 1e-12));
+  }
+  t_enter = enter;
+  return enter <= exit;
+}
+
+// The lecture's ray-triangle test: solve [-d, e1, e2] (t, u, v)^T = s - v0 by Cramer's rule and
+// accept u >= 0, v >= 0, u + v <= 1. Returns t, or -1.
+double intersect_triangle(const Ray& ray, const Triangle& tri, double t_min, double t_max, double& u, double& v) {
+  const dvec3 v0(tri.v[0]);
+  const dvec3 e1 = dvec3(tri.v[1]) - v0, e2 = dvec3(tri.v[2]) - v0, b = ray.origin - v0;
+  const double det = det3(-ray.dir, e1, e2);
+  if (det == 0) return -1;  // parallel to the plane, or degenerate
+  u = det3(-ray.dir, b, e2) / det;
+  v = det3(-ray.dir, e1, b) / det;
+  if (u < 0 || v < 0 || u + v > 1) return -1;
+  const double t = det3(b, e1, e2) / det;
+  return (t > t_min && t < t_max) ? t : -1;
+}
+
+// The lecture's ray-sphere test: |o + t d - c|^2 = r^2 as a t^2 + b t + c = 0; the nearest root
+// in range counts. Returns t, or -1.
+double intersect_sphere(const Ray& ray, const Sphere& s, double t_min, double t_max) {
+  const dvec3 oc = ray.origin - dvec3(s.center);
+  const double a = glm::dot(ray.dir, ray.dir);
+  const double b = 2 * glm::dot(ray.dir, oc);
+  const double c = glm::dot(oc, oc) - double(s.radius) * double(s.radius);
+  const double discriminant = b * b - 4 * a * c;
+  if (discriminant < 0) return -1;
+  const double root = std::sqrt(discriminant);
+  for (const double t : {(-b - root) / (2 * a), (-b + root) / (2 * a)})
+    if (t > t_min && t < t_max) return t;
+  return -1;
+}
+}  // namespace
+
+Hit Tracer::closest(const Ray& ray, double t_min, double t_max, bool any_hit) const {
+  Hit best{t_max, -1};
+  const size_t count = scene_.triangles.size() + scene_.spheres.size();
+  if (!bvh_) {
+    for (size_t p = 0; p < count && !(any_hit && best.primitive >= 0); ++p) test(ray, p, t_min, t_max, best);
+    return best;
+  }
+  if (bvh_->nodes.empty()) return best;
+  // 1 / d with zero components replaced by tiny ones, so a slab test never computes 0 * inf.
+  dvec3 inv;
+  for (int a = 0; a < 3; ++a) inv[a] = (ray.dir[a] < 0 ? -1.0 : 1.0) / std::max(std::abs(ray.dir[a]), 1e-300);
+  visit(0, ray, inv, t_min, t_max, any_hit, best);
+  return best;
+}
+
+
+// with it and comes first in the scene.
+void Tracer::test(const Ray& ray, size_t p, double t_min, double t_max, Hit& best) const {
+  Hit candidate{-1, int(p)};
+  if (p < scene_.triangles.size())
+    candidate.t = intersect_triangle(ray, scene_.triangles[p], t_min, limit(best, t_max), candidate.u, candidate.v);
+  else
+    candidate.t = intersect_sphere(ray, scene_.spheres[p - scene_.triangles.size()], t_min, limit(best, t_max));
+  if (candidate.t < 0) return;
+  if (best.primitive < 0 || candidate.t < best.t * (1 - VKRAY_TIE) || candidate.primitive < best.primitive) best = candidate;
+}
+
+// Recursive descent, nearer child first. Returns true to stop (any_hit found one).
+bool Tracer::visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, Hit& best) const {
+  const BvhNode& n = bvh_->nodes[node];
+  double t_enter[2];
+  const bool hit[2] = {enters(n.child[0], ray, inv, t_min, limit(best, t_max), t_enter[0]),
+                       enters(n.child[1], ray, inv, t_min, limit(best, t_max), t_enter[1])};
+  const int first = (hit[0] && hit[1] && t_enter[1] < t_enter[0]) ? 1 : 0;
+  for (const int c : {first, 1 - first}) {
+    if (!hit[c]) continue;
+    const uint32_t link = n.link[c];
+    if (is_leaf(link)) {
+      for (uint32_t slot = leaf_first(link); slot < leaf_first(link) + leaf_count(link); ++slot) {
+        test(ray, bvh_->order[slot], t_min, t_max, best);
+        if (any_hit && best.primitive >= 0) return true;
+      }
+    } else if (visit(link, ray, inv, t_min, t_max, any_hit, best)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
+  SurfacePoint s;
+  s.position = ray.origin + hit.t * ray.dir;
+  if (size_t(hit.primitive) < scene_.triangles.size()) {
+    const Triangle& tri = scene_.triangles[size_t(hit.primitive)];
+    s.geometric_normal = glm::normalize(glm::cross(dvec3(tri.v[1]) - dvec3(tri.v[0]), dvec3(tri.v[2]) - dvec3(tri.v[0])));
+    s.shading_normal = s.geometric_normal;
+    if (tri.smooth)
+      s.shading_normal = glm::normalize((1 - hit.u - hit.v) * dvec3(tri.normals[0]) + hit.u * dvec3(tri.normals[1]) +
+                                        hit.v * dvec3(tri.normals[2]));
+    s.material = tri.material;
+  } else {
+    const Sphere& sphere = scene_.spheres[size_t(hit.primitive) - scene_.triangles.size()];
+    s.geometric_normal = (s.position - dvec3(sphere.center)) / double(sphere.radius);
+    if (sphere.inward) s.geometric_normal = -s.geometric_normal;
+    s.shading_normal = s.geometric_normal;
+    s.material = sphere.material;
+  }
+  return s;
+}
+
+}  // namespace vkray::cpu

@@ -1,0 +1,64 @@
+// The CPU reference's ray queries, in double precision and written the plain way the lecture writes
+// them: the ray-triangle 3x3 system by Cramer's rule, the ray-sphere quadratic, a recursive BVH walk
+// (or every primitive, to check the walk), and the surface at a hit.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace vkray {
+struct Bvh;
+}
+
+namespace vkray::cpu {
+
+using glm::dvec3;
+
+struct Ray {
+  dvec3 origin;
+  dvec3 dir;  // unit length
+};
+
+struct Hit {
+  double t;
+  int primitive;        // triangle index, then sphere index + triangle count; -1 for none
+  double u = 0, v = 0;  // barycentrics of a triangle hit: x = v0 + u e1 + v e2
+};
+
+// The surface where a ray hit.
+struct SurfacePoint {
+  dvec3 position;
+  dvec3 geometric_normal;  // unit; the side it faces emits, and is glass's outside
+  dvec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal
+  uint32_t material = 0;
+};
+
+class Tracer {
+ public:
+  // `bvh` null: every primitive is tested (slow; checks the traversal).
+  Tracer(const Scene& scene, const Bvh* bvh) : scene_(scene), bvh_(bvh), epsilon_(scene.epsilon()) {}
+
+  // Closest intersection with t in (t_min, t_max); with any_hit, the first one found.
+  Hit closest(const Ray& ray, double t_min, double t_max, bool any_hit = false) const;
+  // Whether anything lies on the ray with t in (t_min, t_max).
+  bool occluded(const Ray& ray, double t_min, double t_max) const { return closest(ray, t_min, t_max, true).primitive >= 0; }
+
+  SurfacePoint surface(const Ray& ray, const Hit& hit) const;
+
+  const Scene& scene() const { return scene_; }
+  // The scene's epsilon (Scene::epsilon, which walks every primitive), computed once.
+  double epsilon() const { return epsilon_; }
+
+ private:
+  void test(const Ray& ray, size_t p, double t_min, double t_max, Hit& best) const;
+  bool visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, Hit& best) const;
+
+  const Scene& scene_;
+  const Bvh* bvh_;
+  double epsilon_;
+};
+
+}  // namespace vkray::cpu

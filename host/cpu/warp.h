@@ -1,0 +1,62 @@
+// The CPU reference's warps from uniform numbers to the shapes it samples, in double: the same maps
+// as the shader's (shaders/warp.glsl), written again, so that the same numbers give the same points.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <glm/glm.hpp>
+
+namespace vkray::cpu {
+
+constexpr double kPi = std::numbers::pi;
+
+// Shirley and Chiu's concentric map of the unit square onto the unit disk.
+inline glm::dvec2 concentric_disk(double u1, double u2) {
+  const double a = 2 * u1 - 1, b = 2 * u2 - 1;
+  if (a == 0 && b == 0) return {0, 0};
+  double r, phi;
+  if (std::abs(a) > std::abs(b)) {
+    r = a;
+    phi = (kPi / 4) * (b / a);
+  } else {
+    r = b;
+    phi = kPi / 2 - (kPi / 4) * (a / b);
+  }
+  return {r * std::cos(phi), r * std::sin(phi)};
+}
+
+// About +z, with density cos(theta) / pi.
+inline glm::dvec3 cosine_hemisphere(double u1, double u2) {
+  const glm::dvec2 d = concentric_disk(u1, u2);
+  return {d.x, d.y, std::sqrt(std::max(0.0, 1 - d.x * d.x - d.y * d.y))};
+}
+
+// Uniform on the unit sphere: density 1 / (4 pi).
+inline glm::dvec3 uniform_sphere(double u1, double u2) {
+  const double z = 1 - 2 * u1;
+  const double r = std::sqrt(std::max(0.0, 1 - z * z));
+  const double phi = 2 * kPi * u2;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+// Barycentric weights (of v0, v1, v2) of a uniform point on a triangle.
+inline glm::dvec3 uniform_triangle(double u1, double u2) {
+  const double s = std::sqrt(u1);
+  const double b0 = 1 - s, b1 = u2 * s;
+  return {b0, b1, 1 - b0 - b1};
+}
+
+// `local` turned so that its +z is the unit vector n: an orthonormal basis about n (Duff et al.
+// 2017), the one the shader builds.
+inline glm::dvec3 to_world(const glm::dvec3& local, const glm::dvec3& n) {
+  const double sign = n.z >= 0 ? 1.0 : -1.0;
+  const double a = -1 / (sign + n.z);
+  const double b = n.x * n.y * a;
+  const glm::dvec3 t(1 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  const glm::dvec3 bt(b, sign + n.y * n.y * a, -n.y);
+  return local.x * t + local.y * bt + local.z * n;
+}
+
+}  // namespace vkray::cpu

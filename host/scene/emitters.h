@@ -1,0 +1,32 @@
+// The area lights: every primitive whose material emits, and the table both renderers pick one from
+// (shaders/shared/scene_layout.h, "Emissive primitives"), so that they pick the same light for the
+// same random number. The table is scene set-up, like the camera basis; how a point on the light
+// is chosen and weighed is each renderer's own code.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "scene/scene.h"
+
+namespace vkray {
+
+struct EmitterTable {
+  struct Entry {
+    float probability = 1.0f;  // of keeping this entry rather than its alias
+    uint32_t alias = 0;
+    uint32_t primitive = 0;    // in the scene's numbering: triangles, then spheres
+  };
+  std::vector<Entry> entries;  // empty when nothing emits
+  double total_weight = 0;     // the sum of area * luminance(emission) over the entries
+};
+
+// The alias table over the emissive primitives, each weighted by its power. Primitives whose
+// weight is 0 (an emission of zero luminance, an area that underflows) are left out: they would
+// never be picked.
+EmitterTable build_emitter_table(const Scene& scene);
+
+// The area of primitive p (scene numbering), in double.
+double primitive_area(const Scene& scene, uint32_t p);
+
+}  // namespace vkray

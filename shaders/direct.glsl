@@ -1,0 +1,47 @@
+// The direct model (the default integrator): what a camera ray sees, lit by the lights directly
+// (shade.glsl). Emitters seen are added; a mirror or glass surface passes the ray on, as a Whitted
+// ray tracer does, up to VKRAY_SPECULAR_BOUNCES times, until it meets a diffuse surface or nothing.
+#ifndef VKRAY_DIRECT_GLSL
+#define VKRAY_DIRECT_GLSL
+
+#include "bsdf.glsl"
+#include "shade.glsl"
+#include "traversal.glsl"
+
+// The radiance along a camera ray; adds the rays it traces after the camera ray to `rays`.
+vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
+  if (!SCENE_HAS_EMITTERS && !SCENE_HAS_SPECULAR) {  // the lecture's model: one hit, shaded
+    Hit hit = trace_closest(ray, frame.epsilon, FAR);
+    if (hit.prim == NO_HIT) return frame.background.rgb;
+    vec3 x = ray_at(ray, hit.t);
+    return shade(ray, x, hit_surface(hit, x), stream, rays);
+  }
+  vec3 radiance = vec3(0.0), throughput = vec3(1.0);
+  uint bounce = 0u;
+  do {
+    Hit hit = trace_closest(ray, frame.epsilon, FAR);
+    if (hit.prim == NO_HIT) {
+      radiance += throughput * frame.background.rgb;
+      break;
+    }
+    vec3 x = ray_at(ray, hit.t);
+    Surface s = hit_surface(hit, x);
+    bool front = !(dot(s.geometric_normal, ray.dir) > 0.0);  // a grazing ray meets the front, as in shade()
+    if (front) radiance += throughput * s.emission;
+    if (s.material_type == VKRAY_MATERIAL_DIFFUSE) {
+      radiance += throughput * shade(ray, x, s, stream, rays);
+      break;
+    }
+    vec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
+    vec3 n = front ? s.shading_normal : -s.shading_normal;
+    BsdfSample b = sample_bsdf(s, -ray.dir, n, front, stream);
+    // A direction on the wrong side of the surface (an interpolated normal can point there) ends it.
+    if ((dot(b.dir, n_geometric) > 0.0) == b.transmitted) break;
+    throughput *= b.weight;
+    ray = Ray(x + (b.transmitted ? -frame.epsilon : frame.epsilon) * n_geometric, b.dir);
+    rays += 1u;
+  } while (++bounce <= VKRAY_SPECULAR_BOUNCES);
+  return radiance;
+}
+
+#endif

@@ -1,0 +1,49 @@
+// The area lights: one picked from the alias table (shared/scene_layout.h) by its power, and a
+// point on it picked uniformly by area. Its density per unit area is then the same for every
+// light, emission_luminance(emission) * frame.inv_emitter_weight, which is what lets a hit on an
+// emitter know how likely light sampling was to find it (multiple importance sampling).
+#ifndef VKRAY_EMITTERS_GLSL
+#define VKRAY_EMITTERS_GLSL
+
+#include "resources.glsl"
+#include "shared/sampling.h"
+#include "warp.glsl"
+
+struct LightPoint {
+  vec3 position;
+  vec3 normal;     // unit, the side that emits
+  vec3 radiance;   // emitted toward that side
+  float pdf_area;  // density of picking this point, per unit area
+};
+
+// Draws three numbers from the stream: the light, then the point on it.
+LightPoint sample_area_light(inout uint stream) {
+  float u_pick = next_random(stream);
+  vec2 u = vec2(next_random(stream), next_random(stream));
+  uint entry = alias_entry(u_pick, frame.emitter_count);
+  vec4 texel = texelFetch(emitters, int(entry) * VKRAY_TEXELS_PER_EMITTER);
+  uint chosen = alias_keeps_entry(u_pick, frame.emitter_count, entry, texel.x) ? entry : floatBitsToUint(texel.y);
+  uint prim = floatBitsToUint(texelFetch(emitters, int(chosen) * VKRAY_TEXELS_PER_EMITTER).z);
+
+  int base = int(prim) * VKRAY_TEXELS_PER_PRIMITIVE;
+  vec4 a = texelFetch(primitives, base), b = texelFetch(primitives, base + 1), c = texelFetch(primitives, base + 2);
+  uint flags = primitive_flags(a);
+  LightPoint light;
+  if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
+    vec3 d = uniform_sphere(u);
+    light.position = a.xyz + sphere_radius(b) * d;
+    light.normal = (flags & VKRAY_PRIM_INWARD) != 0u ? -d : d;
+  } else {
+    vec3 w = uniform_triangle(u);
+    light.position = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
+    light.normal = normalize(cross(b.xyz - a.xyz, c.xyz - a.xyz));
+  }
+  light.radiance = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION).rgb;
+  light.pdf_area = emission_luminance(light.radiance) * frame.inv_emitter_weight;
+  return light;
+}
+
+// The density, per unit area, with which sample_area_light picks a point on a surface emitting `emission`.
+float area_light_pdf(vec3 emission) { return emission_luminance(emission) * frame.inv_emitter_weight; }
+
+#endif

@@ -1,0 +1,101 @@
+// The path integrator: the rendering equation by unidirectional path tracing, as Mitsuba 3's `path`.
+// At every diffuse vertex, next-event estimation: each point light, one area-light sample and one
+// sample of the background (when it is not black), the last two weighed against BSDF sampling by
+// the power heuristic; then the BSDF picks the next direction. A hit on an emitter (or a miss, on
+// the background) adds its light weighed the same way, or whole after a mirror or glass.
+// Depth counts as Mitsuba's max_depth does; Russian roulette from rr_depth on.
+#ifndef VKRAY_PATH_GLSL
+#define VKRAY_PATH_GLSL
+
+#include "bsdf.glsl"
+#include "emitters.glsl"
+#include "shade.glsl"
+#include "traversal.glsl"
+
+// The background is sampled uniformly over the sphere of directions.
+const float BACKGROUND_PDF = 1.0 / (4.0 * PI);
+
+// The power heuristic (Veach 1997, beta = 2): the weight of a sample drawn with density `a` when
+// density `b` could have drawn it too.
+float power_heuristic(float a, float b) {
+  return (a * a) / (a * a + b * b);
+}
+
+vec3 path_radiance(Ray ray, inout uint stream, inout uint rays) {
+  vec3 radiance = vec3(0.0), throughput = vec3(1.0);
+  bool background_sampled = frame.background.r > 0.0 || frame.background.g > 0.0 || frame.background.b > 0.0;
+  bool after_delta = true;  // the last bounce was the camera, a mirror or glass: no light sampling to weigh against
+  float bsdf_pdf = 0.0;     // the solid-angle density of the last bounce's direction
+  float eta_product = 1.0;  // the relative indices crossed: Russian roulette undoes their radiance scaling
+  uint depth = 0u;
+  do {
+    Hit hit = trace_closest(ray, frame.epsilon, FAR);
+    if (hit.prim == NO_HIT) {
+      float weight = after_delta ? 1.0 : power_heuristic(bsdf_pdf, BACKGROUND_PDF);
+      radiance += throughput * frame.background.rgb * weight;
+      break;
+    }
+    vec3 x = ray_at(ray, hit.t);
+    Surface s = hit_surface(hit, x);
+    float cos_hit = -dot(s.geometric_normal, ray.dir);
+    bool front = cos_hit > 0.0;
+    if (SCENE_HAS_EMITTERS && front && s.emission != vec3(0.0)) {  // (0 * a grazing hit's infinite density is NaN)
+      // Light sampling finds this point with density pdf_area t^2 / cos per unit solid angle.
+      float light_pdf = area_light_pdf(s.emission) * hit.t * hit.t / cos_hit;
+      float weight = after_delta ? 1.0 : power_heuristic(bsdf_pdf, light_pdf);
+      radiance += throughput * s.emission * weight;
+    }
+    // Mitsuba's depth: a path of max_depth vertices ends here (-1, as a uint, never does).
+    if (++depth >= uint(frame.max_depth)) break;
+
+    vec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
+    vec3 n = front ? s.shading_normal : -s.shading_normal;
+    vec3 origin = x + frame.epsilon * n_geometric;  // on the side the ray came from
+    bool diffuse = !SCENE_HAS_SPECULAR || s.material_type == VKRAY_MATERIAL_DIFFUSE;
+    if (diffuse) {
+      // ---- Next-event estimation: f = albedo / pi, so each term is albedo * (incident / pi) ----------
+      vec3 irradiance = vec3(0.0);
+      add_point_lights(x, n, origin, irradiance, rays);
+      radiance += throughput * s.albedo * irradiance;
+      if (SCENE_HAS_EMITTERS) {
+        AreaLightSample light = sample_area_light_from(x, n, origin, stream, rays);
+        if (light.pdf > 0.0)
+          radiance += throughput * s.albedo * light.radiance *
+                      (light.cos_x / (PI * light.pdf) * power_heuristic(light.pdf, light.cos_x / PI));
+      }
+      if (background_sampled) {
+        vec3 w = uniform_sphere(vec2(next_random(stream), next_random(stream)));
+        float cos_x = dot(n, w);
+        if (cos_x > 0.0) {
+          rays += 1u;
+          if (!trace_any(Ray(origin, w), frame.epsilon, FAR)) {
+            float weight = power_heuristic(BACKGROUND_PDF, cos_x / PI);
+            radiance += throughput * s.albedo * frame.background.rgb * (cos_x / (PI * BACKGROUND_PDF) * weight);
+          }
+        }
+      }
+    }
+
+    // ---- The next direction ----------------------------------------------------------------------
+    BsdfSample b = sample_bsdf(s, -ray.dir, n, front, stream);
+    // A direction on the wrong side of the surface (an interpolated normal can point there) ends it.
+    if ((dot(b.dir, n_geometric) > 0.0) == b.transmitted) break;
+    throughput *= b.weight;
+    if (max(throughput.r, max(throughput.g, throughput.b)) == 0.0) break;  // a black surface ends it
+    after_delta = b.delta;
+    bsdf_pdf = b.pdf;
+    eta_product *= b.eta;
+    ray = Ray(b.transmitted ? x - frame.epsilon * n_geometric : origin, b.dir);
+    rays += 1u;
+
+    // ---- Russian roulette: survive with probability q, weighted 1 / q --------------------------------
+    if (depth >= frame.rr_depth) {
+      float q = min(max(throughput.r, max(throughput.g, throughput.b)) * eta_product * eta_product, 0.95);
+      if (!(next_random(stream) < q)) break;
+      throughput /= q;
+    }
+  } while (true);
+  return radiance;
+}
+
+#endif
