@@ -42,8 +42,10 @@ void print_text(const ParityResult& r, const std::string& device, const std::fil
               cpu.trace_seconds / gpu.trace_seconds);
   std::printf("max |GPU - CPU| %.3g (linear) at pixel (%u, %u): GPU (%.6g, %.6g, %.6g), CPU (%.6g, %.6g, %.6g)\n",
               m.max_abs, m.worst_x, m.worst_y, worst_gpu.r, worst_gpu.g, worst_gpu.b, worst_cpu.r, worst_cpu.g, worst_cpu.b);
-  std::printf("mean |GPU - CPU| %.3g (linear); PSNR %s\n", m.mean_abs,
-              std::isinf(m.psnr) ? "inf (identical after clamping)" : (std::to_string(m.psnr).substr(0, 5) + " dB").c_str());
+  std::printf("mean |GPU - CPU| %.3g (linear); PSNR %s; the image means differ by %.3g%% (the worst channel)\n", m.mean_abs,
+              std::isinf(m.psnr) ? "inf (identical after clamping)" : (std::to_string(m.psnr).substr(0, 5) + " dB").c_str(),
+              m.mean_relative * 100);
+  if (m.non_finite > 0) std::printf("%llu GPU pixels are NaN or infinite\n", static_cast<unsigned long long>(m.non_finite));
   std::printf("8-bit sRGB differences: > 1 on %llu pixels (%.4f%%), > 2 on %llu (%.4f%%); away from edges: > 1 on %llu, > 2 on %llu\n",
               static_cast<unsigned long long>(m.over_1), m.share_over_1() * 100, static_cast<unsigned long long>(m.over_2),
               m.share_over_2() * 100, static_cast<unsigned long long>(m.interior_over_1),
