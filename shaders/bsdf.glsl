@@ -35,7 +35,10 @@ float fresnel_dielectric(float cos_i, float eta, out float cos_t) {
 }
 
 // wo: unit, toward where the ray came from; n: the shading normal turned to wo's side; front: the
-// ray met the side the geometric normal faces (for glass, from outside).
+// ray met the side the geometric normal faces (for glass, from outside). The direction is
+// normalized again: the ray tests assume a unit direction, and a sphere's normal, from a hit point
+// a float rounding off the surface, is not quite unit; unchecked, the error grew bounce by bounce
+// until paths in a closed sphere left it (0.4% of the light lost by 60 bounces, 2026-11-23).
 BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream) {
   BsdfSample b;
   b.delta = s.material_type != VKRAY_MATERIAL_DIFFUSE;
@@ -45,13 +48,13 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
   if (!SCENE_HAS_SPECULAR || s.material_type == VKRAY_MATERIAL_DIFFUSE) {
     vec2 u = vec2(next_random(stream), next_random(stream));
     vec3 local = cosine_hemisphere(u);
-    b.dir = to_world(local, n);
+    b.dir = normalize(to_world(local, n));
     b.pdf = local.z / PI;
     b.weight = s.albedo;
     return b;
   }
   float cos_i = dot(wo, n);
-  vec3 reflected = 2.0 * cos_i * n - wo;
+  vec3 reflected = normalize(2.0 * cos_i * n - wo);
   if (s.material_type == VKRAY_MATERIAL_MIRROR) {
     b.dir = reflected;
     b.weight = s.albedo;

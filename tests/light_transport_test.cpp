@@ -133,6 +133,25 @@ TEST_F(LightTransportTest, TheDirectModelIsPathsOfTwoVertices) {
   }
 }
 
+class LongPathsTest : public ParityTest {};
+
+TEST_F(LongPathsTest, ThousandsOfSamplesOfLongPathsMatchTheReference) {
+  // A furnace of albedo 0.9 makes paths of dozens of vertices, each a traversal: far more loop
+  // iterations a sample than llvmpipe lets an invocation make (65535), so the renderer must cut
+  // the samples into dispatches small enough, or trace a tile again when its loops were cut short.
+  const Scene scene = parse_scene(R"({
+    "camera": {"position": [0.1, 0.2, 0], "direction": [0, 0, 1], "vertical_fov": 90},
+    "integrator": {"type": "path", "rr_depth": 20},
+    "materials": {"wall": {"albedo": [0.9, 0.9, 0.9], "emission": [1, 1, 1]},
+                  "glass": {"type": "glass", "ior": 1.5}},
+    "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "wall", "flip_normals": true},
+                {"type": "sphere", "center": [0, 0, 0.5], "radius": 0.2, "material": "glass"}]})",
+                                  "long-paths.json");
+  const ParityResult r = run(scene, {8, 8, 2048});
+  expect_parity(r, "long-paths");
+  for (const Image* image : {&r.gpu.image, &r.cpu.image}) expect_mean(*image, {10.0, 10.0, 10.0}, 0.05, "furnace");
+}
+
 // ---- Parity catches errors of light transport ---------------------------------------------------------
 // The shader with one edit, against the CPU reference: each must fail the noisy images' tolerance.
 class BrokenShaderParityTest : public ParityTest {

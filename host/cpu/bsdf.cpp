@@ -26,14 +26,14 @@ BsdfSample sample_bsdf(const Material& material, const glm::dvec3& wo, const glm
     case MaterialType::diffuse: {
       const double u1 = gpu::next_random(stream), u2 = gpu::next_random(stream);
       const glm::dvec3 local = cosine_hemisphere(u1, u2);
-      b.dir = to_world(local, n);
+      b.dir = glm::normalize(to_world(local, n));  // as the shader does (bsdf.glsl says why)
       b.pdf = local.z / kPi;
       b.weight = glm::dvec3(material.albedo);  // (albedo / pi) cos / (cos / pi)
       return b;
     }
     case MaterialType::mirror:
       b.delta = true;
-      b.dir = 2 * glm::dot(wo, n) * n - wo;
+      b.dir = glm::normalize(2 * glm::dot(wo, n) * n - wo);
       b.weight = glm::dvec3(material.albedo);
       return b;
     case MaterialType::glass: {
@@ -43,7 +43,7 @@ BsdfSample sample_bsdf(const Material& material, const glm::dvec3& wo, const glm
       double cos_t;
       const double f = fresnel_dielectric(cos_i, eta, cos_t);
       if (gpu::next_random(stream) < f) {
-        b.dir = 2 * cos_i * n - wo;
+        b.dir = glm::normalize(2 * cos_i * n - wo);
         return b;
       }
       // Refraction: the tangential part scales by 1 / eta, the normal part is cos_t.
