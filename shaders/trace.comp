@@ -48,10 +48,10 @@ void main() {
     if (frame.aperture_radius > 0.0) ray = lens_ray(ray, vec2(next_random(stream), next_random(stream)));
     rays += 1u;
     sum += PATH_TRACING ? path_radiance(ray, stream, rays) : direct_radiance(ray, stream, rays);
-    // llvmpipe ends every loop of an invocation early, without a word, once the loops inside its
-    // outermost one have made 65535 iterations in all (host/gpu/renderer.cpp). A loop that must run
-    // twice tells: past the limit it runs once. (Its count comes from the host, so that the compiler
-    // cannot unroll it.) If the limit ends this loop instead, k falls short of sample_end.
+    // llvmpipe ends every loop of an invocation early, without a word, once the invocation has made
+    // 65535 loop iterations in all (host/gpu/renderer.cpp). A loop that must run twice tells: past
+    // the limit it runs once. (Its count comes from the host, so that the compiler cannot unroll
+    // it.) If the limit ends the sample loop instead, k falls short of sample_end.
     uint probe = 0u;
     do {
       ++probe;

@@ -2,6 +2,7 @@
 // furnace, a diffuse plane under the sky, glass that loses nothing, a symmetric room; the direct
 // model against paths of two vertices; and proof that parity catches a 2% energy error, a missing
 // bounce and a wrong Fresnel term in the shader.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -131,6 +132,34 @@ TEST_F(LightTransportTest, TheDirectModelIsPathsOfTwoVertices) {
     const glm::dvec3 a = mean(render(direct, {32, 32, 256}, {}, cpu)), b = mean(render(paths, {32, 32, 256}, {}, cpu));
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.02 * b[c]) << (cpu ? "CPU" : "GPU") << " channel " << c;
   }
+}
+
+TEST_F(LightTransportTest, SeedsGiveIndependentRendersThatAverage) {
+  // The same seed renders the same image; another seed another one, and the mean of renders with
+  // different seeds is nearer the converged image than either (they can be split across machines).
+  const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell-path.json");
+  const auto with_seed = [&](uint32_t seed, uint32_t spp) {
+    RenderOptions options;
+    options.seed = seed;
+    return render(scene, {24, 24, spp}, options);
+  };
+  // 9 and 1024 samples fill their strata: with 8 of 3 x 3 one cell would be empty in every render alike.
+  const Image a = with_seed(1, 9), b = with_seed(2, 9), again = with_seed(1, 9), converged = with_seed(3, 1024);
+  EXPECT_EQ(a.pixels, again.pixels);
+  EXPECT_NE(a.pixels, b.pixels);
+  const auto squared_error = [&](const auto& pixel_of) {
+    double sum = 0;
+    for (size_t i = 0; i < converged.pixels.size(); ++i) {
+      const glm::dvec3 d = pixel_of(i) - glm::dvec3(converged.pixels[i]);
+      sum += glm::dot(d, d);
+    }
+    return sum;
+  };
+  const double error_a = squared_error([&](size_t i) { return glm::dvec3(a.pixels[i]); });
+  const double error_b = squared_error([&](size_t i) { return glm::dvec3(b.pixels[i]); });
+  const double error_mean = squared_error([&](size_t i) { return (glm::dvec3(a.pixels[i]) + glm::dvec3(b.pixels[i])) / 2.0; });
+  // Independent noise halves the variance of the mean: well below the better of the two.
+  EXPECT_LT(error_mean, 0.75 * std::min(error_a, error_b));
 }
 
 class LongPathsTest : public ParityTest {};
