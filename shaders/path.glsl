@@ -21,81 +21,90 @@ float power_heuristic(float a, float b) {
   return (a * a) / (a * a + b * b);
 }
 
-vec3 path_radiance(Ray ray, inout uint stream, inout uint rays) {
-  vec3 radiance = vec3(0.0), throughput = vec3(1.0);
-  bool background_sampled = frame.background.r > 0.0 || frame.background.g > 0.0 || frame.background.b > 0.0;
-  bool after_delta = true;  // the last bounce was the camera, a mirror or glass: no light sampling to weigh against
-  float bsdf_pdf = 0.0;     // the solid-angle density of the last bounce's direction
-  float eta_product = 1.0;  // the relative indices crossed: Russian roulette undoes their radiance scaling
-  uint depth = 0u;
-  do {
-    Hit hit = trace_closest(ray, frame.epsilon, FAR);
-    if (hit.prim == NO_HIT) {
-      float weight = after_delta ? 1.0 : power_heuristic(bsdf_pdf, BACKGROUND_PDF);
-      radiance += throughput * frame.background.rgb * weight;
-      break;
-    }
-    vec3 x = ray_at(ray, hit.t);
-    Surface s = hit_surface(hit, x);
-    float cos_hit = -dot(s.geometric_normal, ray.dir);
-    bool front = cos_hit > 0.0;
-    if (SCENE_HAS_EMITTERS && front && s.emission != vec3(0.0)) {  // (0 * a grazing hit's infinite density is NaN)
-      // Light sampling finds this point with density pdf_area t^2 / cos per unit solid angle.
-      float light_pdf = area_light_pdf(s.emission) * hit.t * hit.t / cos_hit;
-      float weight = after_delta ? 1.0 : power_heuristic(bsdf_pdf, light_pdf);
-      radiance += throughput * s.emission * weight;
-    }
-    // Mitsuba's depth: a path of max_depth vertices ends here (-1, as a uint, never does).
-    if (++depth >= uint(frame.max_depth)) break;
+// A path under way: where it goes next and what it carries.
+struct PathState {
+  Ray ray;               // the next ray to trace
+  vec3 radiance;         // the light the path has brought so far
+  vec3 throughput;
+  bool after_delta;      // the last bounce was the camera, a mirror or glass: no light sampling to weigh against
+  float bsdf_pdf;        // the solid-angle density of the last bounce's direction
+  float eta_product;     // the relative indices crossed: Russian roulette undoes their radiance scaling
+  uint depth;
+};
 
-    vec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
-    vec3 n = front ? s.shading_normal : -s.shading_normal;
-    vec3 origin = x + frame.epsilon * n_geometric;  // on the side the ray came from
-    bool diffuse = !SCENE_HAS_SPECULAR || s.material_type == VKRAY_MATERIAL_DIFFUSE;
-    if (diffuse) {
-      // ---- Next-event estimation: f = albedo / pi, so each term is albedo * (incident / pi) ----------
-      vec3 irradiance = vec3(0.0);
-      add_point_lights(x, n, origin, irradiance, rays);
-      radiance += throughput * s.albedo * irradiance;
-      if (SCENE_HAS_EMITTERS) {
-        AreaLightSample light = sample_area_light_from(x, n, origin, stream, rays);
-        if (light.pdf > 0.0)
-          radiance += throughput * s.albedo * light.radiance *
+PathState start_path(Ray camera_ray) { return PathState(camera_ray, vec3(0.0), vec3(1.0), true, 0.0, 1.0, 0u); }
+
+// Traces one vertex of the path. Returns true when the path has ended: its light is p.radiance.
+// One vertex at a time, so that trace.comp can start a pixel's next sample as soon as its path ends
+// instead of waiting, masked, for the longest path among the lanes it runs with.
+bool path_step(inout PathState p, inout uint stream, inout uint rays) {
+  bool background_sampled = frame.background.r > 0.0 || frame.background.g > 0.0 || frame.background.b > 0.0;
+  Hit hit = trace_closest(p.ray, frame.epsilon, FAR);
+  if (hit.prim == NO_HIT) {
+    float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, BACKGROUND_PDF);
+    p.radiance += p.throughput * frame.background.rgb * weight;
+    return true;
+  }
+  vec3 x = ray_at(p.ray, hit.t);
+  Surface s = hit_surface(hit, x);
+  float cos_hit = -dot(s.geometric_normal, p.ray.dir);
+  bool front = cos_hit > 0.0;
+  if (SCENE_HAS_EMITTERS && front && s.emission != vec3(0.0)) {  // (0 * a grazing hit's infinite density is NaN)
+    // Light sampling finds this point with density pdf_area t^2 / cos per unit solid angle.
+    float light_pdf = area_light_pdf(s.emission) * hit.t * hit.t / cos_hit;
+    float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, light_pdf);
+    p.radiance += p.throughput * s.emission * weight;
+  }
+  // Mitsuba's depth: a path of max_depth vertices ends here (-1, as a uint, never does).
+  if (++p.depth >= uint(frame.max_depth)) return true;
+
+  vec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
+  vec3 n = front ? s.shading_normal : -s.shading_normal;
+  vec3 origin = x + frame.epsilon * n_geometric;  // on the side the ray came from
+  bool diffuse = !SCENE_HAS_SPECULAR || s.material_type == VKRAY_MATERIAL_DIFFUSE;
+  if (diffuse) {
+    // ---- Next-event estimation: f = albedo / pi, so each term is albedo * (incident / pi) ----------
+    vec3 irradiance = vec3(0.0);
+    add_point_lights(x, n, origin, irradiance, rays);
+    p.radiance += p.throughput * s.albedo * irradiance;
+    if (SCENE_HAS_EMITTERS) {
+      AreaLightSample light = sample_area_light_from(x, n, origin, stream, rays);
+      if (light.pdf > 0.0)
+        p.radiance += p.throughput * s.albedo * light.radiance *
                       (light.cos_x / (PI * light.pdf) * power_heuristic(light.pdf, light.cos_x / PI));
-      }
-      if (background_sampled) {
-        vec3 w = uniform_sphere(vec2(next_random(stream), next_random(stream)));
-        float cos_x = dot(n, w);
-        if (cos_x > 0.0) {
-          rays += 1u;
-          if (!trace_any(Ray(origin, w), frame.epsilon, FAR)) {
-            float weight = power_heuristic(BACKGROUND_PDF, cos_x / PI);
-            radiance += throughput * s.albedo * frame.background.rgb * (cos_x / (PI * BACKGROUND_PDF) * weight);
-          }
+    }
+    if (background_sampled) {
+      vec3 w = uniform_sphere(vec2(next_random(stream), next_random(stream)));
+      float cos_x = dot(n, w);
+      if (cos_x > 0.0) {
+        rays += 1u;
+        if (!trace_any(Ray(origin, w), frame.epsilon, FAR)) {
+          float weight = power_heuristic(BACKGROUND_PDF, cos_x / PI);
+          p.radiance += p.throughput * s.albedo * frame.background.rgb * (cos_x / (PI * BACKGROUND_PDF) * weight);
         }
       }
     }
+  }
 
-    // ---- The next direction ----------------------------------------------------------------------
-    BsdfSample b = sample_bsdf(s, -ray.dir, n, front, stream);
-    // A direction on the wrong side of the surface (an interpolated normal can point there) ends it.
-    if ((dot(b.dir, n_geometric) > 0.0) == b.transmitted) break;
-    throughput *= b.weight;
-    if (max(throughput.r, max(throughput.g, throughput.b)) == 0.0) break;  // a black surface ends it
-    after_delta = b.delta;
-    bsdf_pdf = b.pdf;
-    eta_product *= b.eta;
-    ray = Ray(b.transmitted ? x - frame.epsilon * n_geometric : origin, b.dir);
-    rays += 1u;
+  // ---- The next direction ------------------------------------------------------------------------
+  BsdfSample b = sample_bsdf(s, -p.ray.dir, n, front, stream);
+  // A direction on the wrong side of the surface (an interpolated normal can point there) ends it.
+  if ((dot(b.dir, n_geometric) > 0.0) == b.transmitted) return true;
+  p.throughput *= b.weight;
+  if (max(p.throughput.r, max(p.throughput.g, p.throughput.b)) == 0.0) return true;  // a black surface ends it
+  p.after_delta = b.delta;
+  p.bsdf_pdf = b.pdf;
+  p.eta_product *= b.eta;
+  p.ray = Ray(b.transmitted ? x - frame.epsilon * n_geometric : origin, b.dir);
+  rays += 1u;
 
-    // ---- Russian roulette: survive with probability q, weighted 1 / q --------------------------------
-    if (depth >= frame.rr_depth) {
-      float q = min(max(throughput.r, max(throughput.g, throughput.b)) * eta_product * eta_product, 0.95);
-      if (!(next_random(stream) < q)) break;
-      throughput /= q;
-    }
-  } while (true);
-  return radiance;
+  // ---- Russian roulette: survive with probability q, weighted 1 / q ----------------------------------
+  if (p.depth >= frame.rr_depth) {
+    float q = min(max(p.throughput.r, max(p.throughput.g, p.throughput.b)) * p.eta_product * p.eta_product, 0.95);
+    if (!(next_random(stream) < q)) return true;
+    p.throughput /= q;
+  }
+  return false;
 }
 
 #endif

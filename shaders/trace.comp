@@ -16,6 +16,30 @@ layout(local_size_x = VKRAY_WORKGROUP_X, local_size_y = VKRAY_WORKGROUP_Y, local
 layout(push_constant) uniform Tile { TileConstants tile; };
 layout(std430, set = 0, binding = VKRAY_BINDING_OUTPUT) buffer Output { vec4 radiance[]; };
 
+// Camera ray k of a pixel, through the lens when there is one, and the sample's random stream.
+Ray camera_sample(uvec2 pixel, uint pixel_index, uint k, out uint stream) {
+  // Paths jitter even a single sample: at the pixel centre it would sharpen the image.
+  vec2 xi = PATH_TRACING ? jittered_offset(pixel_index, frame.seed_key, k, frame.strata_x, frame.inv_strata_x, frame.inv_strata_y)
+                         : sample_offset(pixel_index, frame.seed_key, k, frame.samples_per_pixel, frame.strata_x,
+                                         frame.inv_strata_x, frame.inv_strata_y);
+  Ray ray = camera_ray(pixel, xi);
+  stream = sample_stream(pixel_index, frame.seed_key, k);
+  if (frame.aperture_radius > 0.0) ray = lens_ray(ray, vec2(next_random(stream), next_random(stream)));
+  return ray;
+}
+
+// llvmpipe ends every loop of an invocation early, without a word, once the invocation has made
+// 65535 loop iterations in all (host/gpu/renderer.cpp). A loop that must run twice tells: past the
+// limit it runs once. (Its count comes from the host, so that the compiler cannot unroll it.) Run
+// after each sample; if the limit ends the sample loop instead, k falls short of sample_end.
+void probe_loop_limit(inout uint rays) {
+  uint probe = 0u;
+  do {
+    ++probe;
+  } while (probe < tile.probe_iterations);
+  if (probe < tile.probe_iterations) rays |= VKRAY_LOOPS_CUT_SHORT;
+}
+
 void main() {
   load_frame();
   // The workgroup's place in the tile: its row permuted (TileConstants::row_stride).
@@ -38,26 +62,31 @@ void main() {
     rays = floatBitsToUint(so_far.a);
   }
   uint k = tile.sample_begin;
-  do {
-    // Paths jitter even a single sample: at the pixel centre it would sharpen the image.
-    vec2 xi = PATH_TRACING ? jittered_offset(pixel_index, frame.seed_key, k, frame.strata_x, frame.inv_strata_x, frame.inv_strata_y)
-                           : sample_offset(pixel_index, frame.seed_key, k, frame.samples_per_pixel, frame.strata_x,
-                                           frame.inv_strata_x, frame.inv_strata_y);
-    Ray ray = camera_ray(pixel, xi);
-    uint stream = sample_stream(pixel_index, frame.seed_key, k);
-    if (frame.aperture_radius > 0.0) ray = lens_ray(ray, vec2(next_random(stream), next_random(stream)));
+  if (PATH_TRACING) {
+    // One loop over the vertices of all the pixel's samples: a lane whose path ends starts its next
+    // sample at once, so lanes do not wait, masked, for the longest path among them (path.glsl).
+    uint stream;
+    PathState path = start_path(camera_sample(pixel, pixel_index, k, stream));
     rays += 1u;
-    sum += PATH_TRACING ? path_radiance(ray, stream, rays) : direct_radiance(ray, stream, rays);
-    // llvmpipe ends every loop of an invocation early, without a word, once the invocation has made
-    // 65535 loop iterations in all (host/gpu/renderer.cpp). A loop that must run twice tells: past
-    // the limit it runs once. (Its count comes from the host, so that the compiler cannot unroll
-    // it.) If the limit ends the sample loop instead, k falls short of sample_end.
-    uint probe = 0u;
     do {
-      ++probe;
-    } while (probe < tile.probe_iterations);
-    if (probe < tile.probe_iterations) rays |= VKRAY_LOOPS_CUT_SHORT;
-  } while (++k < tile.sample_end);
+      if (path_step(path, stream, rays)) {
+        sum += path.radiance;
+        probe_loop_limit(rays);
+        if (++k < tile.sample_end) {
+          path = start_path(camera_sample(pixel, pixel_index, k, stream));
+          rays += 1u;
+        }
+      }
+    } while (k < tile.sample_end);
+  } else {
+    do {
+      uint stream;
+      Ray ray = camera_sample(pixel, pixel_index, k, stream);
+      rays += 1u;
+      sum += direct_radiance(ray, stream, rays);
+      probe_loop_limit(rays);
+    } while (++k < tile.sample_end);
+  }
   if (k < tile.sample_end) rays |= VKRAY_LOOPS_CUT_SHORT;
   // Alpha carries the number of rays traced for this pixel (bit pattern of a uint) for the rays/s
   // figure, and VKRAY_LOOPS_CUT_SHORT.
