@@ -4,6 +4,7 @@
 #ifndef VKRAY_DIRECT_GLSL
 #define VKRAY_DIRECT_GLSL
 
+#include "aovs.glsl"
 #include "bsdf.glsl"
 #include "shade.glsl"
 #include "traversal.glsl"
@@ -14,7 +15,9 @@ vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
     Hit hit = trace_closest(ray, frame.epsilon, FAR);
     if (hit.prim == NO_HIT) return frame.background.rgb;
     vec3 x = ray_at(ray, hit.t);
-    return shade(ray, x, hit_surface(hit, x), stream, rays);
+    Surface s = hit_surface(hit, x);
+    if (FIRST_HIT_PASSES) add_first_hit(hit, x, s);
+    return shade(ray, x, s, stream, rays);
   }
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
   uint bounce = 0u;
@@ -26,6 +29,7 @@ vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
     }
     vec3 x = ray_at(ray, hit.t);
     Surface s = hit_surface(hit, x);
+    if (FIRST_HIT_PASSES && bounce == 0u) add_first_hit(hit, x, s);
     bool front = !(dot(s.geometric_normal, ray.dir) > 0.0);  // a grazing ray meets the front, as in shade()
     if (front) radiance += throughput * s.emission;
     if (s.material_type == VKRAY_MATERIAL_DIFFUSE) {

@@ -7,6 +7,7 @@
 #ifndef VKRAY_PATH_GLSL
 #define VKRAY_PATH_GLSL
 
+#include "aovs.glsl"
 #include "bsdf.glsl"
 #include "emitters.glsl"
 #include "shade.glsl"
@@ -47,6 +48,7 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   }
   vec3 x = ray_at(p.ray, hit.t);
   Surface s = hit_surface(hit, x);
+  if (FIRST_HIT_PASSES && p.depth == 0u) add_first_hit(hit, x, s);
   float cos_hit = -dot(s.geometric_normal, p.ray.dir);
   bool front = cos_hit > 0.0;
   if (SCENE_HAS_EMITTERS && front && s.emission != vec3(0.0)) {  // (0 * a grazing hit's infinite density is NaN)

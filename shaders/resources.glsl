@@ -30,5 +30,6 @@ layout(constant_id = VKRAY_SPEC_SHADOWS) const bool SHADOW_RAYS = true;
 layout(constant_id = VKRAY_SPEC_PATH) const bool PATH_TRACING = false;
 layout(constant_id = VKRAY_SPEC_EMITTERS) const bool SCENE_HAS_EMITTERS = false;
 layout(constant_id = VKRAY_SPEC_SPECULAR) const bool SCENE_HAS_SPECULAR = false;
+layout(constant_id = VKRAY_SPEC_AOVS) const bool FIRST_HIT_PASSES = false;
 
 #endif

@@ -1,10 +1,12 @@
 // vkray's tracer: one invocation per pixel of the current tile. For each sample: camera ray ->
-// radiance (the direct model, direct.glsl, or paths, path.glsl) -> average -> store linear radiance.
+// radiance (the direct model, direct.glsl, or paths, path.glsl) -> average -> store linear radiance,
+// and the first-hit passes when asked for (aovs.glsl).
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
 #include "shared/sampling.h"
 #include "shared/types.h"
+#include "aovs.glsl"
 #include "camera.glsl"
 #include "resources.glsl"
 #include "direct.glsl"
@@ -24,6 +26,7 @@ Ray camera_sample(uvec2 pixel, uint pixel_index, uint k, out uint stream) {
                                          frame.inv_strata_x, frame.inv_strata_y);
   Ray ray = camera_ray(pixel, xi);
   stream = sample_stream(pixel_index, frame.seed_key, k);
+  first_sample = k == 0u;
   if (frame.aperture_radius > 0.0) ray = lens_ray(ray, vec2(next_random(stream), next_random(stream)));
   return ray;
 }
@@ -61,6 +64,7 @@ void main() {
     sum = so_far.rgb;
     rays = floatBitsToUint(so_far.a);
   }
+  if (FIRST_HIT_PASSES) load_first_hits(index, tile.sample_begin > 0u);
   uint k = tile.sample_begin;
   if (PATH_TRACING) {
     // One loop over the vertices of all the pixel's samples: a lane whose path ends starts its next
@@ -92,4 +96,5 @@ void main() {
   // figure, and VKRAY_LOOPS_CUT_SHORT.
   vec3 stored = tile.sample_end == frame.samples_per_pixel ? sum * frame.inv_samples_per_pixel : sum;
   radiance[index] = vec4(stored, uintBitsToFloat(rays));
+  if (FIRST_HIT_PASSES) store_first_hits(index);
 }

@@ -11,9 +11,11 @@
 
 #include "base/errors.h"
 #include "gpu/context.h"
+#include "mesh/mesh.h"
 #include "session/session.h"
 #include "support/gpu_fixture.h"
 #include "support/slow_shaders.h"
+#include "support/temp_dir.h"
 
 namespace vkray::test {
 namespace {
@@ -109,6 +111,58 @@ TEST(SessionUseTest, ClosingWhileASceneIsHeldIsAnInternalError) {
   Session session(validated());
   const DeviceScene scene = session.upload(shipped("cornell.json"));
   EXPECT_THROW(session.close(), InternalError);
+}
+
+}  // namespace
+}  // namespace vkray::test
+
+namespace vkray::test {
+namespace {
+
+// A scene whose camera, lights and materials change keeps its geometry on the device; the render
+// is bit for bit what a fresh upload gives.
+class SceneEditTest : public GpuTest {};
+
+TEST_F(SceneEditTest, ACameraOrLightingEditSharesTheGeometryAndRendersAsAFreshUpload) {
+  const auto first = shipped("cornell-spheres.json");
+  auto edited = std::make_shared<Scene>(*first);
+  edited->camera.position += glm::vec3(20.0f, -10.0f, 5.0f);
+  edited->lights.at(0).intensity *= 0.5f;
+  edited->materials.at(0).albedo = glm::vec3(0.9f, 0.2f, 0.1f);
+  edited->materials.at(0).emission = glm::vec3(0.5f);  // an area light now: the emitter table changes too
+  RenderOptions options = with_image({}, {48, 48, 2});
+  const DeviceScene uploaded = session().upload(first);
+  const DeviceScene changed = session().upload_changes(uploaded, edited);
+  EXPECT_FALSE(uploaded.shares_geometry());
+  EXPECT_TRUE(changed.shares_geometry());
+  const Image reused = session().render(changed, options).image;
+  const Image fresh = session().render(session().upload(edited), options).image;
+  EXPECT_EQ(reused.pixels, fresh.pixels);
+  // The first scene renders as before beside it.
+  EXPECT_EQ(session().render(uploaded, options).image.pixels, session().render(session().upload(first), options).image.pixels);
+}
+
+TEST_F(SceneEditTest, AGeometryEditUploadsEverything) {
+  const auto first = shipped("cornell-spheres.json");
+  auto moved = std::make_shared<Scene>(*first);
+  moved->spheres.at(0).center.x += 1.0f;
+  EXPECT_FALSE(session().upload_changes(session().upload(first), moved).shares_geometry());
+  auto reassigned = std::make_shared<Scene>(*first);
+  reassigned->triangles.at(0).material = (reassigned->triangles.at(0).material + 1) % uint32_t(reassigned->materials.size());
+  EXPECT_FALSE(same_geometry(*first, *reassigned));
+}
+
+TEST(MeshCacheTest, KeepsAFileUntilItChanges) {
+  TempDir dir;
+  const auto file = dir / "tri.obj";
+  std::ofstream(file) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  MeshCache cache;
+  const auto a = cache.get(file);
+  EXPECT_EQ(cache.get(file), a);
+  std::ofstream(file) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+  const auto b = cache.get(file);
+  EXPECT_NE(b, a);
+  EXPECT_EQ(b->triangles.size(), 2u);
 }
 
 }  // namespace

@@ -20,7 +20,7 @@
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "cli/junit.h"
-#include "cli/parity_report.h"
+#include "session/parity_report.h"
 #include "cli/report.h"
 #include "session/check.h"
 #include "session/paths.h"

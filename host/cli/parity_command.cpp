@@ -12,7 +12,7 @@
 #include "base/errors.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
-#include "cli/parity_report.h"
+#include "session/parity_report.h"
 #include "cli/report.h"
 #include "image/image.h"
 #include "session/parity.h"
@@ -53,6 +53,14 @@ void print_text(const ParityResult& r, const std::string& device, const std::fil
   std::printf("silhouette and shadow edge pixels: %llu (%.2f%% of the image), of which %llu (%.3f%%) differ by > 1\n",
               static_cast<unsigned long long>(m.edge_pixels), 100.0 * double(m.edge_pixels) / double(m.pixels()),
               static_cast<unsigned long long>(m.edge_over_1), 100.0 * m.edge_share_over_1());
+  if (m.aovs_compared) {
+    std::string by_pass;
+    for (size_t pass = 0; pass < kAllAovs.size(); ++pass)
+      by_pass += std::string(pass ? ", " : "") + aov_name(kAllAovs[pass]) + " " + std::to_string(m.aov_differing_by_pass[pass]);
+    std::printf("first-hit passes (AOVs): differ on %llu pixels away from edges and %llu on them (%s)\n",
+                static_cast<unsigned long long>(m.aov_interior_differing), static_cast<unsigned long long>(m.aov_edge_differing),
+                by_pass.c_str());
+  }
   if (!diff.empty() && diff_is_pfm)
     std::printf("difference image: %s (|GPU - CPU| per channel, linear)\n", diff.string().c_str());
   else if (!diff.empty())

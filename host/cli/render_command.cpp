@@ -9,6 +9,8 @@
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "cli/report.h"
+#include "image/aovs.h"
+#include "image/exr.h"
 #include "image/image.h"
 #include "session/cpu_render.h"
 #include "session/session.h"
@@ -23,6 +25,8 @@ struct RenderArgs {
   CpuFlags cpu;
   std::filesystem::path output;  // empty: <scene name>.png in the current folder
   std::string renderer = "gpu";  // "gpu" or "cpu"
+  std::string aovs;              // --aov: first-hit passes, comma-separated (image/aovs.h)
+  bool exr_float = false;
   bool quiet = false;
 };
 
@@ -35,7 +39,14 @@ int run_render(const RenderArgs& args) {
   const std::filesystem::path output =
       args.output.empty() ? std::filesystem::path(loaded.scene->name + ".png") : args.output;
   check_output_path(output);
+  ExrContent content;
+  content.full_float = args.exr_float;
+  if (!args.aovs.empty()) content.passes = parse_aov_list(args.aovs);
+  if ((!content.passes.empty() || content.full_float) && output.extension() != ".exr")
+    throw UsageError(output.string() + ": " + (content.full_float ? "--exr-float" : "--aov") +
+                     " is for EXR files only: name the output *.exr");
   RenderOptions options = render_options(&args.scene, &args.gpu, &args.cpu);
+  options.aovs = !content.passes.empty();
   const ImageSettings image = image_settings(*loaded.scene, options);
 
   RenderResult result;
@@ -77,7 +88,7 @@ int run_render(const RenderArgs& args) {
   }
 
   const auto start = Clock::now();
-  write_image(result.image, output);
+  write_render_image(output, result.image, result.aovs ? &*result.aovs : nullptr, content);
   log(phases + " | write " + format_ms(ms_since(start)));
   log(std::to_string(result.stats.rays) + " rays (camera + shadow), " +
       format_rate(result.stats.rays, result.stats.trace_seconds) + "; total " + format_ms(ms_since(total_start)));
@@ -91,8 +102,11 @@ Command add_render_command(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* command = app.add_subcommand("render", "Render a scene to a PNG or PFM image.");
   add_scene_flags(*command, args->scene);
-  command->add_option("-o,--output", args->output, "Output image, .png (8-bit sRGB) or .pfm (float, linear); "
-                                                   "default: <scene name>.png in the current folder");
+  command->add_option("-o,--output", args->output, "Output image, .png (8-bit sRGB), .pfm (float, linear) or .exr "
+                                                   "(half float, linear); default: <scene name>.png in the current folder");
+  command->add_option("--aov", args->aovs, "First-hit passes to add to an .exr as layers, comma-separated: albedo, normal, "
+                                           "position, depth, object");
+  command->add_flag("--exr-float", args->exr_float, "Write an .exr with 32-bit float channels instead of 16-bit half");
   add_device_flags(*command, args->device);
   add_gpu_flags(*command, args->gpu);
   command->add_option("--renderer", args->renderer, "gpu (Vulkan compute shader) or cpu (the CPU reference)")

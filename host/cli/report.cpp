@@ -13,7 +13,7 @@
 namespace vkray::cli {
 
 void check_output_path(const std::filesystem::path& output) {
-  if (!is_supported_image_path(output)) throw OutputError(output.string() + ": unknown image type (expected .png or .pfm)");
+  if (!is_supported_image_path(output)) throw OutputError(output.string() + ": unknown image type (expected .png, .pfm or .exr)");
   check_output_folder(output);
 }
 

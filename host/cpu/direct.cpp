@@ -40,6 +40,7 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
       break;
     }
     const SurfacePoint s = tracer.surface(ray, hit);
+    if (bounce == 0) add_first_hit(tracer, hit, s, state);
     const Material& material = scene.materials[s.material];
     // Both normals face the incoming ray, as the geometric one decides (a grazing ray meets the front).
     const bool front = !(glm::dot(s.geometric_normal, ray.dir) > 0);

@@ -39,6 +39,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
       break;
     }
     const SurfacePoint s = tracer.surface(ray, hit);
+    if (depth == 0) add_first_hit(tracer, hit, s, state);
     const Material& material = scene.materials[s.material];
     const double cos_hit = -glm::dot(s.geometric_normal, ray.dir);
     const bool front = cos_hit > 0;

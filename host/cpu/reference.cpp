@@ -24,6 +24,7 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
   ReferenceResult result;
   result.image = Image(settings.width, settings.height);
   result.signatures.assign(size_t(settings.width) * settings.height, 0);
+  if (options.aovs) result.aovs.emplace(settings.width, settings.height);
 
   Bvh built;
   if (options.use_bvh && !options.bvh) {
@@ -57,6 +58,7 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
         const uint32_t index = j * settings.width + i;
         uint64_t signature = 0xcbf29ce484222325ull;
         dvec3 sum(0.0);
+        FirstHitSums first_hits;
         for (uint32_t k = 0; k < settings.samples_per_pixel; ++k) {
           // Paths jitter even a single sample (shaders/trace.comp).
           const glm::vec2 xi =
@@ -65,6 +67,8 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
           const double x = i + double(xi.x) - half_w, y = half_h - (j + double(xi.y));
           Ray ray{origin, glm::normalize(x * right + y * up + double(cam.focal_px) * forward)};
           SampleState state{gpu::sample_stream(index, seed, k), signature};
+          state.first_hit = options.aovs ? &first_hits : nullptr;
+          state.first_sample = k == 0;
           if (aperture > 0) {  // the thin lens: from a point of the lens to where the pinhole ray meets the plane of focus
             const double u1 = gpu::next_random(state.stream), u2 = gpu::next_random(state.stream);
             const glm::dvec2 disk = aperture * concentric_disk(u1, u2);
@@ -78,6 +82,7 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
         }
         result.image.pixels[index] = glm::vec3(sum / double(settings.samples_per_pixel));
         result.signatures[index] = signature;
+        if (options.aovs) result.aovs->set(i, j, first_hits);
       }
       if (options.progress && !cancelled) {
         std::lock_guard lock(progress_mutex);

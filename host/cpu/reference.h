@@ -8,6 +8,9 @@
 #include <functional>
 #include <vector>
 
+#include <optional>
+
+#include "image/aovs.h"
 #include "image/image.h"
 #include "scene/scene.h"
 
@@ -22,6 +25,7 @@ struct ReferenceOptions {
   bool use_bvh = true;   // false: test every primitive (slow; checks the traversal)
   const Bvh* bvh = nullptr;  // a BVH already built for this scene; null: build one
   bool shadows = true;   // false: no shadow rays, every light counts as visible (benchmarks)
+  bool aovs = false;     // also the first-hit passes (image/aovs.h)
   std::function<void(uint32_t rows_done, uint32_t rows)> progress;  // called under a lock
   // On an interrupt request (base/interrupt.h) the threads stop and render_reference throws
   // Cancelled.
@@ -29,6 +33,7 @@ struct ReferenceOptions {
 
 struct ReferenceResult {
   Image image;
+  std::optional<Aovs> aovs;  // when ReferenceOptions::aovs asked for them
   // Per pixel, a hash of what each sample saw (the primitive hit and the lights that lit it). Two
   // neighbouring pixels with different signatures straddle a silhouette or shadow edge.
   std::vector<uint64_t> signatures;

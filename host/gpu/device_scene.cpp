@@ -58,8 +58,18 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
 
 }  // namespace
 
-struct GpuScene::Buffers {
-  TexelBuffer primitives, normals, nodes, materials, lights, emitters;
+struct GpuScene::Geometry {
+  TexelBuffer primitives, normals, nodes;
+  std::vector<uint32_t> order;  // the BVH's leaf order: the lighting's area lights name slots in it
+};
+
+struct GpuScene::Lighting {
+  TexelBuffer materials, lights, emitters;
+
+  Lighting(const Context& ctx, const PackedLighting& packed)
+      : materials(make_texel_buffer(ctx, packed.materials, "material")),
+        lights(make_texel_buffer(ctx, packed.lights, "light")),
+        emitters(make_texel_buffer(ctx, packed.emitters, "area light")) {}
 };
 
 GpuScene::GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* prebuilt)
@@ -73,27 +83,40 @@ GpuScene::GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Sce
   const PackedScene packed = pack_scene(*scene_, bvh);
   if (primitive_count_ <= kMaxInlinePrimitives) inline_scene_ = inline_scene_glsl(packed);
   check_memory(*ctx_, packed);
-  buffers_ = std::make_unique<Buffers>(Buffers{make_texel_buffer(*ctx_, packed.primitives, "primitive"),
-                                               make_texel_buffer(*ctx_, packed.normals, "normal"),
-                                               make_texel_buffer(*ctx_, packed.nodes, "BVH node"),
-                                               make_texel_buffer(*ctx_, packed.materials, "material"),
-                                               make_texel_buffer(*ctx_, packed.lights, "light"),
-                                               make_texel_buffer(*ctx_, packed.emitters, "area light")});
+  geometry_ = std::make_shared<const Geometry>(Geometry{make_texel_buffer(*ctx_, packed.primitives, "primitive"),
+                                                        make_texel_buffer(*ctx_, packed.normals, "normal"),
+                                                        make_texel_buffer(*ctx_, packed.nodes, "BVH node"), bvh.order});
+  lighting_ = std::make_unique<Lighting>(*ctx_, packed);
   emitters_ = packed.emitter_frame;
   // A BVH built beforehand (perhaps while the shaders compiled) still counts: the upload stage
   // reports the build's own time.
   upload_seconds_ = seconds_since(start) + (prebuilt ? prebuilt->build_seconds : 0.0);
 }
 
+GpuScene::GpuScene(const GpuScene& same, std::shared_ptr<const Scene> scene)
+    : ctx_(same.ctx_),
+      scene_(std::move(scene)),
+      geometry_(same.geometry_),
+      primitive_count_(same.primitive_count_),
+      inline_scene_(same.inline_scene_),
+      shares_geometry_(true) {
+  if (!same_geometry(same.scene(), *scene_)) throw InternalError("a scene shares the device buffers of one with other geometry");
+  const auto start = Clock::now();
+  const PackedLighting packed = pack_lighting(*scene_, geometry_->order);
+  lighting_ = std::make_unique<Lighting>(*ctx_, packed);
+  emitters_ = packed.emitter_frame;
+  upload_seconds_ = seconds_since(start);
+}
+
 GpuScene::~GpuScene() = default;
 
 void GpuScene::bind(DescriptorWriter& writer) const {
-  writer.texel_buffer(VKRAY_BINDING_PRIMITIVES, *buffers_->primitives.view)
-      .texel_buffer(VKRAY_BINDING_NORMALS, *buffers_->normals.view)
-      .texel_buffer(VKRAY_BINDING_NODES, *buffers_->nodes.view)
-      .texel_buffer(VKRAY_BINDING_MATERIALS, *buffers_->materials.view)
-      .texel_buffer(VKRAY_BINDING_LIGHTS, *buffers_->lights.view)
-      .texel_buffer(VKRAY_BINDING_EMITTERS, *buffers_->emitters.view);
+  writer.texel_buffer(VKRAY_BINDING_PRIMITIVES, *geometry_->primitives.view)
+      .texel_buffer(VKRAY_BINDING_NORMALS, *geometry_->normals.view)
+      .texel_buffer(VKRAY_BINDING_NODES, *geometry_->nodes.view)
+      .texel_buffer(VKRAY_BINDING_MATERIALS, *lighting_->materials.view)
+      .texel_buffer(VKRAY_BINDING_LIGHTS, *lighting_->lights.view)
+      .texel_buffer(VKRAY_BINDING_EMITTERS, *lighting_->emitters.view);
 }
 
 }  // namespace vkray::gpu

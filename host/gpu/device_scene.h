@@ -23,6 +23,9 @@ class GpuScene {
   // `bvh`: one already built for this scene (parity traverses the same one on the CPU); null builds
   // one. Throws DeviceError naming the limit when a buffer or the whole does not fit the device.
   GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* bvh = nullptr);
+  // `scene`, whose geometry is `same`'s (same_geometry): shares `same`'s BVH and primitive buffers,
+  // and uploads only its lighting (materials, lights, area lights).
+  GpuScene(const GpuScene& same, std::shared_ptr<const Scene> scene);
   ~GpuScene();
 
   const Scene& scene() const { return *scene_; }
@@ -33,20 +36,24 @@ class GpuScene {
   uint32_t primitive_count() const { return primitive_count_; }
   double bvh_seconds() const { return bvh_seconds_; }
   double upload_seconds() const { return upload_seconds_; }  // BVH build included, prebuilt or not
+  bool shares_geometry() const { return shares_geometry_; }  // made by the second constructor
   const EmitterFrame& emitters() const { return emitters_; }
 
   // Adds the scene's buffers at their bindings (shared/types.h).
   void bind(DescriptorWriter& writer) const;
 
  private:
-  struct Buffers;
+  struct Geometry;
+  struct Lighting;
   std::shared_ptr<const Context> ctx_;  // first: destroyed last
   std::shared_ptr<const Scene> scene_;
-  std::unique_ptr<Buffers> buffers_;
+  std::shared_ptr<const Geometry> geometry_;  // shared by the scenes made from this one
+  std::unique_ptr<Lighting> lighting_;
   uint32_t primitive_count_ = 0;
   std::string inline_scene_;
   EmitterFrame emitters_;
   double bvh_seconds_ = 0, upload_seconds_ = 0;
+  bool shares_geometry_ = false;
 };
 
 }  // namespace vkray::gpu

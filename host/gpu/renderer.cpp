@@ -76,6 +76,7 @@ struct Renderer::Frame {
   std::shared_ptr<const vk::raii::Pipeline> pipeline;
   Buffer uniforms;
   Buffer output;  // two tiles' slots: one traced while the other is read back
+  Buffer aov_output;  // the same slots' first-hit passes (a placeholder when not asked for)
   std::optional<DescriptorSet> descriptors;
   vk::raii::CommandPool command_pool{nullptr};
   vk::raii::CommandBuffers command_buffers{nullptr};  // one per slot
@@ -113,7 +114,7 @@ bool Renderer::busy(std::chrono::milliseconds wait) {
 }
 
 Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std::shared_ptr<const GpuScene> scene,
-                       const TraceRequest& request, TraceStats* stats_out) {
+                       const TraceRequest& request, TraceStats* stats_out, Aovs* aovs_out) {
   if (busy(request.tile_timeout))
     throw TimeoutError("the device is still running a render tile that timed out before, " +
                        std::to_string(request.tile_timeout.count()) + " ms later");
@@ -128,7 +129,11 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   // request.tile_side when asked for, and otherwise bands sized by SubmissionSizer.
   constexpr uint32_t kSlots = 2;
   constexpr uint32_t kGranule = VKRAY_WORKGROUP_X;
-  const uint64_t slot_limit = ctx_->limits().maxStorageBufferRange / (kSlots * sizeof(glm::vec4));
+  const bool aovs = request.variant.aovs;
+  if (aovs && !aovs_out) throw InternalError("a render of the first-hit passes with nowhere to put them");
+  // The larger of the two outputs per pixel bounds a slot: the AOVs' when asked for.
+  const uint64_t pixel_bytes = (aovs ? VKRAY_TEXELS_PER_AOV_PIXEL : 1) * sizeof(glm::vec4);
+  const uint64_t slot_limit = ctx_->limits().maxStorageBufferRange / (kSlots * pixel_bytes);
   const uint64_t image_pixels = uint64_t(image.width) * image.height;
   const bool fixed_tiles = request.tile_side > 0;
   uint32_t side = request.tile_side;
@@ -137,12 +142,13 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   // The least a slot must hold: the square asked for, or the smallest piece a submission may be.
   const uint64_t needed = fixed_tiles ? square_pixels() : std::min<uint64_t>(image_pixels, kGranule * kGranule);
   if (needed > slot_limit)
-    throw DeviceError("a render tile does not fit " + ctx_->device_name() + ": " + std::to_string(kSlots * needed * sizeof(glm::vec4)) +
+    throw DeviceError("a render tile does not fit " + ctx_->device_name() + ": " + std::to_string(kSlots * needed * pixel_bytes) +
                       " bytes of output, maxStorageBufferRange is " + std::to_string(ctx_->limits().maxStorageBufferRange));
   const uint64_t slot_pixels =
       fixed_tiles ? needed : std::min({kMostSlotPixels, slot_limit, std::max<uint64_t>(image_pixels, kGranule * kGranule)});
   const vk::DeviceSize output_bytes = kSlots * slot_pixels * sizeof(glm::vec4);
   Image result(image.width, image.height);  // the host's copy, filled tile by tile
+  if (aovs) *aovs_out = Aovs(image.width, image.height);
   auto frame = std::make_unique<Frame>();
   frame->trace_pipeline = std::move(trace_pipeline);
   frame->scene = std::move(scene);
@@ -150,8 +156,11 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   frame->uniforms = upload_buffer(*ctx_, &uniforms, sizeof(uniforms), vk::BufferUsageFlagBits::eUniformBuffer);
   using M = vk::MemoryPropertyFlagBits;
   frame->output = create_buffer(*ctx_, output_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
+  const vk::DeviceSize aov_bytes = aovs ? output_bytes * VKRAY_TEXELS_PER_AOV_PIXEL : sizeof(glm::vec4) * VKRAY_TEXELS_PER_AOV_PIXEL;
+  frame->aov_output = create_buffer(*ctx_, aov_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
   DescriptorWriter writer = frame->trace_pipeline->descriptors().writer();
   writer.buffer(VKRAY_BINDING_FRAME, *frame->uniforms.buffer).buffer(VKRAY_BINDING_OUTPUT, *frame->output.buffer);
+  writer.buffer(VKRAY_BINDING_AOVS, *frame->aov_output.buffer);
   frame->scene->bind(writer);
   frame->descriptors = writer.write();
   stats.upload_seconds = seconds_since(start);
@@ -259,6 +268,22 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
         result.at(tile.x0 + x, tile.y0 + y) = glm::vec3(texel);
         stats.rays += std::bit_cast<uint32_t>(texel.w);
       }
+    if (aovs) {
+      frame->aov_output.invalidate(device);
+      const auto* aov_texels = static_cast<const glm::vec4*>(frame->aov_output.mapped) + size_t(tile.output_offset) * VKRAY_TEXELS_PER_AOV_PIXEL;
+      for (uint32_t y = 0; y < tile.height; ++y)
+        for (uint32_t x = 0; x < tile.width; ++x) {
+          const glm::vec4* t = aov_texels + (size_t(y) * tile.width + x) * VKRAY_TEXELS_PER_AOV_PIXEL;
+          FirstHitSums sums;  // shaders/aovs.glsl's layout (shared/types.h)
+          sums.albedo = glm::vec3(t[0]);
+          sums.hits = std::bit_cast<uint32_t>(t[0].w);
+          sums.normal = glm::vec3(t[1]);
+          sums.object = std::bit_cast<int32_t>(t[1].w);
+          sums.position = glm::vec3(t[2]);
+          sums.depth = t[2].w;
+          aovs_out->set(tile.x0 + x, tile.y0 + y, sums);
+        }
+    }
     pixels_done += done.rect.pixels();
     readback_seconds += seconds_since(read_start);
     if (request.progress) request.progress(uint32_t(pixels_done), uint32_t(image_pixels));

@@ -13,6 +13,7 @@
 #include "gpu/context.h"
 #include "gpu/device_scene.h"
 #include "gpu/pipeline.h"
+#include "image/aovs.h"
 #include "image/image.h"
 #include "scene/scene.h"
 
@@ -46,13 +47,14 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Renders `scene` with `pipeline`'s variant for the request. Throws TimeoutError when a tile
+  // Renders `scene` with `pipeline`'s variant for the request; with request.variant.aovs, also the
+  // first-hit passes, into `aovs`. Throws TimeoutError when a tile
   // outlives request.tile_timeout (its work may go on: what it uses is kept until it finishes, and
   // the next render first waits up to its own tile timeout for it), Cancelled on an interrupt
   // request (a tile still running is kept the same way), and DeviceError or vk::SystemError for
   // failed calls.
   Image render(std::shared_ptr<const TracePipeline> pipeline, std::shared_ptr<const GpuScene> scene,
-               const TraceRequest& request, TraceStats* stats = nullptr);
+               const TraceRequest& request, TraceStats* stats = nullptr, Aovs* aovs = nullptr);
 
   // Whether work of a timed-out render is still running, after waiting up to `wait` for it. What
   // finished work used is released.

@@ -25,6 +25,7 @@
 #include "base/check.h"
 #include "base/errors.h"
 #include "base/interrupt.h"
+#include "image/exr.h"
 
 namespace vkray {
 namespace {
@@ -236,14 +237,15 @@ float decode_srgb8(uint8_t encoded) {
 
 bool is_supported_image_path(const std::filesystem::path& file) {
   const std::string ext = lower_extension(file);
-  return ext == ".png" || ext == ".pfm";
+  return ext == ".png" || ext == ".pfm" || ext == ".exr";
 }
 
 void write_image(const Image& image, const std::filesystem::path& file) {
   const std::string ext = lower_extension(file);
   if (ext == ".png") return write_png(image, file);
   if (ext == ".pfm") return write_pfm(image, file);
-  throw OutputError(file.string() + ": unknown image type \"" + ext + "\" (expected .png or .pfm)");
+  if (ext == ".exr") return write_exr(file, image, nullptr, {});
+  throw OutputError(file.string() + ": unknown image type \"" + ext + "\" (expected .png, .pfm or .exr)");
 }
 
 Image read_pfm(const std::filesystem::path& file) {

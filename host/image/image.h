@@ -1,4 +1,5 @@
-// Linear-radiance images and the files they are written to: 8-bit sRGB PNG and 32-bit float PFM.
+// Linear-radiance images and the files they are written to: 8-bit sRGB PNG, 32-bit float PFM, and
+// OpenEXR (image/exr.h, which also writes the first-hit passes).
 #pragma once
 
 #include <cstdint>
@@ -27,8 +28,8 @@ uint8_t encode_srgb8(float linear);
 uint8_t encode_srgb8_by_formula(float linear);
 float decode_srgb8(uint8_t encoded);
 
-// Writes by extension: ".png" (8-bit sRGB) or ".pfm" (32-bit float linear, rows bottom to top,
-// little-endian). The file is written under a temporary name in the same folder and renamed into
+// Writes by extension: ".png" (8-bit sRGB), ".pfm" (32-bit float linear, rows bottom to top,
+// little-endian) or ".exr" (16-bit half float linear RGB; write_exr for more). The file is written under a temporary name in the same folder and renamed into
 // place, so a failure never leaves a partial image. Throws OutputError.
 void write_image(const Image& image, const std::filesystem::path& file);
 

@@ -82,6 +82,41 @@ ParityMetrics compare_images(const Image& gpu, const Image& reference, const std
   return m;
 }
 
+void compare_aovs(const Aovs& gpu, const Aovs& reference, const std::vector<uint64_t>& signatures, double scene_extent,
+                  const ParityTolerance& tolerance, ParityMetrics& m) {
+  const double length_tolerance = 1e-4 * scene_extent;
+  const auto close = [](glm::vec3 a, glm::vec3 b, double allowed) {
+    for (int c = 0; c < 3; ++c)
+      if (!(std::abs(double(a[c]) - double(b[c])) <= allowed)) return false;  // (a NaN is not close)
+    return true;
+  };
+  m.aovs_compared = true;
+  for (uint32_t y = 0; y < m.height; ++y)
+    for (uint32_t x = 0; x < m.width; ++x) {
+      const size_t i = size_t(y) * m.width + x;
+      const float ref_albedo = std::max({1.0f, reference.albedo[i].r, reference.albedo[i].g, reference.albedo[i].b});
+      const bool depth_agrees = std::isinf(reference.depth[i]) ? std::isinf(gpu.depth[i]) && gpu.depth[i] > 0
+                                                               : std::abs(double(gpu.depth[i]) - reference.depth[i]) <= length_tolerance;
+      const bool differs[kAllAovs.size()] = {
+          !close(gpu.albedo[i], reference.albedo[i], 1e-4 * ref_albedo), !close(gpu.normal[i], reference.normal[i], 1e-3),
+          !close(gpu.position[i], reference.position[i], length_tolerance), !depth_agrees, gpu.object[i] != reference.object[i]};
+      bool any = false;
+      for (size_t pass = 0; pass < kAllAovs.size(); ++pass) {
+        m.aov_differing_by_pass[pass] += differs[pass];
+        any = any || differs[pass];
+      }
+      if (!any) continue;
+      const bool edge = on_edge(signatures, m.width, m.height, x, y);
+      ++m.aov_differing;
+      m.aov_edge_differing += edge;
+      m.aov_interior_differing += !edge;
+    }
+  const bool aovs_pass = tolerance.stochastic ? m.aov_share() <= tolerance.max_share_over_1
+                                              : m.aov_edge_share() <= tolerance.max_edge_share_over_1 &&
+                                                    m.aov_interior_differing <= tolerance.max_interior_over_1;
+  m.pass = m.pass && aovs_pass;
+}
+
 Image difference_heatmap(const Image& a, const Image& reference, int& max_steps) {
   max_steps = 0;
   for (size_t i = 0; i < a.pixels.size(); ++i) max_steps = std::max(max_steps, srgb_step_difference(a.pixels[i], reference.pixels[i]));
@@ -133,6 +168,15 @@ std::string describe_metrics(const ParityMetrics& m) {
                 m.worst_x, m.worst_y, m.mean_relative * 100.0);
   std::string result = text;
   if (m.non_finite > 0) result += "; " + std::to_string(m.non_finite) + " GPU pixels are NaN or infinite";
+  if (m.aovs_compared) {
+    result += "; first-hit passes differ on " + std::to_string(m.aov_interior_differing) + " pixels away from edges and " +
+              std::to_string(m.aov_edge_differing) + " on them";
+    std::string which;
+    for (size_t pass = 0; pass < kAllAovs.size(); ++pass)
+      if (m.aov_differing_by_pass[pass] > 0)
+        which += std::string(which.empty() ? "" : ", ") + aov_name(kAllAovs[pass]) + " " + std::to_string(m.aov_differing_by_pass[pass]);
+    if (!which.empty()) result += " (" + which + ")";
+  }
   return result;
 }
 

@@ -2,10 +2,12 @@
 // can read at a glance.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "image/aovs.h"
 #include "image/image.h"
 
 namespace vkray {
@@ -42,18 +44,32 @@ struct ParityMetrics {
   uint32_t worst_x = 0, worst_y = 0;                   // where max_abs is
   double mean_relative = 0;  // largest over channels of |mean GPU - mean CPU| / mean CPU (0 when both are 0)
   uint64_t non_finite = 0;   // GPU pixels with a NaN or infinite channel: never within any tolerance
+  // The first-hit passes (compare_aovs), judged as the image is: pixels where any pass differs beyond
+  // float precision, by where they are, and per pass (in kAllAovs order).
+  bool aovs_compared = false;
+  uint64_t aov_differing = 0, aov_interior_differing = 0, aov_edge_differing = 0;
+  std::array<uint64_t, kAllAovs.size()> aov_differing_by_pass{};
   bool pass = false;
 
   uint64_t pixels() const { return uint64_t(width) * height; }
   double share_over_1() const { return pixels() ? double(over_1) / double(pixels()) : 0; }
   double share_over_2() const { return pixels() ? double(over_2) / double(pixels()) : 0; }
   double edge_share_over_1() const { return edge_pixels ? double(edge_over_1) / double(edge_pixels) : 0; }
+  double aov_share() const { return pixels() ? double(aov_differing) / double(pixels()) : 0; }
+  double aov_edge_share() const { return edge_pixels ? double(aov_edge_differing) / double(edge_pixels) : 0; }
 };
 
 // `signatures` (one per pixel, from the CPU reference) mark edges: a pixel is on an edge when its
 // signature differs from one of its 4 neighbours'.
 ParityMetrics compare_images(const Image& gpu, const Image& reference, const std::vector<uint64_t>& signatures,
                              const ParityTolerance& tolerance = {});
+
+// Adds the comparison of the first-hit passes to `metrics` (from compare_images, whose edges it
+// uses) and judges it by the tolerance's rule for the image: a pass differs at a pixel where the
+// object ids differ, or a value beyond float precision: 1e-4 of the value for albedo, 1e-3 for a
+// normal, 1e-4 of `scene_extent` for position and depth (or one depth is infinite, the other not).
+void compare_aovs(const Aovs& gpu, const Aovs& reference, const std::vector<uint64_t>& signatures, double scene_extent,
+                  const ParityTolerance& tolerance, ParityMetrics& metrics);
 
 // What a person can see: per pixel, the largest difference of the 8-bit sRGB values over the
 // channels. 0 shows as a faint grey copy of `reference`; 1 step is dark purple, rising through red

@@ -27,7 +27,7 @@ std::string vec3_literal(const glm::vec4& v) {
 
 }  // namespace
 
-std::string inline_scene_glsl(const PackedScene& packed) {
+std::string inline_scene_glsl(const PackedGeometry& packed) {
   const size_t count = packed.primitives.size() / VKRAY_TEXELS_PER_PRIMITIVE;
   if (count == 0) return {};
   // Buffer order is the BVH's; the tests go in the scene's order (texel b.w), which is the order

@@ -19,6 +19,6 @@ constexpr uint32_t kMaxInlinePrimitives = 32;
 // (shear_point) and tests every primitive once, in the scene's order, with sheared_triangle or
 // intersect_sphere, coordinates as literals (exact: 17 significant digits), keeping the hit's place
 // in the primitive buffer. Empty when the scene has no primitives.
-std::string inline_scene_glsl(const PackedScene& packed);
+std::string inline_scene_glsl(const PackedGeometry& packed);
 
 }  // namespace vkray::gpu

@@ -196,6 +196,13 @@ FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const Emi
 
 PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
   PackedScene packed;
+  static_cast<PackedGeometry&>(packed) = pack_geometry(scene, bvh);
+  static_cast<PackedLighting&>(packed) = pack_lighting(scene, bvh.order);
+  return packed;
+}
+
+PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
+  PackedGeometry packed;
   const size_t triangle_count = scene.triangles.size();
   const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
   packed.primitives.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);
@@ -207,12 +214,13 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
       PrimitiveTexels texels;
       if (p < triangle_count) {
         const Triangle& t = scene.triangles[p];
-        texels = triangle_texels(t.v[0], t.v[1], t.v[2], t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u), p);
+        texels = triangle_texels(t.v[0], t.v[1], t.v[2], t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u), p, t.object);
         if (t.smooth)
           for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
       } else {
         const Sphere& sphere = scene.spheres[p - triangle_count];
-        texels = sphere_texels(sphere.center, sphere.radius, sphere.material | (sphere.inward ? VKRAY_PRIM_INWARD : 0u), p);
+        texels = sphere_texels(sphere.center, sphere.radius, sphere.material | (sphere.inward ? VKRAY_PRIM_INWARD : 0u), p,
+                               sphere.object);
       }
       glm::vec4* out = &packed.primitives[slot * VKRAY_TEXELS_PER_PRIMITIVE];
       out[0] = texels.a;
@@ -221,6 +229,11 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
     }
   });
   packed.nodes = pack_nodes(bvh);
+  return packed;
+}
+
+PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& order) {
+  PackedLighting packed;
   packed.materials.resize(scene.materials.size() * VKRAY_TEXELS_PER_MATERIAL);
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
@@ -230,8 +243,8 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
   // The area lights, their primitives as slots in the primitive buffer.
   const EmitterTable table = build_emitter_table(scene);
   if (!table.entries.empty()) {
-    std::vector<uint32_t> slot_of(bvh.order.size());
-    for (size_t slot = 0; slot < bvh.order.size(); ++slot) slot_of[bvh.order[slot]] = uint32_t(slot);
+    std::vector<uint32_t> slot_of(order.size());
+    for (size_t slot = 0; slot < order.size(); ++slot) slot_of[order[slot]] = uint32_t(slot);
     for (const EmitterTable::Entry& e : table.entries)
       packed.emitters.push_back(glm::vec4(e.probability, uintBitsToFloat(e.alias), uintBitsToFloat(slot_of[e.primitive]), 0.0f));
     packed.emitter_frame = {uint32_t(table.entries.size()), float(1.0 / table.total_weight)};

@@ -20,18 +20,29 @@ struct EmitterFrame {
   float inv_weight = 0.0f;
 };
 
-// The scene's buffers; the per-frame uniforms come from pack_frame().
-struct PackedScene {
+// The buffers that depend on the primitives alone (same_geometry), which a scene whose camera,
+// lights or materials change keeps on the device.
+struct PackedGeometry {
   std::vector<glm::vec4> primitives;  // PrimitiveTexels (shared/scene_layout.h) each, in BVH leaf order
   std::vector<glm::vec4> normals;     // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when nothing is smooth
   std::vector<glm::uvec4> nodes;      // VKRAY_TEXELS_PER_NODE texels each (pack_nodes)
+};
+
+// The buffers of what lights the scene.
+struct PackedLighting {
   std::vector<glm::vec4> materials;   // VKRAY_TEXELS_PER_MATERIAL texels each
   std::vector<glm::vec4> lights;      // VKRAY_TEXELS_PER_LIGHT texels each
   std::vector<glm::vec4> emitters;    // VKRAY_TEXELS_PER_EMITTER texels each (scene/emitters.h)
   EmitterFrame emitter_frame;
 };
 
+// The scene's buffers; the per-frame uniforms come from pack_frame().
+struct PackedScene : PackedGeometry, PackedLighting {};
+
 PackedScene pack_scene(const Scene& scene, const Bvh& bvh);
+PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh);
+// `order`: the BVH's leaf order (Bvh::order) of the primitive buffer the lighting goes with.
+PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& order);
 
 // The binary BVH as the shader reads it: 4-wide nodes, each a binary node with its children's
 // children, child boxes quantized to 8 bits per side (layout in shaders/shared/scene_layout.h). Empty when

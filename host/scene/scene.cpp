@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include <glm/gtc/constants.hpp>
@@ -15,6 +16,7 @@
 #include "base/input_file.h"
 #include "base/interrupt.h"
 #include "mesh/load.h"
+#include "mesh/mesh.h"
 #include "mesh/normals.h"
 #include "scene/json_document.h"
 #include "scene/transform.h"
@@ -44,7 +46,7 @@ struct Value {
 
 class SceneParser {
  public:
-  SceneParser(const std::filesystem::path& file, Scene& scene) : file_(file), scene_(scene) {}
+  SceneParser(const std::filesystem::path& file, Scene& scene, MeshCache& meshes) : file_(file), scene_(scene), meshes_(meshes) {}
 
   void parse(const json& root);
 
@@ -137,7 +139,9 @@ class SceneParser {
   const std::filesystem::path& file_;
   Scene& scene_;
   std::map<std::string, uint32_t> material_index_;
-  std::map<std::filesystem::path, Mesh> meshes_;  // each file loaded once, however often it is used
+  MeshCache& meshes_;  // each file loaded once, however often it is used
+  std::set<std::filesystem::path> referenced_;  // the files in scene_.referenced_files
+  uint32_t object_ = 0;  // the index in "objects" of the object being parsed
 };
 
 void SceneParser::parse(const json& root_json) {
@@ -161,7 +165,10 @@ void SceneParser::parse(const json& root_json) {
   if (root.has("objects")) {
     const Value objects = root["objects"];
     expect_array(objects);
-    for (size_t i = 0; i < objects.j.size(); ++i) parse_object(objects[i]);
+    for (size_t i = 0; i < objects.j.size(); ++i) {
+      object_ = static_cast<uint32_t>(i);
+      parse_object(objects[i]);
+    }
   }
   const bool path = scene_.integrator.type == Integrator::Type::path;
   if (path && scene_.ambient != glm::vec3(0.0f))
@@ -385,6 +392,7 @@ void SceneParser::parse_object(const Value& v) {
     sphere.center = vec3(require(v, "center"));
     sphere.radius = positive(require(v, "radius"));
     sphere.material = material_ref(require(v, "material"));
+    sphere.object = object_;
     if (v.has("transform")) {
       const auto s = uniform_scale_of(transform);
       if (!s) fail(v["transform"], "a sphere takes only a uniform scale (with rotation and translation)");
@@ -413,6 +421,7 @@ void SceneParser::parse_object(const Value& v) {
       if (!tri.j.is_array() || tri.j.size() != 3) fail(tri, "expected an array of 3 vertex indices, got " + brief(tri.j));
       Triangle t;
       t.material = material;
+      t.object = object_;
       for (size_t k = 0; k < 3; ++k) {
         const Value idx = tri[k];
         if (!idx.j.is_number_integer() || idx.j.get<int64_t>() < 0 ||
@@ -479,25 +488,26 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
     if (!v["smooth"].j.is_boolean()) fail(v["smooth"], std::string("expected true or false, got ") + v["smooth"].j.type_name());
     smooth = v["smooth"].j.get<bool>();
   }
-  auto cached = meshes_.find(file);
-  if (cached == meshes_.end()) {
-    try {
-      cached = meshes_.emplace(file, load_mesh(file)).first;
-    } catch (const MeshError& e) {
-      throw MeshError(file_.string() + ": " + file_value.path + ": " + e.what());
-    }
+  std::shared_ptr<const Mesh> loaded;
+  try {
+    loaded = meshes_.get(file);
+  } catch (const MeshError& e) {
+    throw MeshError(file_.string() + ": " + file_value.path + ": " + e.what());
+  }
+  if (referenced_.insert(file).second) {
     scene_.referenced_files.push_back(file);
-    if (cached->second.polygons_split > 0)
-      warn(file_value, file.filename().string() + ": " + std::to_string(cached->second.polygons_split) +
+    if (loaded->polygons_split > 0)
+      warn(file_value, file.filename().string() + ": " + std::to_string(loaded->polygons_split) +
                            " faces with more than 3 vertices split into triangles");
   }
-  const Mesh& mesh = cached->second;
+  const Mesh& mesh = *loaded;
 
   std::vector<glm::vec3> points(mesh.positions.size());
   for (size_t i = 0; i < points.size(); ++i) points[i] = transform_point(transform, mesh.positions[i]);
   std::vector<Triangle> triangles(mesh.triangles.size());
   for (size_t i = 0; i < triangles.size(); ++i) {
     triangles[i].material = material;
+    triangles[i].object = object_;
     for (int k = 0; k < 3; ++k) triangles[i].v[size_t(k)] = points[mesh.triangles[i][size_t(k)]];
   }
   if (smooth) {
@@ -542,20 +552,47 @@ float Scene::extent() const {
   return e;
 }
 
-Scene parse_scene(std::string_view json_text, const std::filesystem::path& file) {
+bool same_geometry(const Scene& a, const Scene& b) {
+  // Materials are compared by index (a primitive's flags hold it), not by value.
+  return a.triangles == b.triangles && a.spheres == b.spheres && a.materials.size() == b.materials.size();
+}
+
+struct MeshCache::Entry {
+  uintmax_t size = 0;
+  std::filesystem::file_time_type modified;
+  std::shared_ptr<const Mesh> mesh;
+};
+
+MeshCache::MeshCache() = default;
+MeshCache::~MeshCache() = default;
+
+std::shared_ptr<const Mesh> MeshCache::get(const std::filesystem::path& file) {
+  std::error_code size_error, time_error;
+  const uintmax_t size = std::filesystem::file_size(file, size_error);
+  const auto modified = std::filesystem::last_write_time(file, time_error);
+  const auto found = entries_.find(file);
+  if (!size_error && !time_error && found != entries_.end() && found->second.size == size && found->second.modified == modified)
+    return found->second.mesh;
+  auto mesh = std::make_shared<const Mesh>(load_mesh(file));
+  if (!size_error && !time_error) entries_[file] = Entry{size, modified, mesh};
+  return mesh;
+}
+
+Scene parse_scene(std::string_view json_text, const std::filesystem::path& file, MeshCache* meshes) {
   const json root = parse_json_document(json_text, file);
   Scene scene;
   scene.file = file;
   scene.name = file.stem().string();
-  SceneParser(file, scene).parse(root);
+  MeshCache this_scene;
+  SceneParser(file, scene, meshes ? *meshes : this_scene).parse(root);
   return scene;
 }
 
-Scene load_scene(const std::filesystem::path& file) {
+Scene load_scene(const std::filesystem::path& file, MeshCache* meshes) {
   if (file.empty()) throw SceneError("the scene file name is empty");
   const InputFile input = read_input_file(file, kMaxSceneFileBytes);
   if (!input.error.empty()) throw SceneError(file.string() + ": " + input.error);
-  return parse_scene(input.text, file);
+  return parse_scene(input.text, file, meshes);
 }
 
 }  // namespace vkray

@@ -7,6 +7,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <map>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -87,14 +89,20 @@ struct Sphere {
   glm::vec3 center{0.0f};
   float radius = 0.0f;
   uint32_t material = 0;
+  uint32_t object = 0;  // its place in the file's "objects": the `object` pass (AOV) reports it
   bool inward = false;  // "flip_normals": the normal points to the centre (for emission and glass)
+
+  bool operator==(const Sphere&) const = default;
 };
 
 struct Triangle {
   std::array<glm::vec3, 3> v;
   uint32_t material = 0;
+  uint32_t object = 0;                 // its place in the file's "objects"
   bool smooth = false;                 // shade with `normals` interpolated, not the face normal
   std::array<glm::vec3, 3> normals{};  // unit vertex normals, when smooth
+
+  bool operator==(const Triangle&) const = default;
 };
 
 struct Scene {
@@ -122,11 +130,33 @@ struct Scene {
   float epsilon() const { return std::max(extent(), 1e-30f) * 1e-5f; }
 };
 
+// Whether two scenes have the same primitives, bit for bit, with the same materials and objects
+// (a scene on the device can then keep its BVH and primitive buffers: Session::upload_changes).
+bool same_geometry(const Scene& a, const Scene& b);
+
+struct Mesh;
+// Mesh files read by earlier scene loads, kept for the next ones (a face that loads edited scenes
+// in a loop): a file is read again when its size or modification time changed.
+class MeshCache {
+ public:
+  MeshCache();
+  ~MeshCache();
+  MeshCache(const MeshCache&) = delete;
+  MeshCache& operator=(const MeshCache&) = delete;
+  // The mesh in `file`, read now (load_mesh) unless kept. Throws what load_mesh throws.
+  std::shared_ptr<const Mesh> get(const std::filesystem::path& file);
+
+ private:
+  struct Entry;
+  std::map<std::filesystem::path, Entry> entries_;
+};
+
 // Reads and validates a scene file. Throws SceneError naming the file and the key (as a JSON
-// pointer, e.g. /objects/2/radius) or the line and column of a syntax error.
-Scene load_scene(const std::filesystem::path& file);
+// pointer, e.g. /objects/2/radius) or the line and column of a syntax error. `meshes`: a cache to
+// take mesh files from and keep them in; null reads each file once for this scene.
+Scene load_scene(const std::filesystem::path& file, MeshCache* meshes = nullptr);
 
 // The same from text already in memory; `file` is used in messages and to resolve relative paths.
-Scene parse_scene(std::string_view json_text, const std::filesystem::path& file);
+Scene parse_scene(std::string_view json_text, const std::filesystem::path& file, MeshCache* meshes = nullptr);
 
 }  // namespace vkray

@@ -61,6 +61,7 @@ void run_check(Session& session, const CheckOptions& options) {
       render.width = options.width;
       render.height = options.height;
       render.samples_per_pixel = spp;
+      render.aovs = true;  // the first-hit passes are compared too
       if (options.on_case) options.on_case({file, paths.front(), spp});
       // The reference does not depend on the GPU path: rendered once for both.
       const auto cpu_start = Clock::now();
@@ -74,7 +75,7 @@ void run_check(Session& session, const CheckOptions& options) {
         render.inline_scene = path;
         CheckResult result{c, scene->description, {}, 0};
         result.parity = judge_parity(image_settings(*scene, render), session.render(on_device, render), cpu, signatures,
-                                     parity_tolerance(*scene));
+                                     parity_tolerance(*scene), scene->extent());
         if (result.parity.gpu.stats.inline_scene != (path == InlineScene::always))
           throw InternalError(case_name(c) + ": the render did not take the path it was asked for");
         result.seconds = since(start) + shared_seconds;

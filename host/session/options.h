@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "image/aovs.h"
 #include "image/image.h"
 #include "scene/scene.h"
 
@@ -33,6 +34,8 @@ struct RenderOptions {
   std::optional<uint32_t> width, height, samples_per_pixel, seed;
   // false: no shadow rays, every light counts as visible (benchmarks of camera rays alone).
   bool shadows = true;
+  // Also the first-hit passes (image/aovs.h): RenderResult::aovs.
+  bool aovs = false;
   // GPU: how a small scene is traced; the longest one submission (a tile) may run; square tiles of
   // this side in pixels (0: submissions sized by the time they take, gpu/tiling.h).
   InlineScene inline_scene = InlineScene::automatic;
@@ -62,6 +65,7 @@ struct RenderStats {
 
 struct RenderResult {
   Image image;  // linear radiance, top row first
+  std::optional<Aovs> aovs;  // when RenderOptions::aovs asked for them
   RenderStats stats;
 };
 

@@ -10,14 +10,16 @@ namespace vkray {
 ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scene> scene, const RenderOptions& options) {
   const ImageSettings image = image_settings(*scene, options);  // a bad override fails before any work
   const Bvh bvh = build_bvh(primitive_boxes(*scene));  // one hierarchy, traversed by both
+  RenderOptions with_aovs = options;  // parity covers the first-hit passes too
+  with_aovs.aovs = true;
   RenderResult gpu;
   {
     const DeviceScene on_device = session.upload(scene, &bvh);
-    gpu = session.render(on_device, options);
+    gpu = session.render(on_device, with_aovs);
   }
   std::vector<uint64_t> signatures;
-  RenderResult cpu = render_on_cpu(*scene, options, &bvh, &signatures);
-  return judge_parity(image, std::move(gpu), std::move(cpu), std::move(signatures), parity_tolerance(*scene));
+  RenderResult cpu = render_on_cpu(*scene, with_aovs, &bvh, &signatures);
+  return judge_parity(image, std::move(gpu), std::move(cpu), std::move(signatures), parity_tolerance(*scene), scene->extent());
 }
 
 ParityTolerance parity_tolerance(const Scene& scene) {
@@ -29,7 +31,7 @@ ParityTolerance parity_tolerance(const Scene& scene) {
 }
 
 ParityResult judge_parity(const ImageSettings& image, RenderResult gpu, RenderResult cpu, std::vector<uint64_t> signatures,
-                          const ParityTolerance& tolerance) {
+                          const ParityTolerance& tolerance, double scene_extent) {
   ParityResult result;
   result.tolerance = tolerance;
   result.image = image;
@@ -37,6 +39,8 @@ ParityResult judge_parity(const ImageSettings& image, RenderResult gpu, RenderRe
   result.cpu = std::move(cpu);
   result.signatures = std::move(signatures);
   result.metrics = compare_images(result.gpu.image, result.cpu.image, result.signatures, result.tolerance);
+  if (result.gpu.aovs && result.cpu.aovs)
+    compare_aovs(*result.gpu.aovs, *result.cpu.aovs, result.signatures, scene_extent, result.tolerance, result.metrics);
   return result;
 }
 

@@ -1,5 +1,6 @@
 // Parity: a scene rendered on the session's device and with the CPU reference, both traversing the
-// same BVH, and the two images compared against the tolerance (image/parity_metrics.h).
+// same BVH, and the two images and their first-hit passes compared against the tolerance
+// (image/parity_metrics.h).
 #pragma once
 
 #include <cstdint>
@@ -27,8 +28,9 @@ ParityTolerance parity_tolerance(const Scene& scene);
 
 ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scene> scene, const RenderOptions& options);
 
-// The comparison alone, of a GPU render and a reference rendered with `signatures`, both of `image`.
+// The comparison alone, of a GPU render and a reference rendered with `signatures`, both of `image`;
+// their first-hit passes too when both have them (lengths compared against `scene_extent`).
 ParityResult judge_parity(const ImageSettings& image, RenderResult gpu, RenderResult cpu, std::vector<uint64_t> signatures,
-                          const ParityTolerance& tolerance);
+                          const ParityTolerance& tolerance, double scene_extent = 1.0);
 
 }  // namespace vkray

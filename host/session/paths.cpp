@@ -1,5 +1,7 @@
 #include "session/paths.h"
 
+#include <dlfcn.h>
+
 #include <system_error>
 
 namespace vkray {
@@ -12,16 +14,28 @@ std::filesystem::path executable_path() {
 
 namespace {
 
-std::filesystem::path installed_data_dir() {
-  const auto exe = executable_path();
-  if (exe.empty()) return {};
-  return exe.parent_path().parent_path() / "share" / "vkray";
+// The file this code was loaded from: the executable for the command line, the extension module
+// for Python.
+std::filesystem::path code_path() {
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<const void*>(&code_path), &info) != 0 && info.dli_fname && info.dli_fname[0] == '/')
+    return info.dli_fname;
+  return executable_path();
 }
 
+// Where an installed vkray keeps its data: <prefix>/share/vkray, from <prefix>/bin/vkray or from
+// <prefix>/lib/pythonX.Y/site-packages/vkray/_vkray*.so.
 std::filesystem::path find(const char* relative, const char* source_tree_dir, const char* probe) {
-  const auto installed = installed_data_dir() / relative;
+  const auto code = code_path();
   std::error_code ec;
-  if (std::filesystem::exists(installed / probe, ec)) return installed;
+  if (!code.empty()) {
+    const auto from_bin = code.parent_path().parent_path();
+    const auto from_module = from_bin.parent_path().parent_path().parent_path();
+    for (const auto& prefix : {from_bin, from_module}) {
+      const auto installed = prefix / "share" / "vkray" / relative;
+      if (std::filesystem::exists(installed / probe, ec)) return installed;
+    }
+  }
   return source_tree_dir;
 }
 

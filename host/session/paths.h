@@ -1,5 +1,6 @@
-// Where vkray finds its shaders, scenes and check cases: next to an installed executable
-// (<prefix>/bin/vkray -> <prefix>/share/vkray/...), else in the source tree it was built from.
+// Where vkray finds its shaders, scenes and check cases: where an installed vkray keeps them
+// (<prefix>/share/vkray/..., found from <prefix>/bin/vkray or from the Python module in
+// <prefix>/lib/pythonX.Y/site-packages/vkray/), else in the source tree it was built from.
 #pragma once
 
 #include <filesystem>

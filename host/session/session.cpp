@@ -97,6 +97,7 @@ Session::ShaderCompile Session::compile_shaders() {
 const Scene& DeviceScene::scene() const { return scene_->scene(); }
 double DeviceScene::upload_seconds() const { return scene_->upload_seconds(); }
 double DeviceScene::bvh_seconds() const { return scene_->bvh_seconds(); }
+bool DeviceScene::shares_geometry() const { return scene_->shares_geometry(); }
 
 BackgroundBvh::BackgroundBvh(std::shared_ptr<const Scene> scene) : stop_(std::make_shared<std::atomic<bool>>(false)) {
   build_ = std::async(std::launch::async,
@@ -125,6 +126,16 @@ DeviceScene Session::upload(std::shared_ptr<const Scene> scene, const Bvh* bvh) 
   return uploaded;
 }
 
+DeviceScene Session::upload_changes(const DeviceScene& previous, std::shared_ptr<const Scene> scene) {
+  const gpu::GpuScene& same = own(previous);
+  if (!same_geometry(same.scene(), *scene)) return upload(std::move(scene));
+  if (renderer_->busy(std::chrono::milliseconds(0)))
+    throw TimeoutError("the device is still running a render tile that timed out; the scene was not uploaded");
+  DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::GpuScene>(same, std::move(scene)); }));
+  check_validation("scene upload");
+  return uploaded;
+}
+
 namespace {
 
 bool use_inline_scene(const gpu::GpuScene& scene, const ImageSettings& image, InlineScene policy) {
@@ -142,6 +153,7 @@ gpu::ShaderVariant shader_variant(const gpu::GpuScene& scene, const RenderOption
   variant.path = s.integrator.type == Integrator::Type::path;
   variant.emitters = scene.emitters().count > 0;
   variant.specular = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.specular(); });
+  variant.aovs = options.aovs;
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))
     variant.inline_scene = scene.inline_scene();
   return variant;
@@ -178,7 +190,10 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
   prepare(scene, options);  // nothing to do when prepared before
   gpu::TraceStats trace;
   RenderResult result;
-  result.image = on_device([&] { return renderer_->render(shaders_->pipeline, scene.scene_, request, &trace); });
+  if (options.aovs) result.aovs.emplace();
+  result.image = on_device([&] {
+    return renderer_->render(shaders_->pipeline, scene.scene_, request, &trace, result.aovs ? &*result.aovs : nullptr);
+  });
   check_validation("render");
   result.stats.upload_seconds = trace.upload_seconds;
   result.stats.trace_seconds = trace.trace_seconds;

@@ -33,6 +33,9 @@ class DeviceScene {
   const Scene& scene() const;
   double upload_seconds() const;  // BVH build included, also when built beforehand
   double bvh_seconds() const;
+  // Made by Session::upload_changes from a scene with the same geometry, whose BVH and primitive
+  // buffers it shares.
+  bool shares_geometry() const;
 
  private:
   friend class Session;
@@ -73,6 +76,10 @@ class Session {
   // Builds the scene's BVH (or takes `bvh`, built for this scene) and uploads it. Throws
   // TimeoutError at once while a tile that timed out still runs on the device.
   DeviceScene upload(std::shared_ptr<const Scene> scene, const Bvh* bvh = nullptr);
+  // `scene`, an edit of `previous` (uploaded by this session): when their geometry is the same
+  // (same_geometry: a camera, lights, materials, the image or the integrator changed), it shares
+  // `previous`'s BVH and primitive buffers and uploads only the lighting; otherwise upload(scene).
+  DeviceScene upload_changes(const DeviceScene& previous, std::shared_ptr<const Scene> scene);
 
   // ---- Rendering (of a scene uploaded by this session; another's is a UsageError) ----------------
   // Whether a render of `scene` with `options` traces code compiled from the scene, not the BVH.

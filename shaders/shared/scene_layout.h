@@ -11,8 +11,8 @@ VKRAY_SHARED_BEGIN
 // ---- Primitives: VKRAY_TEXELS_PER_PRIMITIVE RGBA32F texels each, in BVH leaf order ---------------------
 // A triangle is its vertices rather than its edges (every triangle sharing a vertex must see bitwise
 // the same coordinates for the watertight test); a sphere is its centre and radius. Each carries its
-// flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH | VKRAY_PRIM_INWARD) and its place in the scene, which
-// decides ties (VKRAY_TIE), as the bits of a float.
+// flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH | VKRAY_PRIM_INWARD), its place in the scene, which
+// decides ties (VKRAY_TIE), and the object it belongs to (the `object` pass), as the bits of floats.
 #define VKRAY_TEXELS_PER_PRIMITIVE 3
 #define VKRAY_PRIM_SPHERE 0x80000000u
 #define VKRAY_PRIM_SMOOTH 0x40000000u  // a triangle with vertex normals in the normals buffer
@@ -22,27 +22,28 @@ VKRAY_SHARED_BEGIN
 struct PrimitiveTexels {
   vec4 a;  // triangle: (v0, flags);          sphere: (centre, flags)
   vec4 b;  // triangle: (v1, scene index);    sphere: (radius, 0, 0, scene index)
-  vec4 c;  // triangle: (v2, 0);              sphere: 0
+  vec4 c;  // triangle: (v2, object);         sphere: (0, 0, 0, object)
 };
 
-VKRAY_INLINE PrimitiveTexels triangle_texels(vec3 v0, vec3 v1, vec3 v2, uint flags, uint scene_index) {
+VKRAY_INLINE PrimitiveTexels triangle_texels(vec3 v0, vec3 v1, vec3 v2, uint flags, uint scene_index, uint object) {
   PrimitiveTexels t;
   t.a = vec4(v0, uintBitsToFloat(flags));
   t.b = vec4(v1, uintBitsToFloat(scene_index));
-  t.c = vec4(v2, 0.0f);
+  t.c = vec4(v2, uintBitsToFloat(object));
   return t;
 }
 
-VKRAY_INLINE PrimitiveTexels sphere_texels(vec3 centre, float radius, uint flags, uint scene_index) {
+VKRAY_INLINE PrimitiveTexels sphere_texels(vec3 centre, float radius, uint flags, uint scene_index, uint object) {
   PrimitiveTexels t;
   t.a = vec4(centre, uintBitsToFloat(flags | VKRAY_PRIM_SPHERE));
   t.b = vec4(radius, 0.0f, 0.0f, uintBitsToFloat(scene_index));
-  t.c = vec4(0.0f);
+  t.c = vec4(0.0f, 0.0f, 0.0f, uintBitsToFloat(object));
   return t;
 }
 
 VKRAY_INLINE uint primitive_flags(vec4 a) { return floatBitsToUint(a.w); }
 VKRAY_INLINE uint primitive_scene_index(vec4 b) { return floatBitsToUint(b.w); }
+VKRAY_INLINE uint primitive_object(vec4 c) { return floatBitsToUint(c.w); }
 VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 
 // Vertex normals of smooth triangles: a second buffer in the same slots as the primitives, one

@@ -21,6 +21,7 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F: point lights
 #define VKRAY_BINDING_OUTPUT 6      // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
 #define VKRAY_BINDING_EMITTERS 7    // uniform texel buffer, RGBA32F: the area lights' alias table
+#define VKRAY_BINDING_AOVS 8        // storage buffer: VKRAY_TEXELS_PER_AOV_PIXEL vec4 per pixel (aovs.glsl)
 
 // ---- Specialization constants ------------------------------------------------------------------
 // false when the scene has no spheres: the pipeline for it has no sphere test (gpu::ShaderVariant).
@@ -34,6 +35,13 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_EMITTERS 3
 // false when every material is diffuse: no code for mirrors and glass.
 #define VKRAY_SPEC_SPECULAR 4
+// true when the render also returns the first-hit passes (AOVs): aovs.glsl's code is compiled in.
+#define VKRAY_SPEC_AOVS 5
+
+// ---- The first-hit passes (AOVs): sums over a pixel's samples, in the output's layout -------------
+// (albedo sum, hits as uint bits), (shading normal sum, object of sample 0 as int bits, -1: none),
+// (position sum, depth sum); the host divides by the hits (image/aovs.h).
+#define VKRAY_TEXELS_PER_AOV_PIXEL 3
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float

@@ -1,4 +1,5 @@
-// What `vkray parity` and `vkray check` report of a comparison: its JSON keys and its difference image.
+// What a face reports of a comparison (`vkray parity`, `vkray check`, vkray.parity() in Python): its JSON
+// keys and its difference image.
 #pragma once
 
 #include <filesystem>
@@ -8,9 +9,10 @@
 
 #include "session/parity.h"
 
-namespace vkray::cli {
+namespace vkray {
 
-// The metrics as `vkray parity --json` prints them (the keys are a contract: DECISIONS.md).
+// The metrics as `vkray parity --json` prints them and vkray.parity() returns them (the keys are a
+// contract: DECISIONS.md).
 nlohmann::json parity_json(const ParityResult& r, const std::string& scene, const std::string& device);
 
 // Writes the difference of the GPU image from the reference to `file`: a PNG heatmap of 8-bit steps
@@ -18,4 +20,4 @@ nlohmann::json parity_json(const ParityResult& r, const std::string& scene, cons
 // brightest colour (0 for a PFM). Throws OutputError.
 int write_difference(const ParityResult& r, const std::filesystem::path& file);
 
-}  // namespace vkray::cli
+}  // namespace vkray

@@ -1,16 +1,16 @@
-#include "cli/parity_report.h"
+#include "session/parity_report.h"
 
 #include <cmath>
 
 #include "image/image.h"
 #include "session/version.h"
 
-namespace vkray::cli {
+namespace vkray {
 
 nlohmann::json parity_json(const ParityResult& r, const std::string& scene, const std::string& device) {
   const ParityMetrics& m = r.metrics;
   const glm::vec3 worst_gpu = r.gpu.image.at(m.worst_x, m.worst_y), worst_cpu = r.cpu.image.at(m.worst_x, m.worst_y);
-  return {
+  nlohmann::json json = {
       {"scene", scene},
       {"width", m.width},
       {"height", m.height},
@@ -41,6 +41,15 @@ nlohmann::json parity_json(const ParityResult& r, const std::string& scene, cons
       {"pass", m.pass},
       {"vkray_version", version_string()},
   };
+  if (m.aovs_compared) {
+    json["aov_pixels_differing"] = m.aov_differing;
+    json["aov_interior_pixels_differing"] = m.aov_interior_differing;
+    json["aov_edge_pixels_differing"] = m.aov_edge_differing;
+    nlohmann::json by_pass = nlohmann::json::object();
+    for (size_t pass = 0; pass < kAllAovs.size(); ++pass) by_pass[aov_name(kAllAovs[pass])] = m.aov_differing_by_pass[pass];
+    json["aov_pixels_differing_by_pass"] = by_pass;
+  }
+  return json;
 }
 
 int write_difference(const ParityResult& r, const std::filesystem::path& file) {
@@ -51,4 +60,4 @@ int write_difference(const ParityResult& r, const std::filesystem::path& file) {
   return max_steps;
 }
 
-}  // namespace vkray::cli
+}  // namespace vkray

@@ -1,0 +1,23 @@
+// The first-hit passes (image/aovs.h) as the CPU reference records them, the same rule as
+// shaders/aovs.glsl written apart from it.
+#include "cpu/integrators.h"
+
+namespace vkray::cpu {
+
+void add_first_hit(const Tracer& tracer, const Hit& hit, const SurfacePoint& surface, SampleState& state) {
+  FirstHitSums* sums = state.first_hit;
+  if (!sums) return;
+  const Scene& scene = tracer.scene();
+  const Material& material = scene.materials[surface.material];
+  ++sums->hits;
+  sums->albedo += material.type == MaterialType::glass ? dvec3(1.0) : dvec3(material.albedo);
+  sums->normal += surface.shading_normal;
+  sums->position += surface.position;
+  sums->depth += hit.t;  // along a unit direction
+  if (state.first_sample) {
+    const size_t p = size_t(hit.primitive), triangles = scene.triangles.size();
+    sums->object = int32_t(p < triangles ? scene.triangles[p].object : scene.spheres[p - triangles].object);
+  }
+}
+
+}  // namespace vkray::cpu

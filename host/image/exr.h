@@ -1,0 +1,40 @@
+// OpenEXR files (through the OpenEXR library): the image as R, G, B, and the first-hit passes as
+// named layers, the channel names other tools expect (DECISIONS.md, 18): albedo.R/G/B,
+// normal.X/Y/Z, position.X/Y/Z, depth.Z, object.id.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "image/aovs.h"
+#include "image/image.h"
+
+namespace vkray {
+
+struct ExrContent {
+  // 32-bit float channels; false: 16-bit half floats (the image and every pass but object.id, which
+  // is always 32-bit float so that every id up to 2^24 stays exact).
+  bool full_float = false;
+  std::vector<Aov> passes;  // the layers written after R, G, B, in this order
+};
+
+// Writes `image` and the `content.passes` of `aovs` (which must then be given, of the same size),
+// ZIP-compressed scan lines, top row first. Like write_image, under a temporary name renamed into
+// place. Throws OutputError.
+void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content);
+
+// What a face calls to write a render: write_exr for a ".exr" file, write_image otherwise. Throws
+// UsageError when passes or 32-bit floats are asked of another type, OutputError.
+void write_render_image(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content);
+
+struct ExrFile {
+  Image image;
+  Aovs aovs;  // the passes the file has; the others keep Aovs' defaults
+  ExrContent content;  // full_float: whether R is 32-bit
+};
+
+// Reads a file written by write_exr (or any scan-line or tiled EXR with R, G, B). Throws InputError
+// naming the file.
+ExrFile read_exr(const std::filesystem::path& file);
+
+}  // namespace vkray

@@ -1,0 +1,112 @@
+// OpenEXR output: the image and the first-hit passes read back as written (exactly in 32-bit, to
+// half precision in 16-bit), the type rules, and bad files. Other tools read the files in
+// python/tests/test_exr.py.
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "base/errors.h"
+#include "image/exr.h"
+#include "support/temp_dir.h"
+
+namespace vkray::test {
+namespace {
+
+// An image and passes with a value in every pixel that differs from its neighbours'.
+std::pair<Image, Aovs> sample_render(uint32_t w, uint32_t h) {
+  Image image(w, h);
+  Aovs aovs(w, h);
+  for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * w + x;
+      image.pixels[i] = glm::vec3(0.01f * float(x), 0.02f * float(y), 3.5f);
+      aovs.albedo[i] = glm::vec3(0.5f, 0.25f, float(x) / float(w));
+      aovs.normal[i] = glm::vec3(0.0f, -1.0f, 0.125f);
+      aovs.position[i] = glm::vec3(float(x) - 7.5f, 100.25f, -float(y));
+      aovs.depth[i] = x == 0 ? std::numeric_limits<float>::infinity() : 1.0f + float(x + y);
+      aovs.object[i] = x == 0 ? -1 : int32_t(i * 1000);
+    }
+  return {image, aovs};
+}
+
+TEST(ExrTest, FullFloatFilesReadBackExactly) {
+  TempDir dir;
+  const auto [image, aovs] = sample_render(13, 7);
+  ExrContent content{true, {Aov::object, Aov::albedo, Aov::normal, Aov::position, Aov::depth}};
+  write_exr(dir / "a.exr", image, &aovs, content);
+  const ExrFile read = read_exr(dir / "a.exr");
+  EXPECT_TRUE(read.content.full_float);
+  EXPECT_EQ(read.content.passes.size(), 5u);
+  ASSERT_EQ(read.image.width, 13u);
+  ASSERT_EQ(read.image.height, 7u);
+  EXPECT_EQ(read.image.pixels, image.pixels);
+  EXPECT_EQ(read.aovs.albedo, aovs.albedo);
+  EXPECT_EQ(read.aovs.normal, aovs.normal);
+  EXPECT_EQ(read.aovs.position, aovs.position);
+  EXPECT_EQ(read.aovs.depth, aovs.depth);
+  EXPECT_EQ(read.aovs.object, aovs.object);
+}
+
+TEST(ExrTest, HalfFilesKeepHalfPrecisionAndExactObjectIds) {
+  TempDir dir;
+  const auto [image, aovs] = sample_render(9, 5);
+  write_exr(dir / "h.exr", image, &aovs, {false, {Aov::depth, Aov::object}});
+  const ExrFile read = read_exr(dir / "h.exr");
+  EXPECT_FALSE(read.content.full_float);
+  EXPECT_EQ(read.content.passes, (std::vector<Aov>{Aov::depth, Aov::object}));
+  for (size_t i = 0; i < image.pixels.size(); ++i) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(read.image.pixels[i][c], image.pixels[i][c], 1e-3 * std::abs(image.pixels[i][c]) + 1e-7);
+    if (std::isinf(aovs.depth[i]))
+      EXPECT_TRUE(std::isinf(read.aovs.depth[i]));
+    else
+      EXPECT_NEAR(read.aovs.depth[i], aovs.depth[i], 1e-3 * aovs.depth[i]);
+  }
+  EXPECT_EQ(read.aovs.object, aovs.object);  // 32-bit even in a half file: ids up to 2^24 exact
+}
+
+TEST(ExrTest, WriteImageWritesHalfRgb) {
+  TempDir dir;
+  const auto [image, aovs] = sample_render(4, 4);
+  write_image(image, dir / "plain.EXR");
+  const ExrFile read = read_exr(dir / "plain.EXR");
+  EXPECT_FALSE(read.content.full_float);
+  EXPECT_TRUE(read.content.passes.empty());
+}
+
+TEST(ExrTest, PassesAndFullFloatAreForExrOnlyAndLeaveNoFile) {
+  TempDir dir;
+  const auto [image, aovs] = sample_render(4, 4);
+  EXPECT_THROW(write_render_image(dir / "x.png", image, &aovs, {false, {Aov::depth}}), UsageError);
+  EXPECT_THROW(write_render_image(dir / "x.pfm", image, nullptr, {true, {}}), UsageError);
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+  write_render_image(dir / "x.pfm", image, nullptr, {});
+  EXPECT_TRUE(std::filesystem::exists(dir / "x.pfm"));
+}
+
+TEST(ExrTest, AnUnwritableFolderIsAnOutputError) {
+  const auto [image, aovs] = sample_render(4, 4);
+  EXPECT_THROW(write_exr("/nonexistent-vkray-folder/x.exr", image, &aovs, {}), OutputError);
+}
+
+TEST(ExrTest, ABrokenFileIsAnInputErrorNamingIt) {
+  TempDir dir;
+  std::ofstream(dir / "bad.exr") << "v/1\x01 this is not an EXR file";
+  try {
+    read_exr(dir / "bad.exr");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.exr"), std::string::npos) << e.what();
+  }
+  // A real file cut short.
+  const auto [image, aovs] = sample_render(64, 64);
+  write_exr(dir / "whole.exr", image, &aovs, {true, {Aov::position}});
+  const auto size = std::filesystem::file_size(dir / "whole.exr");
+  std::filesystem::copy_file(dir / "whole.exr", dir / "cut.exr");
+  std::filesystem::resize_file(dir / "cut.exr", size / 2);
+  EXPECT_THROW(read_exr(dir / "cut.exr"), InputError);
+}
+
+}  // namespace
+}  // namespace vkray::test
