@@ -135,7 +135,8 @@ Context::Context(const ContextOptions& options)
     if (!chosen) {
       std::string names;
       for (size_t i = 0; i < devices.size(); ++i)
-        names += "\n  " + std::to_string(i) + ": " + devices[i].getProperties().deviceName.data();
+        names += (i ? ", " : " ") + std::to_string(i) + ": " + devices[i].getProperties().deviceName.data();
+      // One line: a face prints a device error's message on one line.
       throw DeviceError("no Vulkan device matches --device \"" + options.device + "\"; available:" + names);
     }
     if (!compute_queue_family(devices[*chosen]))

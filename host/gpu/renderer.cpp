@@ -65,6 +65,16 @@ constexpr double kSubmissionSeconds = 0.1;
 // The most pixels a submission (an output slot) holds: 64 MiB a slot, two slots.
 constexpr uint64_t kMostSlotPixels = uint64_t(1) << 22;
 
+bool is_timeout(const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const TimeoutError&) {
+    return true;
+  } catch (...) {
+    return false;
+  }
+}
+
 }  // namespace
 
 // Everything one render's submissions use. Declaration order is destruction order reversed: the
@@ -82,6 +92,7 @@ struct Renderer::Frame {
   vk::raii::CommandBuffers command_buffers{nullptr};  // one per slot
   std::vector<vk::raii::Fence> fences;                // one per slot
   std::vector<vk::Fence> in_flight;                   // submitted and not yet waited for
+  bool timed_out = false;                             // left running by a TimeoutError, not an interrupt
 };
 
 Renderer::Renderer(std::shared_ptr<const Context> ctx) : ctx_(std::move(ctx)) {}
@@ -95,6 +106,22 @@ Renderer::~Renderer() {
   // could hang or crash the driver: leave all of it, and the Context it keeps alive, to the process.
   for (auto& frame : abandoned_) static_cast<void>(frame.release());
   ctx_->abandon_work();
+}
+
+bool Renderer::busy_after_interrupts(std::chrono::milliseconds wait) {
+  const auto deadline = Clock::now() + wait;
+  for (auto it = abandoned_.begin(); it != abandoned_.end();) {
+    const auto& fences = (*it)->in_flight;
+    const auto left = std::max(std::chrono::nanoseconds(0), std::chrono::nanoseconds(deadline - Clock::now()));
+    try {
+      if (!(*it)->timed_out && !fences.empty() &&
+          ctx_->device().waitForFences(fences, VK_TRUE, uint64_t(left.count())) == vk::Result::eTimeout)
+        return true;
+    } catch (const vk::DeviceLostError&) {  // nothing runs on a lost device any more
+    }
+    ++it;
+  }
+  return busy(std::chrono::milliseconds(0));
 }
 
 bool Renderer::busy(std::chrono::milliseconds wait) {
@@ -305,7 +332,10 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   } catch (...) {
     // Timed out, interrupted, or any other failure while a tile may still run: what it uses is kept
     // until the device is done with it (busy()), never destroyed under it.
-    if (!frame->in_flight.empty()) abandoned_.push_back(std::move(frame));  // reserved: cannot throw
+    if (!frame->in_flight.empty()) {
+      frame->timed_out = is_timeout(std::current_exception());
+      abandoned_.push_back(std::move(frame));  // reserved: cannot throw
+    }
     throw;
   }
   // Reading back overlaps tracing: the trace is the whole span (so rays/s are not flattered), the

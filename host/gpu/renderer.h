@@ -59,6 +59,10 @@ class Renderer {
   // Whether work of a timed-out render is still running, after waiting up to `wait` for it. What
   // finished work used is released.
   bool busy(std::chrono::milliseconds wait);
+  // Waits up to `wait` for the tiles interrupted renders left running (a tile runs on after Ctrl-C
+  // until its submission ends), then says, as busy(0) does, whether work is still running: that of
+  // a render that timed out, or an interrupted tile past `wait`.
+  bool busy_after_interrupts(std::chrono::milliseconds wait);
 
  private:
   struct Frame;

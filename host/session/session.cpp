@@ -32,6 +32,10 @@ auto on_device(Work&& work) -> decltype(work()) {
 // "Small scenes compiled into the shader").
 constexpr uint64_t kInlineMinCameraRays = uint64_t(1) << 20;
 
+// A tile that an interrupt left running ends with its submission (about kSubmissionSeconds, at most
+// the render's tile timeout, which defaults to this): an upload or close() waits this long for it.
+constexpr std::chrono::milliseconds kInterruptedTileWait{60000};
+
 }  // namespace
 
 struct Session::Shaders {
@@ -119,7 +123,7 @@ DeviceScene Session::upload(std::shared_ptr<const Scene> scene, const Bvh* bvh) 
                      std::to_string(scene->triangles.size() + scene->spheres.size()));
   // An upload may go through the queue, behind a tile that timed out and still runs: refuse at
   // once rather than wait behind it.
-  if (renderer_->busy(std::chrono::milliseconds(0)))
+  if (renderer_->busy_after_interrupts(kInterruptedTileWait))
     throw TimeoutError("the device is still running a render tile that timed out; the scene was not uploaded");
   DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::GpuScene>(ctx_, std::move(scene), bvh); }));
   check_validation("scene upload");
@@ -129,7 +133,7 @@ DeviceScene Session::upload(std::shared_ptr<const Scene> scene, const Bvh* bvh) 
 DeviceScene Session::upload_changes(const DeviceScene& previous, std::shared_ptr<const Scene> scene) {
   const gpu::GpuScene& same = own(previous);
   if (!same_geometry(same.scene(), *scene)) return upload(std::move(scene));
-  if (renderer_->busy(std::chrono::milliseconds(0)))
+  if (renderer_->busy_after_interrupts(kInterruptedTileWait))
     throw TimeoutError("the device is still running a render tile that timed out; the scene was not uploaded");
   DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::GpuScene>(same, std::move(scene)); }));
   check_validation("scene upload");
@@ -219,7 +223,7 @@ void Session::close() {
   // Everything that keeps the device alive goes first, so that the device is destroyed here and the
   // validation layer's report of what was left alive arrives before the check below. Work a
   // timed-out tile left running keeps its part alive (gpu/renderer.h): the device stays then.
-  const bool work_left = renderer_->busy(std::chrono::milliseconds(0));
+  const bool work_left = renderer_->busy_after_interrupts(kInterruptedTileWait);
   renderer_.reset();
   shaders_.reset();
   const bool last = ctx_.use_count() == 1;
