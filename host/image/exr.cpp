@@ -1,5 +1,6 @@
 #include "image/exr.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -7,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <thread>
 
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -15,6 +17,7 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfThreading.h>
 
 #include "base/atomic_file.h"
 #include "base/errors.h"
@@ -118,6 +121,12 @@ void write_exr(const std::filesystem::path& file, const Image& image, const Aovs
       }
     }
   }
+  // OpenEXR compresses blocks of lines on its own thread pool: every core, set once.
+  static const bool threads_set = [] {
+    Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
+    return true;
+  }();
+  static_cast<void>(threads_set);
   AtomicFile out(file);
   try {
     FileStream stream(out.get(), file.string());
@@ -126,7 +135,7 @@ void write_exr(const std::filesystem::path& file, const Image& image, const Aovs
     // In bands, so that an interrupt request is seen within a fraction of a second.
     for (uint32_t written = 0; written < image.height;) {
       throw_if_interrupted();
-      const uint32_t rows = std::min<uint32_t>(64, image.height - written);
+      const uint32_t rows = std::min<uint32_t>(256, image.height - written);
       exr.writePixels(int(rows));
       written += rows;
     }

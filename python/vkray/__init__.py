@@ -1,0 +1,189 @@
+"""vkray from Python: render scenes on any Vulkan device into numpy arrays.
+
+A thin face on vkray's C++ library (the one the ``vkray`` command uses): the same scenes, the same
+images, the same errors with the same messages.
+
+    >>> import vkray
+    >>> image = vkray.render("scenes/cornell.json", width=256, height=256)
+    >>> image.shape, image.dtype
+    ((256, 256, 3), dtype('float32'))
+
+Scenes are scene files (``.json``, README "Scene files") or dicts in the same format, where numpy
+arrays may stand wherever the format has lists of numbers. Images are linear radiance, float32,
+top row first, exactly what ``vkray render -o x.pfm`` writes.
+
+``vkray.Renderer`` keeps the device, the compiled shaders, the mesh files and the last scene on the
+device between renders, so that a loop that moves the camera or edits lights and materials uploads
+only what changed. Rendering releases the GIL; Ctrl-C stops a render within a fraction of a second
+and raises KeyboardInterrupt.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any, Optional, Union
+
+import numpy as np
+
+from . import _vkray
+from ._vkray import DeviceError, Error, InternalError, SceneError, UsageError, __version__
+
+__all__ = [
+    "AOVS",
+    "DeviceError",
+    "Error",
+    "InternalError",
+    "Renderer",
+    "SceneError",
+    "UsageError",
+    "devices",
+    "parity",
+    "render",
+    "__version__",
+]
+
+#: The first-hit passes a render can return beside the image (README, "First-hit passes").
+AOVS = ("albedo", "normal", "position", "depth", "object")
+
+Scene = Union[str, "os.PathLike[str]", Mapping[str, Any]]
+Image = np.ndarray
+RenderOutput = Union[np.ndarray, dict[str, np.ndarray]]
+
+# The name a scene dict goes by in messages; its relative paths resolve against its folder.
+_DICT_NAME = "<scene dict>"
+
+
+def _json_value(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    raise TypeError(f"a {type(value).__name__} is not a value a scene can hold")
+
+
+def _source(scene: Scene, base_dir: Optional[Union[str, "os.PathLike[str]"]]) -> Any:
+    if isinstance(scene, (str, os.PathLike)):
+        if base_dir is not None:
+            raise UsageError("base_dir is for scene dicts: a scene file's paths resolve against its own folder")
+        return _vkray._SceneSource(os.fspath(scene))
+    if isinstance(scene, Mapping):
+        folder = Path(base_dir) if base_dir is not None else Path.cwd()
+        try:
+            text = json.dumps(scene, default=_json_value, allow_nan=False)
+        except (TypeError, ValueError) as e:
+            raise SceneError(f"{folder / _DICT_NAME}: {e}") from None
+        return _vkray._SceneSource(os.fspath(folder / _DICT_NAME), text)
+    raise UsageError(f"a scene is a file name or a dict, not a {type(scene).__name__}")
+
+
+def _pass_names(aovs: Union[str, Iterable[str]]) -> list[str]:
+    names = [aovs] if isinstance(aovs, str) else list(aovs)
+    return [n for name in names for n in name.split(",")] if names else []
+
+
+class Renderer:
+    """A Vulkan device kept open for any number of renders.
+
+    It keeps the compiled shaders, the mesh files it read and the last scene it uploaded. A render of
+    a scene whose geometry is the last one's (only the camera, lights, materials, background, image
+    settings or integrator changed) re-uploads only the lights and materials, not the BVH or the
+    primitives; ``last_stats`` says what a render cost and whether it reused the geometry.
+
+    Args:
+        device: an index or part of a name from ``vkray.devices()``; None picks the best device
+            (a discrete GPU, then integrated, virtual, CPU).
+        validate: run with the Khronos validation layer; any message it prints raises DeviceError.
+        shader_dir: compile ``trace.comp`` from this folder instead of the installed shaders.
+
+    Use it as a context manager, or call ``close()``, which also reports validation messages that
+    arrive while the device is torn down.
+    """
+
+    def __init__(self, device: Optional[str] = None, *, validate: bool = False,
+                 shader_dir: Optional[Union[str, "os.PathLike[str]"]] = None) -> None:
+        self._renderer = _vkray._Renderer(None if device is None else str(device), validate,
+                                          None if shader_dir is None else os.fspath(shader_dir))
+
+    def render(self, scene: Scene, *, width: Optional[int] = None, height: Optional[int] = None,
+               spp: Optional[int] = None, seed: Optional[int] = None, aovs: Union[str, Iterable[str]] = (),
+               base_dir: Optional[Union[str, "os.PathLike[str]"]] = None) -> RenderOutput:
+        """Renders ``scene`` (see ``vkray.render``) on this renderer's device."""
+        return self._renderer.render(_source(scene, base_dir), width, height, spp, seed, _pass_names(aovs))
+
+    @property
+    def device(self) -> str:
+        """The device in use, "name (driver)"; empty once closed."""
+        return self._renderer.device
+
+    @property
+    def last_stats(self) -> Optional[dict[str, Any]]:
+        """What the last render cost: seconds to load the scene, upload it (BVH build included) and
+        trace it, rays traced, and whether the geometry already on the device was reused."""
+        return self._renderer.last_stats
+
+    def close(self) -> None:
+        """Releases the device. Raises DeviceError when the validation layer reported anything."""
+        self._renderer.close()
+
+    def __enter__(self) -> "Renderer":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] = None, spp: Optional[int] = None,
+           seed: Optional[int] = None, renderer: str = "gpu", device: Optional[str] = None,
+           aovs: Union[str, Iterable[str]] = (), base_dir: Optional[Union[str, "os.PathLike[str]"]] = None,
+           threads: int = 0) -> RenderOutput:
+    """Renders a scene and returns linear radiance as a float32 array of shape (height, width, 3).
+
+    Args:
+        scene: a scene file name, or a dict in the scene format (numpy arrays allowed for lists of
+            numbers); a dict's relative mesh paths resolve against ``base_dir`` (default: the
+            current folder).
+        width, height, spp, seed: override the scene's image settings and seed.
+        renderer: "gpu" (the Vulkan compute shader) or "cpu" (the CPU reference, in double precision).
+        device: for "gpu": an index or part of a name from ``vkray.devices()``.
+        aovs: first-hit passes to return too, names from ``vkray.AOVS`` (or one comma-separated
+            string). With any, the result is a dict: "color" and each pass; "albedo", "normal",
+            "position" are (height, width, 3) float32, "depth" (height, width) float32 (infinite
+            where nothing was hit), "object" (height, width) int32 (-1 where nothing was hit).
+        threads: for "cpu": threads to use; 0, one per hardware thread.
+
+    Raises:
+        SceneError: the scene or a file it names cannot be used (the message names the file and key).
+        UsageError: an argument is out of range.
+        DeviceError: no such device, or the device failed.
+        KeyboardInterrupt: Ctrl-C, within a fraction of a second.
+    """
+    if renderer == "gpu":
+        with Renderer(device) as r:
+            return r.render(scene, width=width, height=height, spp=spp, seed=seed, aovs=aovs, base_dir=base_dir)
+    if renderer == "cpu":
+        if device is not None:
+            raise UsageError("device is for renderer='gpu'; the CPU reference runs on the host")
+        return _vkray.render_cpu(_source(scene, base_dir), width, height, spp, seed, _pass_names(aovs), threads)
+    raise UsageError(f"renderer is 'gpu' or 'cpu', not {renderer!r}")
+
+
+def parity(scene: Scene, *, width: Optional[int] = None, height: Optional[int] = None, spp: Optional[int] = None,
+           seed: Optional[int] = None, device: Optional[str] = None,
+           base_dir: Optional[Union[str, "os.PathLike[str]"]] = None, validate: bool = False,
+           threads: int = 0) -> dict[str, Any]:
+    """Renders ``scene`` on the device and with the CPU reference and compares the images and their
+    first-hit passes, as ``vkray parity`` does. Returns the keys ``vkray parity --json`` prints;
+    ``result["pass"]`` says whether they agree within the tolerance (``result["tolerance"]``)."""
+    return json.loads(_vkray.parity(_source(scene, base_dir), width, height, spp, seed,
+                                    None if device is None else str(device), validate, threads))
+
+
+def devices() -> list[dict[str, Any]]:
+    """Every Vulkan device the loader reports, as ``vkray devices`` lists them: index, name, type,
+    driver, api_version, compute (whether it has a compute queue) and device_local_bytes."""
+    return _vkray.devices()
