@@ -169,9 +169,10 @@ py::dict stats_dict(const RenderStats& stats, double load_seconds, double upload
   return d;
 }
 
-// Warnings the scene raised, as Python warnings.
+// Warnings the scene raised, as Python warnings (an exception when the filter turns them into one).
 void warn_about(const Scene& scene) {
-  for (const std::string& warning : scene.warnings) PyErr_WarnEx(PyExc_UserWarning, warning.c_str(), 2);
+  for (const std::string& warning : scene.warnings)
+    if (PyErr_WarnEx(PyExc_UserWarning, warning.c_str(), 2) != 0) throw py::error_already_set();
 }
 
 // vkray.Renderer: a device kept open, its pipelines, the mesh files read and the last scene

@@ -142,3 +142,15 @@ def test_devices_lists_the_lavapipe_device():
     found = vkray.devices()
     assert found and found[0]["index"] == 0
     assert any(d["type"] == "CPU" and d["compute"] for d in found)
+
+
+def test_scene_warnings_are_python_warnings(scenes):
+    scene = json.loads((scenes / "cornell.json").read_text())
+    scene["colour_of_the_sky"] = "blue"
+    with pytest.warns(UserWarning, match="colour_of_the_sky.*unknown key"):
+        vkray.render(scene, base_dir=scenes, width=8, height=8)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning):
+            vkray.render(scene, base_dir=scenes, width=8, height=8)
