@@ -110,16 +110,20 @@ Renderer::~Renderer() {
 
 bool Renderer::busy_after_interrupts(std::chrono::milliseconds wait) {
   const auto deadline = Clock::now() + wait;
-  for (auto it = abandoned_.begin(); it != abandoned_.end();) {
-    const auto& fences = (*it)->in_flight;
-    const auto left = std::max(std::chrono::nanoseconds(0), std::chrono::nanoseconds(deadline - Clock::now()));
-    try {
-      if (!(*it)->timed_out && !fences.empty() &&
-          ctx_->device().waitForFences(fences, VK_TRUE, uint64_t(left.count())) == vk::Result::eTimeout)
-        return true;
-    } catch (const vk::DeviceLostError&) {  // nothing runs on a lost device any more
+  for (auto it = abandoned_.begin(); it != abandoned_.end(); ++it) {
+    if ((*it)->timed_out || (*it)->in_flight.empty()) continue;
+    // In slices, so that a new interrupt request is not kept waiting (Cancelled).
+    while (true) {
+      const auto left = std::max(std::chrono::nanoseconds(0), std::chrono::nanoseconds(deadline - Clock::now()));
+      const auto slice = std::min<std::chrono::nanoseconds>(left, std::chrono::milliseconds(50));
+      try {
+        if (ctx_->device().waitForFences((*it)->in_flight, VK_TRUE, uint64_t(slice.count())) != vk::Result::eTimeout) break;
+      } catch (const vk::DeviceLostError&) {  // nothing runs on a lost device any more
+        break;
+      }
+      if (left == std::chrono::nanoseconds(0)) return true;
+      throw_if_interrupted();
     }
-    ++it;
   }
   return busy(std::chrono::milliseconds(0));
 }

@@ -61,7 +61,8 @@ class Renderer {
   bool busy(std::chrono::milliseconds wait);
   // Waits up to `wait` for the tiles interrupted renders left running (a tile runs on after Ctrl-C
   // until its submission ends), then says, as busy(0) does, whether work is still running: that of
-  // a render that timed out, or an interrupted tile past `wait`.
+  // a render that timed out, or an interrupted tile past `wait`. Throws Cancelled on an interrupt
+  // request while it waits.
   bool busy_after_interrupts(std::chrono::milliseconds wait);
 
  private:

@@ -115,8 +115,10 @@ void write_exr(const std::filesystem::path& file, const Image& image, const Aovs
       switch (pass) {
         case Aov::albedo: add(name, content.full_float, [&](size_t i) { return aovs->albedo[i][c]; }); break;
         case Aov::normal: add(name, content.full_float, [&](size_t i) { return aovs->normal[i][c]; }); break;
-        case Aov::position: add(name, content.full_float, [&](size_t i) { return aovs->position[i][c]; }); break;
-        case Aov::depth: add(name, content.full_float, [&](size_t i) { return aovs->depth[i]; }); break;
+        // Lengths are always 32-bit: half floats step by 1/32 past 2048, and round depths past 65504
+        // to infinity, which means "nothing hit".
+        case Aov::position: add(name, true, [&](size_t i) { return aovs->position[i][c]; }); break;
+        case Aov::depth: add(name, true, [&](size_t i) { return aovs->depth[i]; }); break;
         case Aov::object: add(name, true, [&](size_t i) { return float(aovs->object[i]); }); break;
       }
     }

@@ -12,8 +12,9 @@
 namespace vkray {
 
 struct ExrContent {
-  // 32-bit float channels; false: 16-bit half floats (the image and every pass but object.id, which
-  // is always 32-bit float so that every id up to 2^24 stays exact).
+  // 32-bit float channels; false: 16-bit half floats for the image, albedo and normal. position and
+  // depth are always 32-bit (half floats would round a far depth to infinity, the miss marker), and
+  // so is object.id (every id below 2^24 exact).
   bool full_float = false;
   std::vector<Aov> passes;  // the layers written after R, G, B, in this order
 };

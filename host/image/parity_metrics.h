@@ -65,7 +65,8 @@ ParityMetrics compare_images(const Image& gpu, const Image& reference, const std
                              const ParityTolerance& tolerance = {});
 
 // Adds the comparison of the first-hit passes to `metrics` (from compare_images, whose edges it
-// uses) and judges it by the tolerance's rule for the image: a pass differs at a pixel where the
+// uses) and judges it by the rule for a deterministic image (camera rays are the same on both
+// renderers, even in a noisy render): a pass differs at a pixel where the
 // object ids differ, or a value beyond float precision: 1e-4 of the value for albedo, 1e-3 for a
 // normal, 1e-4 of `scene_extent` for position and depth (or one depth is infinite, the other not).
 void compare_aovs(const Aovs& gpu, const Aovs& reference, const std::vector<uint64_t>& signatures, double scene_extent,

@@ -196,7 +196,7 @@ class Renderer {
   py::object render(const SceneSource& source, std::optional<uint32_t> width, std::optional<uint32_t> height,
                     std::optional<uint32_t> spp, std::optional<uint32_t> seed, const std::vector<std::string>& aov_names) {
     const std::vector<Aov> passes = parse_passes(aov_names);
-    const auto lock = lock_without_gil();
+    auto lock = lock_without_gil();
     if (!session_) raise_failure(std::make_exception_ptr(UsageError("the renderer is closed")));
     struct Done {
       RenderResult result;
@@ -207,6 +207,7 @@ class Renderer {
     Done done = run_interruptibly([&] {
       const auto start = Clock::now();
       auto scene = load(source, &meshes_);
+      meshes_.keep_only(scene->referenced_files);
       const double load_seconds = seconds_since(start);
       RenderOptions options = render_options(width, height, spp, seed, !passes.empty());
       image_settings(*scene, options);  // a bad override fails before any upload
@@ -219,8 +220,9 @@ class Renderer {
       RenderResult result = session_->render(*on_device, options);
       return Done{std::move(result), scene, load_seconds, on_device->upload_seconds(), on_device->shares_geometry()};
     });
-    warn_about(*done.scene);
     last_stats_ = stats_dict(done.result.stats, done.load_seconds, done.upload_seconds, done.reused);
+    lock.unlock();  // a warning's handler may use this renderer
+    warn_about(*done.scene);
     return to_numpy(done.result, passes);
   }
 
@@ -249,10 +251,12 @@ class Renderer {
     return lock;
   }
 
+  // Releases the device, without the GIL: closing may wait for a tile an interrupt left running.
   void release() {
     last_.reset();
     if (!session_) return;
     std::unique_ptr<Session> session = std::move(session_);
+    py::gil_scoped_release released;
     session->close();
   }
 

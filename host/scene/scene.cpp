@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <initializer_list>
 #include <limits>
 #include <map>
@@ -552,9 +553,30 @@ float Scene::extent() const {
   return e;
 }
 
+namespace {
+
+// Bit for bit: -0 and 0 are different coordinates to the shader's packed buffers.
+bool same_bits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, &b, sizeof(glm::vec3)) == 0; }
+
+bool same_bits(const Triangle& a, const Triangle& b) {
+  for (size_t k = 0; k < 3; ++k)
+    if (!same_bits(a.v[k], b.v[k]) || !same_bits(a.normals[k], b.normals[k])) return false;
+  return a.material == b.material && a.object == b.object && a.smooth == b.smooth;
+}
+
+bool same_bits(const Sphere& a, const Sphere& b) {
+  return same_bits(a.center, b.center) && std::memcmp(&a.radius, &b.radius, sizeof(float)) == 0 && a.material == b.material &&
+         a.object == b.object && a.inward == b.inward;
+}
+
+}  // namespace
+
 bool same_geometry(const Scene& a, const Scene& b) {
   // Materials are compared by index (a primitive's flags hold it), not by value.
-  return a.triangles == b.triangles && a.spheres == b.spheres && a.materials.size() == b.materials.size();
+  const auto same = [](const auto& x, const auto& y) { return same_bits(x, y); };
+  return a.materials.size() == b.materials.size() &&
+         std::equal(a.triangles.begin(), a.triangles.end(), b.triangles.begin(), b.triangles.end(), same) &&
+         std::equal(a.spheres.begin(), a.spheres.end(), b.spheres.begin(), b.spheres.end(), same);
 }
 
 struct MeshCache::Entry {
@@ -576,6 +598,10 @@ std::shared_ptr<const Mesh> MeshCache::get(const std::filesystem::path& file) {
   auto mesh = std::make_shared<const Mesh>(load_mesh(file));
   if (!size_error && !time_error) entries_[file] = Entry{size, modified, mesh};
   return mesh;
+}
+
+void MeshCache::keep_only(const std::vector<std::filesystem::path>& files) {
+  std::erase_if(entries_, [&](const auto& entry) { return std::find(files.begin(), files.end(), entry.first) == files.end(); });
 }
 
 Scene parse_scene(std::string_view json_text, const std::filesystem::path& file, MeshCache* meshes) {

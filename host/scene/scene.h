@@ -92,7 +92,6 @@ struct Sphere {
   uint32_t object = 0;  // its place in the file's "objects": the `object` pass (AOV) reports it
   bool inward = false;  // "flip_normals": the normal points to the centre (for emission and glass)
 
-  bool operator==(const Sphere&) const = default;
 };
 
 struct Triangle {
@@ -102,7 +101,6 @@ struct Triangle {
   bool smooth = false;                 // shade with `normals` interpolated, not the face normal
   std::array<glm::vec3, 3> normals{};  // unit vertex normals, when smooth
 
-  bool operator==(const Triangle&) const = default;
 };
 
 struct Scene {
@@ -145,6 +143,9 @@ class MeshCache {
   MeshCache& operator=(const MeshCache&) = delete;
   // The mesh in `file`, read now (load_mesh) unless kept. Throws what load_mesh throws.
   std::shared_ptr<const Mesh> get(const std::filesystem::path& file);
+  // Forgets every file but these (a scene's referenced_files), so that a long-lived cache holds
+  // only what the last scene uses.
+  void keep_only(const std::vector<std::filesystem::path>& files);
 
  private:
   struct Entry;

@@ -4,6 +4,10 @@
 
 #include <system_error>
 
+#ifndef VKRAY_MODULE_TO_PREFIX  // built without the Python module
+#define VKRAY_MODULE_TO_PREFIX "../../../.."
+#endif
+
 namespace vkray {
 
 std::filesystem::path executable_path() {
@@ -18,19 +22,22 @@ namespace {
 // for Python.
 std::filesystem::path code_path() {
   Dl_info info{};
-  if (dladdr(reinterpret_cast<const void*>(&code_path), &info) != 0 && info.dli_fname && info.dli_fname[0] == '/')
-    return info.dli_fname;
+  if (dladdr(reinterpret_cast<const void*>(&code_path), &info) != 0 && info.dli_fname && info.dli_fname[0] == '/') {
+    std::error_code ec;  // glibc names the main program as it was started: a symlink is resolved here
+    const auto resolved = std::filesystem::canonical(info.dli_fname, ec);
+    if (!ec) return resolved;
+  }
   return executable_path();
 }
 
 // Where an installed vkray keeps its data: <prefix>/share/vkray, from <prefix>/bin/vkray or from
-// <prefix>/lib/pythonX.Y/site-packages/vkray/_vkray*.so.
+// the Python module in <prefix>/VKRAY_PYTHON_INSTALL_DIR/vkray/ (VKRAY_MODULE_TO_PREFIX leads back).
 std::filesystem::path find(const char* relative, const char* source_tree_dir, const char* probe) {
   const auto code = code_path();
   std::error_code ec;
   if (!code.empty()) {
     const auto from_bin = code.parent_path().parent_path();
-    const auto from_module = from_bin.parent_path().parent_path().parent_path();
+    const auto from_module = (code.parent_path() / VKRAY_MODULE_TO_PREFIX).lexically_normal();
     for (const auto& prefix : {from_bin, from_module}) {
       const auto installed = prefix / "share" / "vkray" / relative;
       if (std::filesystem::exists(installed / probe, ec)) return installed;

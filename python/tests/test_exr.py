@@ -44,18 +44,19 @@ def test_a_full_float_exr_holds_the_image_and_every_pass_exactly(scenes, vkray_c
     assert np.array_equal(channels["object.id"].astype(np.int32), rendered["object"])
 
 
-def test_a_default_exr_is_half_float_with_32_bit_object_ids(scenes, vkray_command, tmp_path, rendered):
-    out = tmp_path / "h.exr"
+def test_a_default_exr_is_half_float_with_32_bit_lengths_and_object_ids(scenes, vkray_command, tmp_path, rendered):
+    out = tmp_path / "h.EXR"  # the extension in any case
     run(vkray_command, "render", str(scenes / "cornell-spheres.json"), "--width", "64", "--height", "48", "--spp", "4",
-        "--aov", "depth,object", "-o", str(out), "-q")
+        "--aov", "depth,object,normal", "-o", str(out), "-q")
     header = run("exrheader", str(out)).stdout
-    for name in ("R", "G", "B", "depth.Z"):
+    for name in ("R", "G", "B", "normal.X"):
         assert f"    {name}, 16-bit floating-point" in header, header
-    assert "    object.id, 32-bit floating-point" in header, header
+    for name in ("depth.Z", "object.id"):
+        assert f"    {name}, 32-bit floating-point" in header, header
     assert "albedo.R" not in header
     channels, _ = read_exr(out)
     assert np.allclose(channels["R"], rendered["color"][:, :, 0], rtol=1e-3, atol=1e-6)
-    assert np.allclose(channels["depth.Z"], rendered["depth"], rtol=1e-3)
+    assert np.array_equal(channels["depth.Z"], rendered["depth"])
     assert np.array_equal(channels["object.id"].astype(np.int32), rendered["object"])
 
 
