@@ -42,11 +42,7 @@ int run_render(const RenderArgs& args) {
   ExrContent content;
   content.full_float = args.exr_float;
   if (!args.aovs.empty()) content.passes = parse_aov_list(args.aovs);
-  std::string extension = output.extension().string();
-  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if ((!content.passes.empty() || content.full_float) && extension != ".exr")
-    throw UsageError(output.string() + ": " + (content.full_float ? "--exr-float" : "--aov") +
-                     " is for EXR files only: name the output *.exr");
+  check_render_image(output, content);
   RenderOptions options = render_options(&args.scene, &args.gpu, &args.cpu);
   options.aovs = !content.passes.empty();
   const ImageSettings image = image_settings(*loaded.scene, options);

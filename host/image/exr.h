@@ -28,6 +28,11 @@ void write_exr(const std::filesystem::path& file, const Image& image, const Aovs
 // UsageError when passes or 32-bit floats are asked of another type, OutputError.
 void write_render_image(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content);
 
+// Whether `file` is named *.exr (in any case).
+bool is_exr(const std::filesystem::path& file);
+// Throws the UsageError write_render_image would, before any work is done.
+void check_render_image(const std::filesystem::path& file, const ExrContent& content);
+
 struct ExrFile {
   Image image;
   Aovs aovs;  // the passes the file has; the others keep Aovs' defaults
