@@ -7,6 +7,7 @@
 
 #include "resources.glsl"
 #include "shared/sampling.h"
+#include "texture.glsl"
 #include "warp.glsl"
 
 struct LightPoint {
@@ -29,17 +30,24 @@ LightPoint sample_area_light(inout uint stream) {
   vec4 a = texelFetch(primitives, base), b = texelFetch(primitives, base + 1), c = texelFetch(primitives, base + 2);
   uint flags = primitive_flags(a);
   LightPoint light;
+  vec3 w = vec3(0.0);
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     vec3 d = uniform_sphere(u);
     light.position = a.xyz + sphere_radius(b) * d;
     light.normal = (flags & VKRAY_PRIM_INWARD) != 0u ? -d : d;
   } else {
-    vec3 w = uniform_triangle(u);
+    w = uniform_triangle(u);
     light.position = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
     light.normal = normalize(cross(b.xyz - a.xyz, c.xyz - a.xyz));
   }
-  light.radiance = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION).rgb;
-  light.pdf_area = emission_luminance(light.radiance) * frame.inv_emitter_weight;
+  vec3 emission = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION).rgb;
+  // The light is picked by its material's emission; a texture only scales what the point sends.
+  light.pdf_area = emission_luminance(emission) * frame.inv_emitter_weight;
+  light.radiance = emission;
+  if (SCENE_HAS_TEXTURES) {
+    vec4 emission_texture = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION_TEXTURE);
+    if (has_texture(emission_texture)) light.radiance *= sample_texture(emission_texture, triangle_texcoord(prim, w.yz));
+  }
   return light;
 }
 

@@ -53,7 +53,7 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   bool front = cos_hit > 0.0;
   if (SCENE_HAS_EMITTERS && front && s.emission != vec3(0.0)) {  // (0 * a grazing hit's infinite density is NaN)
     // Light sampling finds this point with density pdf_area t^2 / cos per unit solid angle.
-    float light_pdf = area_light_pdf(s.emission) * hit.t * hit.t / cos_hit;
+    float light_pdf = area_light_pdf(s.emission_factor) * hit.t * hit.t / cos_hit;
     float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, light_pdf);
     p.radiance += p.throughput * s.emission * weight;
   }

@@ -5,6 +5,7 @@
 
 #include "intersect.glsl"
 #include "resources.glsl"
+#include "texture.glsl"
 
 // t of the nearest intersection with the primitive in (t_min, t_max), or -1.
 float intersect_primitive(Ray ray, RayShear shear, vec4 a, vec4 b, vec4 c, float t_min, float t_max) {
@@ -17,10 +18,11 @@ float intersect_primitive(Ray ray, RayShear shear, vec4 a, vec4 b, vec4 c, float
 struct Surface {
   vec3 geometric_normal;  // unit, not yet oriented toward the ray: the side it faces emits
   vec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal
-  vec3 albedo;            // or a mirror's reflectance
+  vec3 albedo;            // or a mirror's reflectance, its texture applied
   uint material_type;     // VKRAY_MATERIAL_*
-  vec3 emission;
+  vec3 emission;          // its texture applied
   float ior;
+  vec3 emission_factor;   // the material's emission, which weighs area lights (emitters.glsl)
 };
 
 Surface hit_surface(Hit hit, vec3 position) {
@@ -38,6 +40,7 @@ Surface hit_surface(Hit hit, vec3 position) {
     s.emission = emission.rgb;
     s.ior = emission.w;
   }
+  s.emission_factor = s.emission;
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     s.geometric_normal = (position - a.xyz) / sphere_radius(texelFetch(primitives, base + 1));
     if ((flags & VKRAY_PRIM_INWARD) != 0u) s.geometric_normal = -s.geometric_normal;
@@ -47,10 +50,22 @@ Surface hit_surface(Hit hit, vec3 position) {
   vec3 v1 = texelFetch(primitives, base + 1).xyz, v2 = texelFetch(primitives, base + 2).xyz;
   s.geometric_normal = normalize(cross(v1 - a.xyz, v2 - a.xyz));
   s.shading_normal = s.geometric_normal;
-  if ((flags & VKRAY_PRIM_SMOOTH) != 0u) {
-    vec2 uv = triangle_barycentrics(position, a.xyz, v1, v2);
-    s.shading_normal = normalize((1.0 - uv.x - uv.y) * texelFetch(normals, base).xyz + uv.x * texelFetch(normals, base + 1).xyz +
-                                 uv.y * texelFetch(normals, base + 2).xyz);
+  bool smooth_normals = (flags & VKRAY_PRIM_SMOOTH) != 0u;
+  vec4 albedo_texture = vec4(0.0), emission_texture = vec4(0.0);
+  if (SCENE_HAS_TEXTURES) {
+    albedo_texture = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_ALBEDO_TEXTURE);
+    emission_texture = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION_TEXTURE);
+  }
+  bool textured = SCENE_HAS_TEXTURES && (has_texture(albedo_texture) || has_texture(emission_texture));
+  if (!smooth_normals && !textured) return s;
+  vec2 b = triangle_barycentrics(position, a.xyz, v1, v2);
+  if (smooth_normals)
+    s.shading_normal = normalize((1.0 - b.x - b.y) * texelFetch(normals, base).xyz + b.x * texelFetch(normals, base + 1).xyz +
+                                 b.y * texelFetch(normals, base + 2).xyz);
+  if (textured) {
+    vec2 uv = triangle_texcoord(hit.prim, b);
+    if (has_texture(albedo_texture)) s.albedo *= sample_texture(albedo_texture, uv);
+    if (has_texture(emission_texture)) s.emission *= sample_texture(emission_texture, uv);
   }
   return s;
 }

@@ -14,6 +14,8 @@ layout(set = 0, binding = VKRAY_BINDING_NODES) uniform usamplerBuffer nodes;
 layout(set = 0, binding = VKRAY_BINDING_MATERIALS) uniform samplerBuffer materials;
 layout(set = 0, binding = VKRAY_BINDING_LIGHTS) uniform samplerBuffer lights;
 layout(set = 0, binding = VKRAY_BINDING_EMITTERS) uniform samplerBuffer emitters;
+layout(set = 0, binding = VKRAY_BINDING_TEXCOORDS) uniform samplerBuffer texcoords;
+layout(set = 0, binding = VKRAY_BINDING_TEXTURES) uniform samplerBuffer textures;
 
 // The frame's constants as every function reads them: a private copy of the uniform block, made
 // by load_frame() before anything else in main. llvmpipe reads a uniform block lane by lane at
@@ -31,5 +33,6 @@ layout(constant_id = VKRAY_SPEC_PATH) const bool PATH_TRACING = false;
 layout(constant_id = VKRAY_SPEC_EMITTERS) const bool SCENE_HAS_EMITTERS = false;
 layout(constant_id = VKRAY_SPEC_SPECULAR) const bool SCENE_HAS_SPECULAR = false;
 layout(constant_id = VKRAY_SPEC_AOVS) const bool FIRST_HIT_PASSES = false;
+layout(constant_id = VKRAY_SPEC_TEXTURES) const bool SCENE_HAS_TEXTURES = false;
 
 #endif

@@ -109,10 +109,10 @@ TEST(CliTest, AShaderThatDeclaresABindingOtherwiseThanVkrayBindsItExitsOne) {
   EXPECT_FALSE(std::filesystem::exists(retyped / "out.png"));
 
   TempDir moved;
-  copy_shaders_with_edit(moved.path(), "resources.glsl", "binding = VKRAY_BINDING_LIGHTS)", "binding = 9)");
+  copy_shaders_with_edit(moved.path(), "resources.glsl", "binding = VKRAY_BINDING_LIGHTS)", "binding = 19)");
   const Result run2 = vkray("render --validate --shader-dir shaders -o out.png", moved.path());
   EXPECT_EQ(run2.exit_code, 1) << run2.err;
-  EXPECT_NE(run2.err.find("'lights' is declared at binding 9, where vkray binds nothing"), std::string::npos) << run2.err;
+  EXPECT_NE(run2.err.find("'lights' is declared at binding 19, where vkray binds nothing"), std::string::npos) << run2.err;
 
   TempDir other_set;
   copy_shaders_with_edit(other_set.path(), "resources.glsl", "set = 0, binding = VKRAY_BINDING_LIGHTS",

@@ -63,7 +63,7 @@ TEST(ShaderCompilerTest, CompilesTheTracerAndListsEveryIncludedFile) {
                          "shared/sampling.h", "camera.glsl",     "ray.glsl",        "resources.glsl",
                          "shade.glsl",      "primitives.glsl",   "intersect.glsl",  "traversal.glsl",
                          "inline_scene.glsl", "warp.glsl",        "emitters.glsl",   "bsdf.glsl",
-                         "direct.glsl",     "path.glsl",         "aovs.glsl"};
+                         "direct.glsl",     "path.glsl",         "aovs.glsl",       "texture.glsl"};
   for (const char* file : files) {
     const auto expected = (dir / file).lexically_normal();
     EXPECT_NE(std::find(shader.sources.begin(), shader.sources.end(), expected), shader.sources.end()) << file;
@@ -91,6 +91,8 @@ TEST(ShaderCompilerTest, ReflectsTheBindingsTheShaderDeclares) {
       {VKRAY_BINDING_OUTPUT, {"Output", D::eStorageBuffer}},
       {VKRAY_BINDING_EMITTERS, {"emitters", D::eUniformTexelBuffer}},
       {VKRAY_BINDING_AOVS, {"AovOutput", D::eStorageBuffer}},
+      {VKRAY_BINDING_TEXCOORDS, {"texcoords", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_TEXTURES, {"textures", D::eUniformTexelBuffer}},
   };
   EXPECT_EQ(found, expected);
 }

@@ -13,6 +13,8 @@ namespace vkray {
 constexpr uint64_t kMaxSceneFileBytes = uint64_t(64) << 20;
 constexpr uint64_t kMaxMeshFileBytes = uint64_t(4) << 30;
 constexpr uint64_t kMaxShaderFileBytes = uint64_t(4) << 20;
+constexpr uint64_t kMaxPictureFileBytes = uint64_t(1) << 30;  // a texture's PNG or JPEG file
+constexpr uint64_t kMaxGltfFileBytes = uint64_t(2) << 30;     // a .gltf, .glb or .bin file (tinygltf counts in 32 bits)
 
 struct InputFile {
   std::string text;   // the contents, when error is empty

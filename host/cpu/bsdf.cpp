@@ -20,7 +20,7 @@ double fresnel_dielectric(double cos_i, double eta, double& cos_t) {
   return (rs * rs + rp * rp) / 2;
 }
 
-BsdfSample sample_bsdf(const Material& material, const glm::dvec3& wo, const glm::dvec3& n, bool front, uint32_t& stream) {
+BsdfSample sample_bsdf(const Material& material, const glm::dvec3& albedo, const glm::dvec3& wo, const glm::dvec3& n, bool front, uint32_t& stream) {
   BsdfSample b;
   switch (material.type) {
     case MaterialType::diffuse: {
@@ -28,13 +28,13 @@ BsdfSample sample_bsdf(const Material& material, const glm::dvec3& wo, const glm
       const glm::dvec3 local = cosine_hemisphere(u1, u2);
       b.dir = glm::normalize(to_world(local, n));  // as the shader does (bsdf.glsl says why)
       b.pdf = local.z / kPi;
-      b.weight = glm::dvec3(material.albedo);  // (albedo / pi) cos / (cos / pi)
+      b.weight = albedo;  // (albedo / pi) cos / (cos / pi)
       return b;
     }
     case MaterialType::mirror:
       b.delta = true;
       b.dir = glm::normalize(2 * glm::dot(wo, n) * n - wo);
-      b.weight = glm::dvec3(material.albedo);
+      b.weight = albedo;
       return b;
     case MaterialType::glass: {
       b.delta = true;

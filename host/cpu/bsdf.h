@@ -24,7 +24,8 @@ struct BsdfSample {
 double fresnel_dielectric(double cos_i, double eta, double& cos_t);
 
 // wo: unit, back along the incoming ray; n: the shading normal on wo's side; front: the ray met the
-// side the geometric normal faces (glass: from outside). Draws from `stream`.
-BsdfSample sample_bsdf(const Material& material, const glm::dvec3& wo, const glm::dvec3& n, bool front, uint32_t& stream);
+// side the geometric normal faces (glass: from outside); albedo: the material's, its texture applied
+// (SurfacePoint::albedo). Draws from `stream`.
+BsdfSample sample_bsdf(const Material& material, const glm::dvec3& albedo, const glm::dvec3& wo, const glm::dvec3& n, bool front, uint32_t& stream);
 
 }  // namespace vkray::cpu

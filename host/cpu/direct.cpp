@@ -22,7 +22,7 @@ dvec3 shade(const Tracer& tracer, const Lights& lights, const SurfacePoint& s, c
     const AreaLightSample light = lights.sample_area_light_from(x, n, shadow_origin, state.stream, state.rays);
     if (light.pdf > 0) irradiance += light.radiance * (light.cos_x / (kPi * light.pdf));
   }
-  return dvec3(scene.materials[s.material].albedo) * irradiance;
+  return s.albedo * irradiance;
 }
 
 }  // namespace
@@ -46,12 +46,12 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
     const bool front = !(glm::dot(s.geometric_normal, ray.dir) > 0);
     const dvec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
     const dvec3 n = front ? s.shading_normal : -s.shading_normal;
-    if (front) radiance += throughput * dvec3(material.emission);
+    if (front) radiance += throughput * s.emission;
     if (!material.specular()) {
       radiance += throughput * shade(tracer, lights, s, n, n_geometric, state, bounce == 0);
       break;
     }
-    const BsdfSample b = sample_bsdf(material, -ray.dir, n, front, state.stream);
+    const BsdfSample b = sample_bsdf(material, s.albedo, -ray.dir, n, front, state.stream);
     if ((glm::dot(b.dir, n_geometric) > 0) == b.transmitted) break;  // the wrong side of the surface
     throughput *= b.weight;
     ray = {s.position + (b.transmitted ? -epsilon : epsilon) * n_geometric, b.dir};

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "cpu/texture.h"
 #include "cpu/warp.h"
 #include "shared/sampling.h"
 #include "shared/scene_layout.h"
@@ -69,9 +70,10 @@ LightPoint Lights::sample_area_light(uint32_t& stream) const {
 
   LightPoint light;
   uint32_t material;
+  dvec3 b(0.0);  // the barycentrics of a point on a triangle
   if (p < scene.triangles.size()) {
     const Triangle& t = scene.triangles[p];
-    const dvec3 b = uniform_triangle(u1, u2);
+    b = uniform_triangle(u1, u2);
     light.position = b.x * dvec3(t.v[0]) + b.y * dvec3(t.v[1]) + b.z * dvec3(t.v[2]);
     light.normal = glm::normalize(glm::cross(dvec3(t.v[1]) - dvec3(t.v[0]), dvec3(t.v[2]) - dvec3(t.v[0])));
     material = t.material;
@@ -82,8 +84,14 @@ LightPoint Lights::sample_area_light(uint32_t& stream) const {
     light.normal = s.inward ? -d : d;
     material = s.material;
   }
-  light.radiance = dvec3(scene.materials[material].emission);
-  light.pdf_area = area_pdf(scene.materials[material].emission);
+  // The light is picked by its material's emission; a texture only scales what the point sends.
+  const Material& m = scene.materials[material];
+  light.radiance = dvec3(m.emission);
+  light.pdf_area = area_pdf(m.emission);
+  if (p < scene.triangles.size() && m.emission_texture.present()) {
+    const Triangle& t = scene.triangles[p];
+    light.radiance *= sample_texture(scene, m.emission_texture, b.x * glm::dvec2(t.uv[0]) + b.y * glm::dvec2(t.uv[1]) + b.z * glm::dvec2(t.uv[2]));
+  }
   return light;
 }
 

@@ -45,7 +45,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     const bool front = cos_hit > 0;
     if (front && material.emissive()) {
       const double light_pdf = lights.area_pdf(material.emission) * hit.t * hit.t / cos_hit;
-      radiance += throughput * dvec3(material.emission) * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, light_pdf));
+      radiance += throughput * s.emission * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, light_pdf));
     }
     if (++depth >= max_depth) break;
 
@@ -54,7 +54,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     const dvec3 x = s.position;
     const dvec3 origin = x + epsilon * n_geometric;
     if (!material.specular()) {
-      const dvec3 albedo(material.albedo);
+      const dvec3 albedo = s.albedo;
       dvec3 irradiance(0.0);
       lights.add_point_lights(x, n, origin, irradiance, depth == 1 ? &state.signature : nullptr, state.rays);
       radiance += throughput * albedo * irradiance;
@@ -78,7 +78,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     }
 
     // The next direction.
-    const BsdfSample b = sample_bsdf(material, -ray.dir, n, front, state.stream);
+    const BsdfSample b = sample_bsdf(material, s.albedo, -ray.dir, n, front, state.stream);
     if ((glm::dot(b.dir, n_geometric) > 0) == b.transmitted) break;  // the wrong side of the surface
     throughput *= b.weight;
     if (std::max({throughput.r, throughput.g, throughput.b}) == 0) break;

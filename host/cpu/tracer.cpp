@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "bvh/bvh.h"
+#include "cpu/texture.h"
 #include "shared/types.h"
 
 namespace vkray::cpu {
@@ -123,12 +124,22 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
       s.shading_normal = glm::normalize((1 - hit.u - hit.v) * dvec3(tri.normals[0]) + hit.u * dvec3(tri.normals[1]) +
                                         hit.v * dvec3(tri.normals[2]));
     s.material = tri.material;
+    const Material& m = scene_.materials[tri.material];
+    s.albedo = dvec3(m.albedo);
+    s.emission = dvec3(m.emission);
+    if (m.textured()) {
+      const glm::dvec2 uv = (1 - hit.u - hit.v) * glm::dvec2(tri.uv[0]) + hit.u * glm::dvec2(tri.uv[1]) + hit.v * glm::dvec2(tri.uv[2]);
+      if (m.albedo_texture.present()) s.albedo *= sample_texture(scene_, m.albedo_texture, uv);
+      if (m.emission_texture.present()) s.emission *= sample_texture(scene_, m.emission_texture, uv);
+    }
   } else {
     const Sphere& sphere = scene_.spheres[size_t(hit.primitive) - scene_.triangles.size()];
     s.geometric_normal = (s.position - dvec3(sphere.center)) / double(sphere.radius);
     if (sphere.inward) s.geometric_normal = -s.geometric_normal;
     s.shading_normal = s.geometric_normal;
     s.material = sphere.material;
+    s.albedo = dvec3(scene_.materials[sphere.material].albedo);
+    s.emission = dvec3(scene_.materials[sphere.material].emission);
   }
   return s;
 }

@@ -34,6 +34,8 @@ struct SurfacePoint {
   dvec3 geometric_normal;  // unit; the side it faces emits, and is glass's outside
   dvec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal
   uint32_t material = 0;
+  dvec3 albedo{0.0};    // the material's albedo (or reflectance), its texture applied
+  dvec3 emission{0.0};  // the material's emission, its texture applied
 };
 
 class Tracer {

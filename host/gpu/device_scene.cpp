@@ -40,12 +40,31 @@ TexelBuffer make_texel_buffer(const Context& ctx, const std::vector<Texel>& texe
   return t;
 }
 
+// The textures' texels, half-float RGBA, in an RGBA16F texel buffer (a format every Vulkan device
+// reads from uniform texel buffers; checked anyway, so that a device that does not says so).
+TexelBuffer make_texture_buffer(const Context& ctx, const std::vector<uint16_t>& halves) {
+  constexpr vk::Format format = vk::Format::eR16G16B16A16Sfloat;
+  const size_t texels = halves.size() / 4;
+  if (!(ctx.physical_device().getFormatProperties(format).bufferFeatures & vk::FormatFeatureFlagBits::eUniformTexelBuffer))
+    throw DeviceError(ctx.device_name() + " cannot read RGBA16F uniform texel buffers, which vkray keeps textures in");
+  if (texels > ctx.limits().maxTexelBufferElements)
+    throw DeviceError("textures too large for " + ctx.device_name() + ": " + std::to_string(texels) +
+                      " texels together, maxTexelBufferElements is " + std::to_string(ctx.limits().maxTexelBufferElements));
+  static const uint16_t placeholder[4] = {};
+  TexelBuffer t;
+  const vk::DeviceSize bytes = checked_mul(std::max<size_t>(texels, 1), 4 * sizeof(uint16_t), "textures");
+  t.buffer = upload_buffer(ctx, halves.empty() ? placeholder : halves.data(), bytes, vk::BufferUsageFlagBits::eUniformTexelBuffer);
+  t.view = vk::raii::BufferView(ctx.device(), vk::BufferViewCreateInfo({}, *t.buffer.buffer, format, 0, bytes));
+  return t;
+}
+
 // Refuses, before allocating anything, a scene whose buffers cannot fit the device's memory.
 void check_memory(const Context& ctx, const PackedScene& packed) {
   uint64_t texels = packed.nodes.size();
-  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.materials, &packed.lights, &packed.emitters})
+  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.texcoords, &packed.materials, &packed.lights, &packed.emitters})
     texels = checked_add(texels, buffer->size(), "scene buffers");
-  const uint64_t bytes = checked_mul(texels, sizeof(glm::vec4), "scene buffers");
+  const uint64_t bytes = checked_add(checked_mul(texels, sizeof(glm::vec4), "scene buffers"),
+                                     checked_mul(packed.textures.size(), sizeof(uint16_t), "textures"), "scene buffers");
   const auto memory = ctx.physical_device().getMemoryProperties();
   uint64_t largest_heap = 0;
   for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
@@ -59,7 +78,7 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
 }  // namespace
 
 struct GpuScene::Geometry {
-  TexelBuffer primitives, normals, nodes;
+  TexelBuffer primitives, normals, nodes, texcoords, textures;
   std::vector<uint32_t> order;  // the BVH's leaf order: the lighting's area lights name slots in it
 };
 
@@ -85,7 +104,9 @@ GpuScene::GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Sce
   check_memory(*ctx_, packed);
   geometry_ = std::make_shared<const Geometry>(Geometry{make_texel_buffer(*ctx_, packed.primitives, "primitive"),
                                                         make_texel_buffer(*ctx_, packed.normals, "normal"),
-                                                        make_texel_buffer(*ctx_, packed.nodes, "BVH node"), bvh.order});
+                                                        make_texel_buffer(*ctx_, packed.nodes, "BVH node"),
+                                                        make_texel_buffer(*ctx_, packed.texcoords, "texture coordinate"),
+                                                        make_texture_buffer(*ctx_, packed.textures), bvh.order});
   lighting_ = std::make_unique<Lighting>(*ctx_, packed);
   emitters_ = packed.emitter_frame;
   // A BVH built beforehand (perhaps while the shaders compiled) still counts: the upload stage
@@ -116,7 +137,9 @@ void GpuScene::bind(DescriptorWriter& writer) const {
       .texel_buffer(VKRAY_BINDING_NODES, *geometry_->nodes.view)
       .texel_buffer(VKRAY_BINDING_MATERIALS, *lighting_->materials.view)
       .texel_buffer(VKRAY_BINDING_LIGHTS, *lighting_->lights.view)
-      .texel_buffer(VKRAY_BINDING_EMITTERS, *lighting_->emitters.view);
+      .texel_buffer(VKRAY_BINDING_EMITTERS, *lighting_->emitters.view)
+      .texel_buffer(VKRAY_BINDING_TEXCOORDS, *geometry_->texcoords.view)
+      .texel_buffer(VKRAY_BINDING_TEXTURES, *geometry_->textures.view);
 }
 
 }  // namespace vkray::gpu

@@ -25,6 +25,8 @@ constexpr BindingSlot kTraceBindings[] = {
     {VKRAY_BINDING_OUTPUT, vk::DescriptorType::eStorageBuffer, "output"},
     {VKRAY_BINDING_EMITTERS, kTexel, "emitters"},
     {VKRAY_BINDING_AOVS, vk::DescriptorType::eStorageBuffer, "aovs"},
+    {VKRAY_BINDING_TEXCOORDS, kTexel, "texcoords"},
+    {VKRAY_BINDING_TEXTURES, kTexel, "textures"},
 };
 
 // Whether a SPIR-V module declares `capability` (its OpCapability instructions come first).
@@ -101,10 +103,12 @@ std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVari
     inline_module = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, shader.spirv));
   }
   const vk::ShaderModule module = variant.inline_scene.empty() ? *module_ : *inline_module;
-  const VkBool32 constants[] = {variant.spheres, variant.shadows, variant.path, variant.emitters, variant.specular, variant.aovs};
+  const VkBool32 constants[] = {variant.spheres, variant.shadows, variant.path, variant.emitters, variant.specular, variant.aovs,
+                                variant.textures};
   const auto entry = [](uint32_t id, uint32_t index) { return vk::SpecializationMapEntry(id, index * sizeof(VkBool32), sizeof(VkBool32)); };
   const vk::SpecializationMapEntry entries[] = {entry(VKRAY_SPEC_SPHERES, 0), entry(VKRAY_SPEC_SHADOWS, 1), entry(VKRAY_SPEC_PATH, 2),
-                                                entry(VKRAY_SPEC_EMITTERS, 3), entry(VKRAY_SPEC_SPECULAR, 4), entry(VKRAY_SPEC_AOVS, 5)};
+                                                entry(VKRAY_SPEC_EMITTERS, 3), entry(VKRAY_SPEC_SPECULAR, 4), entry(VKRAY_SPEC_AOVS, 5),
+                                                entry(VKRAY_SPEC_TEXTURES, 6)};
   const vk::SpecializationInfo specialization(entries, vk::ArrayProxyNoTemporaries<const VkBool32>(constants));
   const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, module, "main", &specialization);
   return std::make_shared<const vk::raii::Pipeline>(

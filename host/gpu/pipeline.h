@@ -31,6 +31,7 @@ struct ShaderVariant {
   bool emitters = false;     // VKRAY_SPEC_EMITTERS
   bool specular = false;     // VKRAY_SPEC_SPECULAR
   bool aovs = false;         // VKRAY_SPEC_AOVS
+  bool textures = false;     // VKRAY_SPEC_TEXTURES
   std::string inline_scene;  // served as shaders/inline_scene.glsl; empty: that file, and the BVH is walked
 
   auto operator<=>(const ShaderVariant&) const = default;

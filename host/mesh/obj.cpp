@@ -1,5 +1,6 @@
 #include "mesh/obj.h"
 
+#include <algorithm>
 #include <cfloat>
 #include <charconv>
 #include <cmath>
@@ -56,11 +57,17 @@ class ObjParser {
         ++lists_[kNormal].count;
       } else if (keyword == "vt") {
         numbers("texture coordinate", 1, 3);
+        // OBJ's v runs up from the bottom of the picture, glTF's (vkray's) down from its top.
+        texcoords_.push_back({coordinates_[0], 1.0f - (coordinates_.size() > 1 ? coordinates_[1] : 0.0f)});
         ++lists_[kTexture].count;
       } else if (keyword == "f") {
         face();
+      } else if (keyword == "usemtl") {
+        use_material(line);
+      } else if (keyword == "mtllib") {
+        for (size_t i = 1; i < tokens_.size(); ++i) mesh_.material_libraries.emplace_back(tokens_[i]);
       }
-      // Anything else (o, g, s, usemtl, mtllib, l, p, ...) says nothing vkray uses.
+      // Anything else (o, g, s, l, p, ...) says nothing vkray uses.
     }
     for (const IndexedList& list : lists_)
       if (list.max_index > int64_t(list.count)) out_of_range(list, list.max_token, list.max_line, list.max_face);
@@ -68,10 +75,29 @@ class ObjParser {
       mesh_.corner_normals.reserve(corner_normal_indices_.size());
       for (const auto& n : corner_normal_indices_) mesh_.corner_normals.push_back({normals_[n[0]], normals_[n[1]], normals_[n[2]]});
     }
+    if (all_texcoords_) {
+      mesh_.corner_uvs.reserve(corner_texcoord_indices_.size());
+      for (const auto& t : corner_texcoord_indices_) mesh_.corner_uvs.push_back({texcoords_[t[0]], texcoords_[t[1]], texcoords_[t[2]]});
+    }
+    if (mesh_.material_names.empty()) mesh_.triangle_materials.clear();
     return std::move(mesh_);
   }
 
  private:
+  // usemtl NAME: the faces after it have that material. The name is the rest of the line (names may
+  // hold spaces).
+  void use_material(std::string_view line) {
+    const size_t at = line.find("usemtl") + 6;
+    std::string name(line.substr(at));
+    const auto space = [](char c) { return is_space(c); };
+    while (!name.empty() && space(name.back())) name.pop_back();
+    name.erase(name.begin(), std::find_if_not(name.begin(), name.end(), space));
+    if (name.empty()) fail("usemtl without a material name");
+    const auto found = std::find(mesh_.material_names.begin(), mesh_.material_names.end(), name);
+    material_ = uint32_t(found - mesh_.material_names.begin());
+    if (found == mesh_.material_names.end()) mesh_.material_names.push_back(std::move(name));
+  }
+
   // Spaces between tokens. Tested by hand: std::string_view::find_first_of calls memchr on the set
   // for every character, which was a fifth of loading the bunny.
   static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
@@ -143,6 +169,7 @@ class ObjParser {
     if (corners < 3) fail("face " + std::to_string(face_number_) + ": " + std::to_string(corners) + " corners, a face needs at least 3");
     vertices_.clear();
     face_normals_.clear();
+    face_texcoords_.clear();
     int first_form = -1;
     for (size_t c = 1; c < tokens_.size(); ++c) {
       // v, v/vt, v//vn or v/vt/vn, the same form at every corner of a face.
@@ -167,15 +194,18 @@ class ObjParser {
         fail("face " + std::to_string(face_number_) + ": corner \"" + printable(corner) +
              "\" does not give the same indices as the first corner \"" + printable(tokens_[1]) + "\"");
       vertices_.push_back(index(lists_[kVertex], parts[0]));
-      if (has_texture) index(lists_[kTexture], parts[1]);
+      if (has_texture) face_texcoords_.push_back(index(lists_[kTexture], parts[1]));
       if (has_normal) face_normals_.push_back(index(lists_[kNormal], parts[2]));
     }
     all_normals_ = all_normals_ && !face_normals_.empty();
+    all_texcoords_ = all_texcoords_ && !face_texcoords_.empty();
     mesh_.polygons_split += corners > 3;
     // A fan from the first corner: exact for the convex polygons OBJ files hold.
     for (size_t c = 1; c + 1 < corners; ++c) {
       mesh_.triangles.push_back({vertices_[0], vertices_[c], vertices_[c + 1]});
+      mesh_.triangle_materials.push_back(material_);
       if (all_normals_) corner_normal_indices_.push_back({face_normals_[0], face_normals_[c], face_normals_[c + 1]});
+      if (all_texcoords_) corner_texcoord_indices_.push_back({face_texcoords_[0], face_texcoords_[c], face_texcoords_[c + 1]});
     }
   }
 
@@ -188,10 +218,14 @@ class ObjParser {
   std::vector<glm::vec3> normals_;
   bool all_normals_ = true;  // every face so far gives a normal at each corner
   std::vector<std::array<uint32_t, 3>> corner_normal_indices_;
+  std::vector<glm::vec2> texcoords_;
+  bool all_texcoords_ = true;  // and a texture coordinate
+  std::vector<std::array<uint32_t, 3>> corner_texcoord_indices_;
+  uint32_t material_ = Mesh::kNoMaterial;  // of the faces being read (usemtl)
   // Scratch space for the line being read, kept to save allocations.
   std::vector<std::string_view> tokens_;
   std::vector<float> coordinates_;
-  std::vector<uint32_t> vertices_, face_normals_;
+  std::vector<uint32_t> vertices_, face_normals_, face_texcoords_;
 };
 
 }  // namespace

@@ -15,8 +15,8 @@
 namespace vkray {
 
 // Reads positions (v), faces (f; polygons of any number of corners split into fans) and, when every
-// face has them, vertex normals (vn); texture coordinates (vt) are checked and counted, other
-// statements skipped. A line ends at "\n", "\r\n" or a lone "\r"; '#' starts a comment. Throws
+// face has them, vertex normals (vn) and texture coordinates (vt); the material each face names
+// (usemtl) and the files that define them (mtllib, read by mesh/mtl.h); other statements are skipped. A line ends at "\n", "\r\n" or a lone "\r"; '#' starts a comment. Throws
 // MeshError naming the file and the line, and the face where there is one: a coordinate that is not
 // a finite 32-bit number, "face 12: vertex index 9 is out of range (the file has 8 vertices)", an
 // index that is not an integer, a corner not written v, v/vt, v//vn or v/vt/vn like the face's first.

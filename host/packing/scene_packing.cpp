@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "base/check.h"
+#include "base/errors.h"
 #include "base/interrupt.h"
 #include "scene/camera.h"
 #include "scene/emitters.h"
@@ -205,8 +206,10 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
   PackedGeometry packed;
   const size_t triangle_count = scene.triangles.size();
   const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
+  const bool textured = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.textured(); });
   packed.primitives.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);
   if (any_smooth) packed.normals.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
+  if (textured) packed.texcoords.resize(bvh.order.size() * VKRAY_TEXELS_PER_TEXCOORDS, glm::vec4(0.0f));
   for_blocks(bvh.order.size(), [&](size_t begin, size_t end) {
     throw_if_interrupted();
     for (size_t slot = begin; slot < end; ++slot) {
@@ -217,6 +220,10 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
         texels = triangle_texels(t.v[0], t.v[1], t.v[2], t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u), p, t.object);
         if (t.smooth)
           for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
+        if (textured) {
+          packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS] = glm::vec4(t.uv[0], t.uv[1]);
+          packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS + 1] = glm::vec4(t.uv[2], 0.0f, 0.0f);
+        }
       } else {
         const Sphere& sphere = scene.spheres[p - triangle_count];
         texels = sphere_texels(sphere.center, sphere.radius, sphere.material | (sphere.inward ? VKRAY_PRIM_INWARD : 0u), p,
@@ -229,16 +236,43 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
     }
   });
   packed.nodes = pack_nodes(bvh);
+  const std::vector<uint32_t> offsets = texture_offsets(scene);
+  packed.textures.resize(scene.textures.empty() ? 0 : (size_t(offsets.back()) + scene.textures.back()->texels.size() / 4) * 4);
+  for (size_t i = 0; i < scene.textures.size(); ++i)
+    std::copy(scene.textures[i]->texels.begin(), scene.textures[i]->texels.end(), packed.textures.begin() + ptrdiff_t(offsets[i]) * 4);
   return packed;
+}
+
+std::vector<uint32_t> texture_offsets(const Scene& scene) {
+  std::vector<uint32_t> offsets;
+  uint64_t next = 0;
+  for (const auto& texture : scene.textures) {
+    offsets.push_back(uint32_t(next));
+    next += uint64_t(texture->width) * texture->height;
+    if (next > uint64_t(INT32_MAX))
+      throw LimitError(scene.file.string() + ": the textures have " + std::to_string(next) +
+                       " texels together or more; vkray renders at most 2^31");
+  }
+  return offsets;
 }
 
 PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& order) {
   PackedLighting packed;
   packed.materials.resize(scene.materials.size() * VKRAY_TEXELS_PER_MATERIAL);
+  const std::vector<uint32_t> offsets = texture_offsets(scene);
+  const auto header = [&](const TextureRef& ref) {
+    if (!ref.present()) return glm::vec4(0.0f);  // width 0: none
+    const Texture& t = *scene.textures[size_t(ref.texture)];
+    return texture_texel(offsets[size_t(ref.texture)], t.width, t.height, uint32_t(ref.wrap_s), uint32_t(ref.wrap_t),
+                         uint32_t(ref.filter));
+  };
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
-    packed.materials[i * VKRAY_TEXELS_PER_MATERIAL + VKRAY_MATERIAL_COLOR] = glm::vec4(m.albedo, uintBitsToFloat(uint32_t(m.type)));
-    packed.materials[i * VKRAY_TEXELS_PER_MATERIAL + VKRAY_MATERIAL_EMISSION] = glm::vec4(m.emission, m.ior);
+    glm::vec4* texels = &packed.materials[i * VKRAY_TEXELS_PER_MATERIAL];
+    texels[VKRAY_MATERIAL_COLOR] = glm::vec4(m.albedo, uintBitsToFloat(uint32_t(m.type)));
+    texels[VKRAY_MATERIAL_EMISSION] = glm::vec4(m.emission, m.ior);
+    texels[VKRAY_MATERIAL_ALBEDO_TEXTURE] = header(m.albedo_texture);
+    texels[VKRAY_MATERIAL_EMISSION_TEXTURE] = header(m.emission_texture);
   }
   // The area lights, their primitives as slots in the primitive buffer.
   const EmitterTable table = build_emitter_table(scene);

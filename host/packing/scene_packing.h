@@ -26,6 +26,9 @@ struct PackedGeometry {
   std::vector<glm::vec4> primitives;  // PrimitiveTexels (shared/scene_layout.h) each, in BVH leaf order
   std::vector<glm::vec4> normals;     // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when nothing is smooth
   std::vector<glm::uvec4> nodes;      // VKRAY_TEXELS_PER_NODE texels each (pack_nodes)
+  std::vector<glm::vec4> texcoords;   // VKRAY_TEXELS_PER_TEXCOORDS texels each; empty when nothing is textured
+  // Every texture's texels, in Scene::textures order: half floats, 4 a texel (an RGBA16F texel buffer).
+  std::vector<uint16_t> textures;
 };
 
 // The buffers of what lights the scene.
@@ -40,6 +43,9 @@ struct PackedLighting {
 struct PackedScene : PackedGeometry, PackedLighting {};
 
 PackedScene pack_scene(const Scene& scene, const Bvh& bvh);
+// Where each of Scene::textures starts in PackedGeometry::textures, in texels. Throws LimitError when
+// the textures together pass 2^31 texels.
+std::vector<uint32_t> texture_offsets(const Scene& scene);
 PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh);
 // `order`: the BVH's leaf order (Bvh::order) of the primitive buffer the lighting goes with.
 PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& order);

@@ -16,8 +16,10 @@
 #include "base/errors.h"
 #include "base/input_file.h"
 #include "base/interrupt.h"
+#include "gltf/gltf.h"
 #include "mesh/load.h"
 #include "mesh/mesh.h"
+#include "mesh/mtl.h"
 #include "mesh/normals.h"
 #include "scene/json_document.h"
 #include "scene/transform.h"
@@ -50,6 +52,10 @@ class SceneParser {
   SceneParser(const std::filesystem::path& file, Scene& scene, MeshCache& meshes) : file_(file), scene_(scene), meshes_(meshes) {}
 
   void parse(const json& root);
+  // Adds a glTF file's triangles, materials, textures and point lights, placed by `transform`, as the
+  // object being parsed. `where` is the scene's key that names the file; null when the glTF file is
+  // the scene itself (its messages then name it alone). Returns its camera and aspect ratio.
+  std::pair<std::optional<Camera>, float> add_gltf(const Value* where, const std::filesystem::path& file, const glm::mat4& transform);
 
  private:
   [[noreturn]] void fail(const Value& v, const std::string& what) const {
@@ -130,6 +136,12 @@ class SceneParser {
   glm::mat4 parse_transform(const Value& v);
   uint32_t material_ref(const Value& v) const;
   void parse_mesh(const Value& v, const glm::mat4& transform);
+  // Adds a file the scene reads to Scene::referenced_files, once.
+  void reference(const std::filesystem::path& file);
+  // The index in Scene::textures of a texture file, read the first time it is named.
+  int32_t texture_file(const Value& where, const std::filesystem::path& file, bool srgb);
+  // The scene materials made from the .mtl materials a mesh's faces name, in Mesh::material_names order.
+  std::vector<uint32_t> mesh_materials(const Value& where, const std::filesystem::path& mesh_file, const Mesh& mesh);
   // Appends triangles, leaving out zero-area ones (they have no normal and are never hit).
   void add_triangles(const Value& where, std::vector<Triangle>& triangles);
   // Fails at `where` unless every coordinate of `p` lies within +-kMaxCoordinate (and so is finite).
@@ -142,6 +154,7 @@ class SceneParser {
   std::map<std::string, uint32_t> material_index_;
   MeshCache& meshes_;  // each file loaded once, however often it is used
   std::set<std::filesystem::path> referenced_;  // the files in scene_.referenced_files
+  std::map<std::pair<std::filesystem::path, bool>, int32_t> texture_files_;  // (file, sRGB) -> Scene::textures
   uint32_t object_ = 0;  // the index in "objects" of the object being parsed
 };
 
@@ -438,9 +451,73 @@ void SceneParser::parse_object(const Value& v) {
   } else if (type == "mesh") {
     check_keys(v, {"type", "file", "material", "transform", "smooth", "flip_normals"});
     parse_mesh(v, transform);
+  } else if (type == "gltf") {
+    check_keys(v, {"type", "file", "transform"});
+    const Value file_value = require(v, "file");
+    add_gltf(&file_value, (file_.parent_path() / string(file_value)).lexically_normal(), transform);
   } else {
-    fail(type_value, "unknown object type \"" + printable(type) + "\" (expected \"sphere\", \"triangles\" or \"mesh\")");
+    fail(type_value, "unknown object type \"" + printable(type) + "\" (expected \"sphere\", \"triangles\", \"mesh\" or \"gltf\")");
   }
+}
+
+std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where, const std::filesystem::path& file,
+                                                              const glm::mat4& transform) {
+  GltfScene gltf;
+  try {
+    gltf = load_gltf(file);
+  } catch (const SceneError& e) {
+    if (!where) throw;
+    throw SceneError(file_.string() + ": " + where->path + ": " + e.what());
+  }
+  const Value root{json(), ""};
+  const Value& at = where ? *where : root;
+  reference(file);
+  for (const auto& f : gltf.files) reference(f);
+  for (const std::string& w : gltf.warnings) {
+    if (where) warn(*where, w);
+    else scene_.warnings.push_back(w);
+  }
+  const auto material_offset = uint32_t(scene_.materials.size());
+  const auto texture_offset = int32_t(scene_.textures.size());
+  for (Material m : gltf.materials) {
+    for (TextureRef* ref : {&m.albedo_texture, &m.emission_texture})
+      if (ref->present()) ref->texture += texture_offset;
+    scene_.materials.push_back(std::move(m));
+  }
+  for (auto& t : gltf.textures) scene_.textures.push_back(std::move(t));
+  // The object's transform on top of the file's own: normals by the inverse transpose, and the
+  // winding turned around where it mirrors.
+  const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(transform)));
+  const bool mirrors = glm::determinant(glm::mat3(transform)) < 0.0f;
+  const bool moved = transform != glm::mat4(1.0f);
+  for (Triangle& t : gltf.triangles) {
+    t.material += material_offset;
+    t.object = object_;
+    if (!moved) continue;
+    for (size_t k = 0; k < 3; ++k) {
+      t.v[k] = transform_point(transform, t.v[k]);
+      if (t.smooth) t.normals[k] = glm::normalize(normal_matrix * t.normals[k]);
+    }
+    if (t.smooth && !std::all_of(t.normals.begin(), t.normals.end(), [](const glm::vec3& n) { return std::isfinite(n.x) && glm::length(n) > 0.5f; }))
+      t.smooth = false;
+    if (mirrors) {
+      std::swap(t.v[1], t.v[2]);
+      std::swap(t.normals[1], t.normals[2]);
+      std::swap(t.uv[1], t.uv[2]);
+    }
+  }
+  add_triangles(at, gltf.triangles);
+  for (PointLight light : gltf.lights) {
+    light.position = transform_point(transform, light.position);
+    check_coordinates(at, light.position, "a light of the glTF file");
+    scene_.lights.push_back(light);
+  }
+  if (gltf.camera && moved) {
+    gltf.camera->position = transform_point(transform, gltf.camera->position);
+    gltf.camera->forward = glm::normalize(glm::mat3(transform) * gltf.camera->forward);
+    gltf.camera->up = glm::normalize(glm::mat3(transform) * gltf.camera->up);
+  }
+  return {gltf.camera, gltf.aspect_ratio};
 }
 
 void SceneParser::check_coordinates(const Value& where, const glm::vec3& p, const char* what) const {
@@ -480,10 +557,76 @@ void SceneParser::add_triangles(const Value& where, std::vector<Triangle>& trian
   if (left_out > 0) warn(where, std::to_string(left_out) + " degenerate (zero-area) triangles left out");
 }
 
+void SceneParser::reference(const std::filesystem::path& file) {
+  if (referenced_.insert(file).second) scene_.referenced_files.push_back(file);
+}
+
+int32_t SceneParser::texture_file(const Value& where, const std::filesystem::path& file, bool srgb) {
+  const auto key = std::make_pair(file, srgb);
+  if (const auto found = texture_files_.find(key); found != texture_files_.end()) return found->second;
+  reference(file);
+  std::shared_ptr<const Texture> texture;
+  try {
+    texture = std::make_shared<const Texture>(load_texture(file, srgb));
+  } catch (const SceneError& e) {
+    throw SceneError(file_.string() + ": " + where.path + ": " + e.what());
+  }
+  const auto index = int32_t(scene_.textures.size());
+  scene_.textures.push_back(std::move(texture));
+  texture_files_[key] = index;
+  return index;
+}
+
+std::vector<uint32_t> SceneParser::mesh_materials(const Value& where, const std::filesystem::path& mesh_file, const Mesh& mesh) {
+  // Every library the file names, read now; a later definition of a name replaces an earlier one.
+  std::map<std::string, std::pair<MtlMaterial, std::filesystem::path>> defined;
+  for (const std::string& library : mesh.material_libraries) {
+    const std::filesystem::path file = (mesh_file.parent_path() / library).lexically_normal();
+    reference(file);
+    const InputFile input = read_input_file(file, kMaxSceneFileBytes);
+    if (!input.error.empty())
+      throw MeshError(file_.string() + ": " + where.path + ": " + mesh_file.filename().string() + ": mtllib " + printable(library) +
+                      ": " + (input.error == "not found" ? "material library not found" : input.error));
+    MtlLibrary parsed;
+    try {
+      parsed = parse_mtl(input.text, file);
+    } catch (const MeshError& e) {
+      throw MeshError(file_.string() + ": " + where.path + ": " + e.what());
+    }
+    for (const std::string& w : parsed.warnings) warn(where, w);
+    for (MtlMaterial& m : parsed.materials) {
+      const std::string name = m.name;
+      defined[name] = {std::move(m), file};
+    }
+  }
+  std::vector<uint32_t> index;  // mesh material -> scene material
+  for (const std::string& name : mesh.material_names) {
+    const auto found = defined.find(name);
+    if (found == defined.end())
+      throw MeshError(file_.string() + ": " + where.path + ": " + mesh_file.filename().string() + ": usemtl " + printable(name) +
+                      ": no material library it names (mtllib) defines it");
+    const auto& [mtl, library] = found->second;
+    Material material;
+    material.name = mesh_file.filename().string() + ": " + name;
+    material.albedo = mtl.diffuse;
+    material.emission = mtl.emission;
+    const auto map = [&](const MtlTexture& t) {
+      TextureRef ref;
+      ref.texture = texture_file(where, (library.parent_path() / t.file).lexically_normal(), true);
+      ref.wrap_s = ref.wrap_t = t.wrap;
+      return ref;
+    };
+    if (!mtl.diffuse_map.file.empty()) material.albedo_texture = map(mtl.diffuse_map);
+    if (!mtl.emission_map.file.empty()) material.emission_texture = map(mtl.emission_map);
+    index.push_back(uint32_t(scene_.materials.size()));
+    scene_.materials.push_back(std::move(material));
+  }
+  return index;
+}
+
 void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
   const Value file_value = require(v, "file");
   const std::filesystem::path file = (file_.parent_path() / string(file_value)).lexically_normal();
-  const uint32_t material = material_ref(require(v, "material"));
   bool smooth = false;
   if (v.has("smooth")) {
     if (!v["smooth"].j.is_boolean()) fail(v["smooth"], std::string("expected true or false, got ") + v["smooth"].j.type_name());
@@ -503,14 +646,40 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
   }
   const Mesh& mesh = *loaded;
 
+  // The scene's material for every face, or the ones the file's faces name (an OBJ file's usemtl).
+  std::vector<uint32_t> file_materials;
+  uint32_t material = 0;
+  if (v.has("material")) {
+    material = material_ref(v["material"]);
+  } else if (!mesh.material_names.empty()) {
+    file_materials = mesh_materials(file_value, file, mesh);
+    const bool unnamed = std::find(mesh.triangle_materials.begin(), mesh.triangle_materials.end(), Mesh::kNoMaterial) !=
+                         mesh.triangle_materials.end();
+    if (unnamed) {  // faces before the first usemtl
+      Material grey;
+      grey.name = file.filename().string() + ": (no usemtl)";
+      grey.albedo = glm::vec3(0.8f);
+      material = uint32_t(scene_.materials.size());
+      scene_.materials.push_back(grey);
+    }
+  } else {
+    fail(v, "missing required key \"material\" (" + file.filename().string() + " names no materials of its own)");
+  }
+
   std::vector<glm::vec3> points(mesh.positions.size());
   for (size_t i = 0; i < points.size(); ++i) points[i] = transform_point(transform, mesh.positions[i]);
   std::vector<Triangle> triangles(mesh.triangles.size());
   for (size_t i = 0; i < triangles.size(); ++i) {
-    triangles[i].material = material;
+    const uint32_t named = file_materials.empty() ? Mesh::kNoMaterial : mesh.triangle_materials[i];
+    triangles[i].material = named == Mesh::kNoMaterial ? material : file_materials[named];
     triangles[i].object = object_;
     for (int k = 0; k < 3; ++k) triangles[i].v[size_t(k)] = points[mesh.triangles[i][size_t(k)]];
+    if (!mesh.corner_uvs.empty()) triangles[i].uv = mesh.corner_uvs[i];
   }
+  if (mesh.corner_uvs.empty() &&
+      std::any_of(triangles.begin(), triangles.end(), [&](const Triangle& t) { return scene_.materials[t.material].textured(); }))
+    warn(file_value, file.filename().string() + ": a textured material on faces without texture coordinates (vt): "
+                                                "they show the texture's top left texel");
   if (smooth) {
     if (!mesh.corner_normals.empty()) {
       // Normals transform by the inverse transpose.
@@ -535,6 +704,7 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
     for (Triangle& t : triangles) {  // the other winding, and the vertex normals turned with it
       std::swap(t.v[1], t.v[2]);
       std::swap(t.normals[1], t.normals[2]);
+      std::swap(t.uv[1], t.uv[2]);
       for (glm::vec3& n : t.normals) n = -n;
     }
   add_triangles(file_value, triangles);
@@ -560,7 +730,9 @@ bool same_bits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, 
 
 bool same_bits(const Triangle& a, const Triangle& b) {
   for (size_t k = 0; k < 3; ++k)
-    if (!same_bits(a.v[k], b.v[k]) || !same_bits(a.normals[k], b.normals[k])) return false;
+    if (!same_bits(a.v[k], b.v[k]) || !same_bits(a.normals[k], b.normals[k]) ||
+        std::memcmp(&a.uv[k], &b.uv[k], sizeof(glm::vec2)) != 0)
+      return false;
   return a.material == b.material && a.object == b.object && a.smooth == b.smooth;
 }
 
@@ -574,7 +746,15 @@ bool same_bits(const Sphere& a, const Sphere& b) {
 bool same_geometry(const Scene& a, const Scene& b) {
   // Materials are compared by index (a primitive's flags hold it), not by value.
   const auto same = [](const auto& x, const auto& y) { return same_bits(x, y); };
-  return a.materials.size() == b.materials.size() &&
+  const auto same_texture = [](const std::shared_ptr<const Texture>& x, const std::shared_ptr<const Texture>& y) {
+    return x == y || (x->width == y->width && x->height == y->height && x->texels == y->texels);
+  };
+  // The texture coordinates are on the device when some material has a texture.
+  const auto textured = [](const Scene& s) {
+    return std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.textured(); });
+  };
+  return a.materials.size() == b.materials.size() && textured(a) == textured(b) &&
+         std::equal(a.textures.begin(), a.textures.end(), b.textures.begin(), b.textures.end(), same_texture) &&
          std::equal(a.triangles.begin(), a.triangles.end(), b.triangles.begin(), b.triangles.end(), same) &&
          std::equal(a.spheres.begin(), a.spheres.end(), b.spheres.begin(), b.spheres.end(), same);
 }
@@ -614,8 +794,67 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& file,
   return scene;
 }
 
+namespace {
+
+// The camera vkray frames a glTF scene with when the file has none: a 45-degree vertical field of
+// view from the front (glTF's +z) and a little above, so that the bounding sphere fills the height.
+Camera framing_camera(const Scene& scene) {
+  Camera camera;
+  camera.focal_length = 0.5f / std::tan(glm::radians(45.0f) / 2);
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (const Triangle& t : scene.triangles)
+    for (const glm::vec3& p : t.v) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+  if (scene.triangles.empty()) {
+    camera.position = glm::vec3(0.0f, 0.0f, 1.0f);
+    camera.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+    return camera;
+  }
+  const glm::dvec3 centre = (glm::dvec3(lo) + glm::dvec3(hi)) / 2.0;
+  const double radius = std::max(glm::length(glm::dvec3(hi) - glm::dvec3(lo)) / 2.0, 1e-6);
+  const double distance = radius / std::sin(glm::radians(45.0 / 2)) * 1.05;
+  const glm::dvec3 direction = glm::normalize(glm::dvec3(0.0, 0.3, 1.0));
+  camera.position = glm::vec3(centre + distance * direction);
+  camera.forward = glm::vec3(-direction);
+  return camera;
+}
+
+}  // namespace
+
+Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
+  Scene scene;
+  scene.file = file;
+  scene.name = file.stem().string();
+  scene.description = "The glTF file " + file.filename().string();
+  MeshCache this_scene;
+  SceneParser parser(file, scene, meshes ? *meshes : this_scene);
+  const auto [camera, aspect] = parser.add_gltf(nullptr, file, glm::mat4(1.0f));
+  scene.camera = camera ? *camera : framing_camera(scene);
+  if (!camera) scene.warnings.push_back(file.string() + ": no perspective camera: vkray frames the scene from the front");
+  if (aspect > 0.0f)
+    scene.image.width = uint32_t(std::clamp(std::lround(double(scene.image.height) * aspect), 1l, long(kMaxImageSide)));
+  // A file that brings no light is lit from the camera, so that it is seen at all (DECISIONS.md, 19):
+  // a point light whose irradiance at the scene's centre, straight on, is 1.
+  const bool emitters = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissive(); });
+  if (scene.lights.empty() && !emitters && !scene.triangles.empty()) {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const Triangle& t : scene.triangles)
+      for (const glm::vec3& p : t.v) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+      }
+    const float distance = std::max(glm::length((lo + hi) / 2.0f - scene.camera.position), 1e-6f);
+    scene.lights.push_back(PointLight{scene.camera.position, glm::vec3(glm::pi<float>() * distance * distance)});
+    scene.warnings.push_back(file.string() + ": the file brings no light: vkray adds a point light at the camera");
+  }
+  return scene;
+}
+
 Scene load_scene(const std::filesystem::path& file, MeshCache* meshes) {
   if (file.empty()) throw SceneError("the scene file name is empty");
+  if (is_gltf_path(file)) return load_gltf_scene(file, meshes);
   const InputFile input = read_input_file(file, kMaxSceneFileBytes);
   if (!input.error.empty()) throw SceneError(file.string() + ": " + input.error);
   return parse_scene(input.text, file, meshes);

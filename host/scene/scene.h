@@ -15,6 +15,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/texture.h"
+
 namespace vkray {
 
 // Upper bounds of a scene's image settings, which keep later size arithmetic far from overflow; the
@@ -67,8 +69,13 @@ struct Material {
   glm::vec3 albedo{0.0f};    // diffuse: the albedo; mirror: the reflectance; glass: unused
   float ior = 1.5f;          // glass: the index of refraction inside (outside: 1, vacuum)
   glm::vec3 emission{0.0f};  // radiance emitted on the side the geometric normal faces
+  // Textures that multiply albedo (or reflectance) and emission where a triangle has texture
+  // coordinates (glTF's baseColorTexture and emissiveTexture, an .mtl file's map_Kd).
+  TextureRef albedo_texture;
+  TextureRef emission_texture;
 
   bool emissive() const { return emission != glm::vec3(0.0f); }
+  bool textured() const { return albedo_texture.present() || emission_texture.present(); }
   bool specular() const { return type != MaterialType::diffuse; }  // a delta BSDF
 };
 
@@ -100,6 +107,9 @@ struct Triangle {
   uint32_t object = 0;                 // its place in the file's "objects"
   bool smooth = false;                 // shade with `normals` interpolated, not the face normal
   std::array<glm::vec3, 3> normals{};  // unit vertex normals, when smooth
+  // Texture coordinates of the vertices, as glTF has them: (0, 0) is the top left corner of a
+  // picture, (1, 1) its bottom right. All zero where the mesh has none.
+  std::array<glm::vec2, 3> uv{};
 
 };
 
@@ -116,6 +126,7 @@ struct Scene {
   std::vector<PointLight> lights;
   std::vector<Sphere> spheres;
   std::vector<Triangle> triangles;
+  std::vector<std::shared_ptr<const Texture>> textures;  // what the materials' TextureRefs index
   std::vector<std::string> warnings;  // odd but valid input, e.g. unknown keys
   // Files the scene reads besides itself (meshes): `vkray watch` watches them.
   std::vector<std::filesystem::path> referenced_files;
@@ -128,8 +139,9 @@ struct Scene {
   float epsilon() const { return std::max(extent(), 1e-30f) * 1e-5f; }
 };
 
-// Whether two scenes have the same primitives, bit for bit, with the same materials and objects
-// (a scene on the device can then keep its BVH and primitive buffers: Session::upload_changes).
+// Whether two scenes have the same primitives, bit for bit, with the same materials, objects and
+// textures (a scene on the device can then keep its BVH, primitive and texture buffers:
+// Session::upload_changes).
 bool same_geometry(const Scene& a, const Scene& b);
 
 struct Mesh;
@@ -156,6 +168,12 @@ class MeshCache {
 // pointer, e.g. /objects/2/radius) or the line and column of a syntax error. `meshes`: a cache to
 // take mesh files from and keep them in; null reads each file once for this scene.
 Scene load_scene(const std::filesystem::path& file, MeshCache* meshes = nullptr);
+
+// A glTF file (.gltf or .glb, gltf/gltf.h) as a whole scene: its first camera, or one that frames its
+// geometry from the front; its point lights, or a point light at the camera when it brings no light;
+// a 512-pixel-high image in its camera's aspect ratio; the direct model. load_scene calls it for a
+// file with either extension.
+Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes = nullptr);
 
 // The same from text already in memory; `file` is used in messages and to resolve relative paths.
 Scene parse_scene(std::string_view json_text, const std::filesystem::path& file, MeshCache* meshes = nullptr);

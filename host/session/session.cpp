@@ -158,6 +158,7 @@ gpu::ShaderVariant shader_variant(const gpu::GpuScene& scene, const RenderOption
   variant.emitters = scene.emitters().count > 0;
   variant.specular = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.specular(); });
   variant.aovs = options.aovs;
+  variant.textures = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.textured(); });
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))
     variant.inline_scene = scene.inline_scene();
   return variant;

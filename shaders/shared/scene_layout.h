@@ -49,12 +49,21 @@ VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 // Vertex normals of smooth triangles: a second buffer in the same slots as the primitives, one
 // texel per vertex (xyz), present only when some triangle is smooth.
 
+// Texture coordinates of textured triangles: a buffer in the same slots as the primitives,
+// VKRAY_TEXELS_PER_TEXCOORDS texels each, (u0, v0, u1, v1), (u2, v2, 0, 0), present only when some
+// material has a texture.
+#define VKRAY_TEXELS_PER_TEXCOORDS 2
+
 // ---- Materials: VKRAY_TEXELS_PER_MATERIAL RGBA32F texels each -----------------------------------------
-//   VKRAY_MATERIAL_COLOR:     (albedo or reflectance, type as uint bits)
-//   VKRAY_MATERIAL_EMISSION:  (emitted radiance, index of refraction)
-#define VKRAY_TEXELS_PER_MATERIAL 2
+//   VKRAY_MATERIAL_COLOR:             (albedo or reflectance, type as uint bits)
+//   VKRAY_MATERIAL_EMISSION:          (emitted radiance, index of refraction)
+//   VKRAY_MATERIAL_ALBEDO_TEXTURE:    the texture that multiplies the colour (texture_texel)
+//   VKRAY_MATERIAL_EMISSION_TEXTURE:  the texture that multiplies the emission
+#define VKRAY_TEXELS_PER_MATERIAL 4
 #define VKRAY_MATERIAL_COLOR 0
 #define VKRAY_MATERIAL_EMISSION 1
+#define VKRAY_MATERIAL_ALBEDO_TEXTURE 2
+#define VKRAY_MATERIAL_EMISSION_TEXTURE 3
 // The types, as vkray::MaterialType numbers them.
 #define VKRAY_MATERIAL_DIFFUSE 0u
 #define VKRAY_MATERIAL_MIRROR 1u
@@ -62,6 +71,41 @@ VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 
 // The first texel of the material a primitive's flags name.
 VKRAY_INLINE int material_texel(uint flags) { return int(flags & VKRAY_PRIM_MATERIAL_MASK) * VKRAY_TEXELS_PER_MATERIAL; }
+
+// ---- Textures: RGBA16F texels in one buffer, each texture's rows one after another ---------------------
+// A material names a texture by one texel, the bits of four uints: (its first texel in the buffer,
+// width, height, mode); width 0: no texture. mode = wrap_s | wrap_t << 2 | filter << 4, with the
+// values of vkray::TextureWrap and TextureFilter, which are glTF's sampler modes.
+#define VKRAY_WRAP_REPEAT 0u
+#define VKRAY_WRAP_CLAMP_TO_EDGE 1u
+#define VKRAY_WRAP_MIRRORED_REPEAT 2u
+#define VKRAY_FILTER_LINEAR 0u
+#define VKRAY_FILTER_NEAREST 1u
+
+struct TextureHeader {
+  uint first;
+  uint width;
+  uint height;
+  uint mode;
+};
+
+VKRAY_INLINE vec4 texture_texel(uint first, uint width, uint height, uint wrap_s, uint wrap_t, uint filter_mode) {
+  return vec4(uintBitsToFloat(first), uintBitsToFloat(width), uintBitsToFloat(height),
+              uintBitsToFloat(wrap_s | (wrap_t << 2u) | (filter_mode << 4u)));
+}
+
+VKRAY_INLINE TextureHeader texture_header(vec4 t) {
+  TextureHeader h;
+  h.first = floatBitsToUint(t.x);
+  h.width = floatBitsToUint(t.y);
+  h.height = floatBitsToUint(t.z);
+  h.mode = floatBitsToUint(t.w);
+  return h;
+}
+
+VKRAY_INLINE uint texture_wrap_s(uint mode) { return mode & 3u; }
+VKRAY_INLINE uint texture_wrap_t(uint mode) { return (mode >> 2u) & 3u; }
+VKRAY_INLINE uint texture_filter(uint mode) { return (mode >> 4u) & 1u; }
 
 // ---- Emissive primitives: the area lights, one RGBA32F texel each ------------------------------------
 // An alias table (Walker 1977) over the primitives whose material emits, each weighted by its power

@@ -22,6 +22,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BINDING_OUTPUT 6      // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
 #define VKRAY_BINDING_EMITTERS 7    // uniform texel buffer, RGBA32F: the area lights' alias table
 #define VKRAY_BINDING_AOVS 8        // storage buffer: VKRAY_TEXELS_PER_AOV_PIXEL vec4 per pixel (aovs.glsl)
+#define VKRAY_BINDING_TEXCOORDS 9   // uniform texel buffer, RGBA32F: texture coordinates of textured triangles
+#define VKRAY_BINDING_TEXTURES 10   // uniform texel buffer, RGBA16F: every texture's texels
 
 // ---- Specialization constants ------------------------------------------------------------------
 // false when the scene has no spheres: the pipeline for it has no sphere test (gpu::ShaderVariant).
@@ -37,6 +39,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_SPECULAR 4
 // true when the render also returns the first-hit passes (AOVs): aovs.glsl's code is compiled in.
 #define VKRAY_SPEC_AOVS 5
+// false when no material has a texture: no texture coordinates and no texture code.
+#define VKRAY_SPEC_TEXTURES 6
 
 // ---- The first-hit passes (AOVs): sums over a pixel's samples, in the output's layout -------------
 // (albedo sum, hits as uint bits), (shading normal sum, object of sample 0 as int bits, -1: none),

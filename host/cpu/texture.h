@@ -1,0 +1,14 @@
+// Texture lookups for the CPU reference: bilinear or nearest with glTF's wrap modes, in double,
+// written apart from shaders/texture.glsl.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace vkray::cpu {
+
+// The colour of `ref`'s texture at texture coordinate uv ((0, 0) the top left corner of the picture).
+glm::dvec3 sample_texture(const Scene& scene, const TextureRef& ref, const glm::dvec2& uv);
+
+}  // namespace vkray::cpu

@@ -1,0 +1,738 @@
+#include "gltf/gltf.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <set>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "base/errors.h"
+#include "base/input_file.h"
+#include "base/interrupt.h"
+#include "gltf/tinygltf.h"
+#include "image/decode.h"
+#include "scene/json_document.h"
+
+namespace vkray {
+namespace {
+
+using glm::dmat4;
+using glm::dvec3;
+
+// Extensions whose content vkray reads; a file that requires any other is refused.
+const std::set<std::string> kReadExtensions = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+
+std::string element(const char* array, size_t index) { return std::string(array) + "[" + std::to_string(index) + "]"; }
+
+// "%20" and the like in a URI, decoded; other characters as they are.
+std::string percent_decoded(const std::string& uri) {
+  std::string out;
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
+      out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  return out;
+}
+
+// tinygltf's file callbacks: files read with vkray's checks (regular files, a size limit, Ctrl-C),
+// or none at all.
+struct FileAccess {
+  bool allowed = true;
+  std::vector<std::filesystem::path> read;
+};
+
+bool file_exists(const std::string& path, void* user) {
+  std::error_code error;
+  return static_cast<FileAccess*>(user)->allowed && std::filesystem::is_regular_file(path, error);
+}
+
+std::string expand_path(const std::string& path, void*) { return path; }  // no shell expansion (wordexp) for a file's URIs
+
+bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  auto* access = static_cast<FileAccess*>(user);
+  if (!access->allowed) {
+    if (err) *err += "external files are not read here: " + printable(path, 200) + "\n";
+    return false;
+  }
+  const InputFile input = read_input_file(path, kMaxGltfFileBytes);
+  if (!input.error.empty()) {
+    if (err) *err += printable(path, 200) + ": " + input.error + "\n";
+    return false;
+  }
+  access->read.emplace_back(path);
+  out->assign(input.text.begin(), input.text.end());
+  return true;
+}
+
+bool write_whole_file(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "vkray writes no glTF files\n";
+  return false;
+}
+
+// Keeps a picture's bytes as they are (image.image); vkray decodes the pictures a material uses.
+bool keep_encoded(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes, int size, void*) {
+  image->image.assign(bytes, bytes + std::max(size, 0));
+  image->as_is = true;
+  return true;
+}
+
+// A primitive vkray leaves out, with the reason, named in a warning.
+struct Skip {
+  std::string kind;  // one warning per kind
+  std::string what;
+};
+
+// An accessor's elements, checked to lie inside their buffer.
+struct AccessorView {
+  const unsigned char* data = nullptr;  // null: every element is zero (an accessor without a buffer view)
+  size_t count = 0;
+  size_t stride = 0;
+  int component_type = 0;
+  int components = 0;
+  bool normalized = false;
+
+  // Component c of element i, normalized integers mapped to [0, 1] or [-1, 1] as glTF defines.
+  double get(size_t i, int c) const {
+    if (!data) return 0.0;
+    const unsigned char* p = data + i * stride;
+    switch (component_type) {
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        float f;
+        std::memcpy(&f, p + 4 * c, 4);
+        return f;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return normalized ? p[c] / 255.0 : p[c];
+      case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        const auto v = static_cast<signed char>(p[c]);
+        return normalized ? std::max(v / 127.0, -1.0) : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v;
+        std::memcpy(&v, p + 2 * c, 2);
+        return normalized ? v / 65535.0 : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t v;
+        std::memcpy(&v, p + 2 * c, 2);
+        return normalized ? std::max(v / 32767.0, -1.0) : v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        uint32_t v;
+        std::memcpy(&v, p + 4 * c, 4);
+        return v;
+      }
+    }
+    return 0.0;
+  }
+
+  uint32_t index(size_t i) const {
+    if (!data) return 0;
+    const unsigned char* p = data + i * stride;
+    if (component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) return p[0];
+    if (component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    uint32_t v;
+    std::memcpy(&v, p, 4);
+    return v;
+  }
+};
+
+size_t component_size(int type) {
+  switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+  }
+  return 0;
+}
+
+const char* type_name(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
+    case TINYGLTF_TYPE_VEC2: return "VEC2";
+    case TINYGLTF_TYPE_VEC3: return "VEC3";
+    case TINYGLTF_TYPE_VEC4: return "VEC4";
+    case TINYGLTF_TYPE_MAT2: return "MAT2";
+    case TINYGLTF_TYPE_MAT3: return "MAT3";
+    case TINYGLTF_TYPE_MAT4: return "MAT4";
+  }
+  return "an unknown type";
+}
+
+class GltfReader {
+ public:
+  GltfReader(const std::filesystem::path& file, const GltfLimits& limits) : file_(file), limits_(limits) {
+    access_.allowed = limits.read_files;
+  }
+
+  GltfScene read(std::string_view bytes);
+
+ private:
+  [[noreturn]] void fail(const std::string& where, const std::string& what) const {
+    throw SceneError(file_.string() + ": " + (where.empty() ? "" : where + ": ") + what);
+  }
+  // One warning for each kind of thing vkray cannot render, naming where it was first seen.
+  void warn_once(const std::string& kind, const std::string& where, const std::string& what) {
+    if (warned_.insert(kind).second)
+      scene_.warnings.push_back(printable(file_.string() + ": " + (where.empty() ? "" : where + ": ") + what, 400));
+  }
+
+  void check_glb(std::string_view bytes) const;
+  void check_extensions();
+  AccessorView accessor(int index, const std::string& where, std::initializer_list<int> types,
+                        std::initializer_list<int> component_types) const;
+  dmat4 local_transform(size_t node) const;
+  void walk_nodes();
+  void add_mesh(size_t mesh_index, const dmat4& world);
+  void add_primitive(const tinygltf::Primitive& p, const std::string& where, const dmat4& world);
+  uint32_t material(int index, const std::string& where);
+  TextureRef texture(const tinygltf::TextureInfo& info, const std::string& where);
+  int32_t image_texture(int image, const std::string& where);
+  void add_camera(size_t node, const dmat4& world);
+  void add_light(size_t node, const dmat4& world);
+
+  const std::filesystem::path& file_;
+  GltfLimits limits_;
+  FileAccess access_;
+  tinygltf::Model model_;
+  GltfScene scene_;
+  std::set<std::string> warned_;
+  std::map<int, uint32_t> materials_;     // glTF material (-1: the default) -> scene_.materials
+  std::map<int, int> texcoord_sets_;      // glTF material -> the TEXCOORD_n its textures use
+  std::map<int, int32_t> image_textures_;  // glTF image -> scene_.textures
+  bool camera_found_ = false;
+};
+
+void GltfReader::check_glb(std::string_view bytes) const {
+  // The 12-byte header, then chunks of (length, type, data): JSON first, BIN optionally second.
+  const auto word = [&](size_t at) {
+    uint32_t w;
+    std::memcpy(&w, bytes.data() + at, 4);
+    return w;
+  };
+  if (bytes.size() < 20) fail("", "a .glb file shorter than its header (" + std::to_string(bytes.size()) + " bytes)");
+  if (word(4) != 2) fail("", "glTF binary version " + std::to_string(word(4)) + "; vkray reads version 2");
+  if (word(8) > bytes.size())
+    fail("", "the header gives a length of " + std::to_string(word(8)) + " bytes, the file has " + std::to_string(bytes.size()));
+  const uint64_t json_length = word(12);
+  if (word(16) != 0x4E4F534Au) fail("", "the first chunk is not JSON");
+  if (20 + json_length > word(8)) fail("", "the JSON chunk (" + std::to_string(json_length) + " bytes) runs past the file's end");
+  const uint64_t bin_at = 20 + ((json_length + 3) & ~uint64_t(3));
+  if (bin_at + 8 <= word(8)) {
+    const uint64_t bin_length = word(size_t(bin_at));
+    if (bin_at + 8 + bin_length > word(8)) fail("", "the binary chunk (" + std::to_string(bin_length) + " bytes) runs past the file's end");
+  }
+}
+
+void GltfReader::check_extensions() {
+  for (const std::string& name : model_.extensionsRequired)
+    if (!kReadExtensions.count(name)) fail("extensionsRequired", "the file requires " + printable(name) + ", which vkray does not read");
+  for (const std::string& name : model_.extensionsUsed)
+    if (!kReadExtensions.count(name))
+      warn_once("extension " + name, "extensionsUsed", printable(name) + " is not read; what it adds is not rendered");
+}
+
+AccessorView GltfReader::accessor(int index, const std::string& where, std::initializer_list<int> types,
+                                  std::initializer_list<int> component_types) const {
+  if (index < 0 || size_t(index) >= model_.accessors.size())
+    fail(where, "accessors[" + std::to_string(index) + "] does not exist (the file has " + std::to_string(model_.accessors.size()) + ")");
+  const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+  const std::string name = where + ": " + element("accessors", size_t(index));
+  if (std::find(types.begin(), types.end(), a.type) == types.end()) {
+    std::string expected;
+    for (const int t : types) expected += (expected.empty() ? "" : " or ") + std::string(type_name(t));
+    fail(name, std::string("expected ") + expected + ", got " + type_name(a.type));
+  }
+  if (std::find(component_types.begin(), component_types.end(), a.componentType) == component_types.end() ||
+      (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT &&
+       !a.normalized && types.size() != 1))
+    fail(name, "componentType " + std::to_string(a.componentType) + " is not one glTF allows here");
+  if (a.sparse.isSparse) throw Skip{"sparse", name + ": sparse accessors are not read"};
+  AccessorView view;
+  view.count = a.count;
+  view.component_type = a.componentType;
+  view.components = a.type == TINYGLTF_TYPE_SCALAR ? 1 : a.type;  // VEC2..VEC4 are 2..4
+  view.normalized = a.normalized;
+  const size_t element_size = component_size(a.componentType) * size_t(view.components);
+  view.stride = element_size;
+  if (a.bufferView < 0) return view;  // zeros
+  if (size_t(a.bufferView) >= model_.bufferViews.size())
+    fail(name, "bufferViews[" + std::to_string(a.bufferView) + "] does not exist (the file has " +
+                   std::to_string(model_.bufferViews.size()) + ")");
+  const tinygltf::BufferView& bv = model_.bufferViews[size_t(a.bufferView)];
+  const std::string bv_name = element("bufferViews", size_t(a.bufferView));
+  if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size())
+    fail(bv_name, "buffers[" + std::to_string(bv.buffer) + "] does not exist (the file has " + std::to_string(model_.buffers.size()) + ")");
+  const std::vector<unsigned char>& data = model_.buffers[size_t(bv.buffer)].data;
+  if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
+    fail(bv_name, "bytes " + std::to_string(bv.byteOffset) + " + " + std::to_string(bv.byteLength) + " run past the end of buffers[" +
+                      std::to_string(bv.buffer) + "] (" + std::to_string(data.size()) + " bytes)");
+  if (bv.byteStride != 0) {
+    if (bv.byteStride < element_size) fail(bv_name, "byteStride " + std::to_string(bv.byteStride) + " is less than an element of " + name);
+    view.stride = bv.byteStride;
+  }
+  if (a.count > 0) {
+    const size_t room = bv.byteLength;
+    const bool fits = a.byteOffset <= room && element_size <= room - a.byteOffset &&
+                      (a.count - 1) <= (room - a.byteOffset - element_size) / view.stride;
+    if (!fits)
+      fail(name, std::to_string(a.count) + " elements from byte " + std::to_string(a.byteOffset) + " run past the end of " + bv_name +
+                     " (" + std::to_string(room) + " bytes)");
+    view.data = data.data() + bv.byteOffset + a.byteOffset;
+  }
+  return view;
+}
+
+dmat4 GltfReader::local_transform(size_t node) const {
+  const tinygltf::Node& n = model_.nodes[node];
+  const std::string where = element("nodes", node);
+  const auto finite = [&](const std::vector<double>& values, size_t size, const char* key) {
+    if (values.empty()) return false;
+    if (values.size() != size) fail(where + "." + key, "expected " + std::to_string(size) + " numbers, got " + std::to_string(values.size()));
+    for (const double v : values)
+      if (!std::isfinite(v) || std::abs(v) > FLT_MAX) fail(where + "." + key, "a number that is not a finite 32-bit float");
+    return true;
+  };
+  if (finite(n.matrix, 16, "matrix")) {
+    dmat4 m;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[size_t(c * 4 + r)];  // column-major, as glm
+    return m;
+  }
+  dmat4 m(1.0);
+  if (finite(n.translation, 3, "translation")) m = glm::translate(m, dvec3(n.translation[0], n.translation[1], n.translation[2]));
+  if (finite(n.rotation, 4, "rotation")) {
+    glm::dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);  // glTF: x, y, z, w
+    if (!(glm::length(q) > 0)) fail(where + ".rotation", "a zero quaternion is no rotation");
+    m *= glm::mat4_cast(glm::normalize(q));
+  }
+  if (finite(n.scale, 3, "scale")) m = glm::scale(m, dvec3(n.scale[0], n.scale[1], n.scale[2]));
+  return m;
+}
+
+void GltfReader::walk_nodes() {
+  // The hierarchy is a forest: every node has at most one parent and no node is its own ancestor.
+  // Checked first, so that the walk below cannot loop or recurse without end.
+  const size_t count = model_.nodes.size();
+  std::vector<int64_t> parent(count, -1);
+  for (size_t n = 0; n < count; ++n)
+    for (const int child : model_.nodes[n].children) {
+      const std::string where = element("nodes", n) + ".children";
+      if (child < 0 || size_t(child) >= count)
+        fail(where, "nodes[" + std::to_string(child) + "] does not exist (the file has " + std::to_string(count) + ")");
+      if (parent[size_t(child)] >= 0 || size_t(child) == n)
+        fail(where, element("nodes", size_t(child)) + " has two parents (or is its own child); glTF's nodes form trees");
+      parent[size_t(child)] = int64_t(n);
+    }
+  std::vector<size_t> roots;
+  if (!model_.scenes.empty()) {
+    const int chosen = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+    if (size_t(chosen) >= model_.scenes.size())
+      fail("scene", "scenes[" + std::to_string(chosen) + "] does not exist (the file has " + std::to_string(model_.scenes.size()) + ")");
+    std::set<size_t> seen;
+    for (const int root : model_.scenes[size_t(chosen)].nodes) {
+      const std::string where = element("scenes", size_t(chosen)) + ".nodes";
+      if (root < 0 || size_t(root) >= count)
+        fail(where, "nodes[" + std::to_string(root) + "] does not exist (the file has " + std::to_string(count) + ")");
+      if (parent[size_t(root)] >= 0) fail(where, element("nodes", size_t(root)) + " is a child of another node, not a root");
+      if (!seen.insert(size_t(root)).second) fail(where, element("nodes", size_t(root)) + " is listed twice");
+      roots.push_back(size_t(root));
+    }
+  } else {
+    // No scenes: the file is a library of nodes; render its root nodes.
+    for (size_t n = 0; n < count; ++n)
+      if (parent[n] < 0) roots.push_back(n);
+  }
+  // A node whose ancestors form a cycle has a parent, so no root leads into the cycle; but a cycle
+  // with no root at all is unreachable, which is fine. Depth-first, in the file's order.
+  std::vector<std::pair<size_t, dmat4>> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, dmat4(1.0));
+  size_t visited = 0;
+  while (!stack.empty()) {
+    auto [node, parent_world] = stack.back();
+    stack.pop_back();
+    if (++visited % 1024 == 0) throw_if_interrupted();
+    if (visited > count) fail("nodes", "the hierarchy visits more nodes than the file has");  // cannot happen in a forest
+    const dmat4 world = parent_world * local_transform(node);
+    const tinygltf::Node& n = model_.nodes[node];
+    if (n.camera >= 0) add_camera(node, world);
+    if (n.extensions.count("KHR_lights_punctual")) add_light(node, world);
+    if (n.mesh >= 0) {
+      if (size_t(n.mesh) >= model_.meshes.size())
+        fail(element("nodes", node) + ".mesh", "meshes[" + std::to_string(n.mesh) + "] does not exist (the file has " +
+                                                  std::to_string(model_.meshes.size()) + ")");
+      if (n.skin >= 0) warn_once("skin", element("nodes", node), "skins are not rendered: the mesh is shown in its bind pose");
+      add_mesh(size_t(n.mesh), world);
+    }
+    for (auto child = n.children.rbegin(); child != n.children.rend(); ++child) stack.emplace_back(size_t(*child), world);
+  }
+}
+
+void GltfReader::add_mesh(size_t mesh_index, const dmat4& world) {
+  const tinygltf::Mesh& mesh = model_.meshes[mesh_index];
+  for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+    const std::string where = element("meshes", mesh_index) + "." + element("primitives", p);
+    try {
+      add_primitive(mesh.primitives[p], where, world);
+    } catch (const Skip& skip) {
+      warn_once(skip.kind, "", skip.what + "; the primitive is left out");
+    }
+  }
+}
+
+void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& where, const dmat4& world) {
+  const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+  if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+    if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP)
+      throw Skip{"points and lines", where + ": points and lines (mode " + std::to_string(mode) + ") are not rendered"};
+    fail(where + ".mode", "unknown mode " + std::to_string(mode));
+  }
+  if (!p.targets.empty()) warn_once("morph targets", where, "morph targets are not rendered: the mesh is shown unmorphed");
+  const auto position_at = p.attributes.find("POSITION");
+  if (position_at == p.attributes.end()) fail(where + ".attributes", "no POSITION");
+  const AccessorView positions = accessor(position_at->second, where + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  if (!positions.data) return;  // every vertex at the origin: nothing to see
+  const size_t vertices = positions.count;
+
+  const uint32_t mat = material(p.material, where + ".material");
+  const int set = texcoord_sets_[p.material];
+  std::optional<AccessorView> normals, uvs;
+  if (const auto at = p.attributes.find("NORMAL"); at != p.attributes.end())
+    normals = accessor(at->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  const std::string uv_name = "TEXCOORD_" + std::to_string(set);
+  if (scene_.materials[mat].textured()) {
+    if (const auto at = p.attributes.find(uv_name); at != p.attributes.end())
+      uvs = accessor(at->second, where + ".attributes." + uv_name, {TINYGLTF_TYPE_VEC2},
+                     {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+    else
+      warn_once("no " + uv_name, where + ".attributes", "no " + uv_name + " for its material's texture: it shows the texture's top left texel");
+  }
+  for (const auto* a : {normals ? &*normals : nullptr, uvs ? &*uvs : nullptr})
+    if (a && a->count != vertices)
+      fail(where + ".attributes", "an attribute has " + std::to_string(a->count) + " elements, POSITION has " + std::to_string(vertices));
+
+  // The corners: indexed, or the vertices in order.
+  std::optional<AccessorView> indices;
+  if (p.indices >= 0)
+    indices = accessor(p.indices, where + ".indices", {TINYGLTF_TYPE_SCALAR},
+                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
+  const size_t corners = indices ? indices->count : vertices;
+  const auto corner = [&](size_t i) -> uint32_t {
+    if (!indices) return uint32_t(i);
+    const uint32_t v = indices->index(i);
+    if (v >= vertices)
+      fail(where + ".indices", "index " + std::to_string(v) + " at " + std::to_string(i) + " is out of range (POSITION has " +
+                                   std::to_string(vertices) + " vertices)");
+    return v;
+  };
+  size_t triangles = 0;
+  if (mode == TINYGLTF_MODE_TRIANGLES) {
+    triangles = corners / 3;
+    if (corners % 3 != 0) warn_once("loose corners", where, std::to_string(corners % 3) + " corners past the last whole triangle are left out");
+  } else {
+    triangles = corners >= 3 ? corners - 2 : 0;
+  }
+  if (triangles > limits_.max_triangles - std::min(limits_.max_triangles, scene_.triangles.size()))
+    throw LimitError(file_.string() + ": " + where + ": the file places more than " + std::to_string(limits_.max_triangles) +
+                     " triangles; vkray renders at most that many");
+
+  // Positions and normals in world space: normals by the inverse transpose. A negative determinant
+  // mirrors the mesh, which turns its front faces' winding around (glTF 3.7.2.1).
+  const glm::dmat3 linear(world);
+  const double det = glm::determinant(linear);
+  if (!(det != 0.0) || !std::isfinite(det)) return;  // scaled to nothing (or past a double): not visible
+  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
+  const bool mirrored = det < 0;
+  const auto position = [&](uint32_t v) {
+    const dvec3 p_local(positions.get(v, 0), positions.get(v, 1), positions.get(v, 2));
+    if (!std::isfinite(p_local.x) || !std::isfinite(p_local.y) || !std::isfinite(p_local.z))
+      fail(where + ".attributes.POSITION", "vertex " + std::to_string(v) + " is not finite");
+    return glm::vec3(dvec3(world * glm::dvec4(p_local, 1.0)));
+  };
+  const auto normal = [&](uint32_t v) {
+    const dvec3 n = normal_matrix * dvec3(normals->get(v, 0), normals->get(v, 1), normals->get(v, 2));
+    const double length = glm::length(n);
+    return length > 0 && std::isfinite(length) ? glm::vec3(n / length) : glm::vec3(0.0f);
+  };
+  const auto uv = [&](uint32_t v) {
+    const glm::dvec2 t(uvs->get(v, 0), uvs->get(v, 1));
+    if (!(std::abs(t.x) <= kMaxCoordinate && std::abs(t.y) <= kMaxCoordinate))
+      fail(where + ".attributes." + uv_name, "texture coordinate " + std::to_string(v) + " is not finite or past +-1e9");
+    return glm::vec2(t);
+  };
+  scene_.triangles.reserve(scene_.triangles.size() + triangles);
+  for (size_t t = 0; t < triangles; ++t) {
+    if (t % 4096 == 0) throw_if_interrupted();
+    std::array<uint32_t, 3> c;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      c = {corner(3 * t), corner(3 * t + 1), corner(3 * t + 2)};
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+      c = t % 2 == 0 ? std::array<uint32_t, 3>{corner(t), corner(t + 1), corner(t + 2)}
+                     : std::array<uint32_t, 3>{corner(t + 1), corner(t), corner(t + 2)};
+    } else {
+      c = {corner(t + 1), corner(t + 2), corner(0)};
+    }
+    if (mirrored) std::swap(c[1], c[2]);
+    Triangle tri;
+    tri.material = mat;
+    for (size_t k = 0; k < 3; ++k) {
+      tri.v[k] = position(c[k]);
+      if (normals) tri.normals[k] = normal(c[k]);
+      if (uvs) tri.uv[k] = uv(c[k]);
+    }
+    tri.smooth = normals.has_value() && std::all_of(tri.normals.begin(), tri.normals.end(), [](const glm::vec3& n) { return n != glm::vec3(0.0f); });
+    scene_.triangles.push_back(tri);
+  }
+}
+
+uint32_t GltfReader::material(int index, const std::string& where) {
+  if (const auto found = materials_.find(index); found != materials_.end()) return found->second;
+  Material m;
+  if (index < 0) {  // glTF's default material: white, fully rough
+    m.name = file_.filename().string() + ": default material";
+    m.albedo = glm::vec3(1.0f);
+  } else {
+    if (size_t(index) >= model_.materials.size())
+      fail(where, "materials[" + std::to_string(index) + "] does not exist (the file has " + std::to_string(model_.materials.size()) + ")");
+    const tinygltf::Material& g = model_.materials[size_t(index)];
+    const std::string name = element("materials", size_t(index));
+    m.name = file_.filename().string() + ": " + (g.name.empty() ? name : printable(g.name));
+    const auto colour = [&](const std::vector<double>& values, size_t size, const std::string& key, double max) {
+      if (values.size() != size) fail(name + "." + key, "expected " + std::to_string(size) + " numbers, got " + std::to_string(values.size()));
+      for (size_t c = 0; c < 3; ++c)
+        if (!(values[c] >= 0.0 && values[c] <= max))
+          fail(name + "." + key, max == 1.0 ? "a value outside [0, 1]" : "a value that is negative or not a finite 32-bit float");
+      return glm::vec3(float(values[0]), float(values[1]), float(values[2]));
+    };
+    const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+    m.albedo = colour(pbr.baseColorFactor, 4, "pbrMetallicRoughness.baseColorFactor", 1.0);
+    m.emission = colour(g.emissiveFactor, 3, "emissiveFactor", FLT_MAX);
+    if (const auto strength = g.extensions.find("KHR_materials_emissive_strength"); strength != g.extensions.end()) {
+      const tinygltf::Value& v = strength->second.Get("emissiveStrength");
+      const double s = v.IsNumber() ? v.GetNumberAsDouble() : 1.0;
+      if (!(s >= 0.0 && s <= 1e6)) fail(name + ".extensions.KHR_materials_emissive_strength", "emissiveStrength outside [0, 1e6]");
+      m.emission *= float(s);
+    }
+    int set = 0;
+    if (pbr.baseColorTexture.index >= 0) {
+      m.albedo_texture = texture(pbr.baseColorTexture, name + ".pbrMetallicRoughness.baseColorTexture");
+      set = pbr.baseColorTexture.texCoord;
+    }
+    if (g.emissiveTexture.index >= 0 && m.emission != glm::vec3(0.0f)) {
+      m.emission_texture = texture(g.emissiveTexture, name + ".emissiveTexture");
+      if (m.albedo_texture.present() && g.emissiveTexture.texCoord != set)
+        warn_once("texcoord sets", name, "the emissive texture's texCoord differs from the base colour's: both use TEXCOORD_" + std::to_string(set));
+      if (!m.albedo_texture.present()) set = g.emissiveTexture.texCoord;
+    }
+    if (set < 0 || set > 7) fail(name, "texCoord " + std::to_string(set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
+    texcoord_sets_[index] = set;
+    if (pbr.metallicFactor > 0.0 || pbr.metallicRoughnessTexture.index >= 0 || pbr.roughnessFactor < 1.0)
+      warn_once("metallic-roughness", name, "metalness and roughness are not rendered: surfaces are diffuse in their base colour");
+    if (g.normalTexture.index >= 0) warn_once("normalTexture", name, "normal textures are not rendered");
+    if (g.occlusionTexture.index >= 0) warn_once("occlusionTexture", name, "occlusion textures are not rendered (light transport computes occlusion)");
+    if (g.alphaMode == "MASK" || g.alphaMode == "BLEND")
+      warn_once("alphaMode", name, "alphaMode " + g.alphaMode + " is not rendered: surfaces are opaque");
+  }
+  const auto at = uint32_t(scene_.materials.size());
+  scene_.materials.push_back(std::move(m));
+  materials_[index] = at;
+  return at;
+}
+
+TextureRef GltfReader::texture(const tinygltf::TextureInfo& info, const std::string& where) {
+  if (size_t(info.index) >= model_.textures.size())
+    fail(where, "textures[" + std::to_string(info.index) + "] does not exist (the file has " + std::to_string(model_.textures.size()) + ")");
+  if (info.extensions.count("KHR_texture_transform"))
+    warn_once("KHR_texture_transform", where, "KHR_texture_transform is not rendered: the texture is placed untransformed");
+  const tinygltf::Texture& t = model_.textures[size_t(info.index)];
+  const std::string name = element("textures", size_t(info.index));
+  TextureRef ref;
+  if (t.source < 0) {
+    warn_once("no source", name, "a texture with no PNG or JPEG source (another extension's format?) is not rendered");
+    return ref;
+  }
+  ref.texture = image_texture(t.source, name + ".source");
+  if (t.sampler >= 0) {
+    if (size_t(t.sampler) >= model_.samplers.size())
+      fail(name + ".sampler", "samplers[" + std::to_string(t.sampler) + "] does not exist (the file has " + std::to_string(model_.samplers.size()) + ")");
+    const tinygltf::Sampler& s = model_.samplers[size_t(t.sampler)];
+    const auto wrap = [&](int mode, const char* key) {
+      switch (mode) {
+        case TINYGLTF_TEXTURE_WRAP_REPEAT: return TextureWrap::repeat;
+        case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureWrap::clamp_to_edge;
+        case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureWrap::mirrored_repeat;
+      }
+      fail(element("samplers", size_t(t.sampler)) + "." + key, "unknown wrap mode " + std::to_string(mode));
+    };
+    ref.wrap_s = wrap(s.wrapS, "wrapS");
+    ref.wrap_t = wrap(s.wrapT, "wrapT");
+    // Magnification decides: vkray has no mipmaps, so minification filters as magnification does.
+    if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) ref.filter = TextureFilter::nearest;
+  }
+  return ref;
+}
+
+int32_t GltfReader::image_texture(int image, const std::string& where) {
+  if (const auto found = image_textures_.find(image); found != image_textures_.end()) return found->second;
+  if (size_t(image) >= model_.images.size())
+    fail(where, "images[" + std::to_string(image) + "] does not exist (the file has " + std::to_string(model_.images.size()) + ")");
+  const tinygltf::Image& img = model_.images[size_t(image)];
+  std::string name = file_.string() + ": " + element("images", size_t(image));
+  std::string_view bytes(reinterpret_cast<const char*>(img.image.data()), img.image.size());
+  InputFile external;
+  if (img.image.empty()) {  // a file beside the glTF file (tinygltf keeps its URI)
+    if (img.uri.empty()) fail(element("images", size_t(image)), "no picture (neither a uri nor a bufferView with data)");
+    const std::filesystem::path path = (file_.parent_path() / percent_decoded(img.uri)).lexically_normal();
+    name += " (" + printable(img.uri, 200) + ")";
+    if (!access_.allowed) fail(element("images", size_t(image)), "external files are not read here: " + printable(img.uri, 200));
+    external = read_input_file(path, kMaxPictureFileBytes);
+    if (!external.error.empty()) throw SceneError(name + ": " + (external.error == "not found" ? "picture file not found" : external.error));
+    scene_.files.push_back(path);
+    bytes = external.text;
+  }
+  auto texture = std::make_shared<const Texture>(make_texture(decode_picture(bytes, name), name, true));
+  const auto index = int32_t(scene_.textures.size());
+  scene_.textures.push_back(std::move(texture));
+  image_textures_[image] = index;
+  return index;
+}
+
+void GltfReader::add_camera(size_t node, const dmat4& world) {
+  const tinygltf::Node& n = model_.nodes[node];
+  const std::string where = element("nodes", node) + ".camera";
+  if (size_t(n.camera) >= model_.cameras.size())
+    fail(where, "cameras[" + std::to_string(n.camera) + "] does not exist (the file has " + std::to_string(model_.cameras.size()) + ")");
+  if (camera_found_) return;  // the first one is the one
+  const tinygltf::Camera& c = model_.cameras[size_t(n.camera)];
+  const std::string name = element("cameras", size_t(n.camera));
+  if (c.type != "perspective") {
+    warn_once("orthographic", name, "an orthographic camera is not rendered; vkray frames the scene with its own camera");
+    return;
+  }
+  camera_found_ = true;
+  const double yfov = c.perspective.yfov;
+  if (!(yfov > 1e-6 && yfov < 3.14159)) fail(name + ".perspective.yfov", "expected radians in (0, pi)");
+  // A camera looks down its local -z, with +y up (glTF 3.10.1).
+  const dvec3 position(world * glm::dvec4(0, 0, 0, 1));
+  const dvec3 forward(world * glm::dvec4(0, 0, -1, 0)), up(world * glm::dvec4(0, 1, 0, 0));
+  const double f = glm::length(forward);
+  if (!(f > 0 && std::isfinite(f)) || !(glm::length(glm::cross(forward / f, up)) > 1e-6 * glm::length(up)) ||
+      !(glm::length(position) < double(kMaxCoordinate))) {
+    warn_once("degenerate camera", element("nodes", node), "the camera's transform is degenerate; vkray frames the scene with its own camera");
+    camera_found_ = false;
+    return;
+  }
+  Camera camera;
+  camera.position = glm::vec3(position);
+  camera.forward = glm::vec3(forward / f);
+  camera.up = glm::vec3(glm::normalize(up));
+  camera.focal_length = float(0.5 / std::tan(yfov / 2));
+  scene_.camera = camera;
+  const double aspect = c.perspective.aspectRatio;
+  scene_.aspect_ratio = aspect > 0 && aspect < 1e4 ? float(aspect) : 0.0f;
+}
+
+void GltfReader::add_light(size_t node, const dmat4& world) {
+  const tinygltf::Value& ext = model_.nodes[node].extensions.at("KHR_lights_punctual");
+  const std::string where = element("nodes", node) + ".extensions.KHR_lights_punctual.light";
+  if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsInt()) fail(where, "expected the index of a light");
+  const int index = ext.Get("light").GetNumberAsInt();
+  if (index < 0 || size_t(index) >= model_.lights.size())
+    fail(where, "lights[" + std::to_string(index) + "] does not exist (the file has " + std::to_string(model_.lights.size()) + ")");
+  const tinygltf::Light& l = model_.lights[size_t(index)];
+  const std::string name = "KHR_lights_punctual." + element("lights", size_t(index));
+  if (l.type != "point") {
+    warn_once("light " + l.type, name, printable(l.type) + " lights are not rendered (vkray renders point lights)");
+    return;
+  }
+  glm::vec3 colour(1.0f);
+  if (!l.color.empty()) {
+    if (l.color.size() != 3) fail(name + ".color", "expected 3 numbers");
+    for (size_t c = 0; c < 3; ++c) {
+      if (!(l.color[c] >= 0.0 && l.color[c] <= 1e6)) fail(name + ".color", "a value outside [0, 1e6]");
+      colour[int(c)] = float(l.color[c]);
+    }
+  }
+  if (!(l.intensity >= 0.0 && l.intensity <= 1e12)) fail(name + ".intensity", "expected a number from 0 to 1e12");
+  if (l.range > 0) warn_once("light range", name, "a light's range is not rendered: its light reaches everywhere");
+  PointLight light;
+  const dvec3 position(world * glm::dvec4(0, 0, 0, 1));
+  if (!(glm::length(position) < double(kMaxCoordinate))) fail(element("nodes", node), "the light lies past +-1e9");
+  light.position = glm::vec3(position);
+  // glTF's intensity is in candela (lm/sr); vkray's point lights give W/sr, and the value is taken as it is.
+  light.intensity = colour * float(l.intensity);
+  scene_.lights.push_back(light);
+}
+
+GltfScene GltfReader::read(std::string_view bytes) {
+  const bool binary = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
+  // The JSON is checked by vkray's own reader first (syntax with line and column, nesting depth,
+  // duplicate keys), so that what reaches tinygltf is well-formed and shallow.
+  if (binary) {
+    check_glb(bytes);
+    uint32_t json_length;
+    std::memcpy(&json_length, bytes.data() + 12, 4);
+    parse_json_document(bytes.substr(20, json_length), file_);
+  } else {
+    parse_json_document(bytes, file_);
+  }
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(keep_encoded, nullptr);
+  loader.SetFsCallbacks(tinygltf::FsCallbacks{file_exists, expand_path, read_whole_file, write_whole_file, &access_});
+  std::string err, warn;
+  const std::string base_dir = file_.parent_path().string();
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  const auto size = static_cast<unsigned int>(bytes.size());
+  const bool ok = binary ? loader.LoadBinaryFromMemory(&model_, &err, &warn, data, size, base_dir)
+                         : loader.LoadASCIIFromString(&model_, &err, &warn, bytes.data(), size, base_dir);
+  if (!ok) {
+    std::string message = err.empty() ? "tinygltf could not read the file" : err;
+    std::replace(message.begin(), message.end(), '\n', ' ');
+    fail("", printable(message, 400));
+  }
+  scene_.files = access_.read;
+  check_extensions();
+  walk_nodes();
+  return std::move(scene_);
+}
+
+}  // namespace
+
+GltfScene parse_gltf(std::string_view bytes, const std::filesystem::path& file, const GltfLimits& limits) {
+  if (bytes.size() > kMaxGltfFileBytes) throw LimitError(file.string() + ": larger than vkray's limit for glTF files (2 GiB)");
+  return GltfReader(file, limits).read(bytes);
+}
+
+GltfScene load_gltf(const std::filesystem::path& file, const GltfLimits& limits) {
+  const InputFile input = read_input_file(file, kMaxGltfFileBytes);
+  if (!input.error.empty()) throw SceneError(file.string() + ": " + (input.error == "not found" ? "glTF file not found" : input.error));
+  return parse_gltf(input.text, file, limits);
+}
+
+bool is_gltf_path(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext == ".gltf" || ext == ".glb";
+}
+
+}  // namespace vkray

@@ -1,0 +1,50 @@
+// glTF 2.0 files: a .gltf with its buffers and pictures, or a .glb. tinygltf (Debian's libtinygltf-dev)
+// parses them; vkray checks every index, accessor and size before it reads anything through them, and
+// places the meshes of the default scene's node hierarchy in the file's world space. The metallic-
+// roughness material's base colour and emission (with their textures) become vkray's diffuse
+// materials; what vkray cannot render is named in one warning each.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scene/scene.h"
+
+namespace vkray {
+
+struct GltfScene {
+  std::vector<Triangle> triangles;  // in the file's world space; `material` indexes `materials`, `object` is 0
+  std::vector<Material> materials;  // their TextureRefs index `textures`
+  std::vector<std::shared_ptr<const Texture>> textures;
+  std::vector<PointLight> lights;   // KHR_lights_punctual point lights, in world space
+  // The first camera, depth-first from the default scene's root nodes, and its aspect ratio (width
+  // over height; 0 when the file gives none).
+  std::optional<Camera> camera;
+  float aspect_ratio = 0.0f;
+  std::vector<std::string> warnings;
+  std::vector<std::filesystem::path> files;  // the files read besides the file itself (buffers, pictures)
+};
+
+struct GltfLimits {
+  // The most triangles a file may place (instancing multiplies a mesh's): more throws LimitError.
+  size_t max_triangles = kMaxScenePrimitives;
+  // Whether buffers and pictures outside the file are read (the fuzz target reads none).
+  bool read_files = true;
+};
+
+// Reads a .gltf or .glb file (by its first bytes, not its name). Throws SceneError naming the file and
+// the element ("meshes[2].primitives[0]: ...") or LimitError.
+GltfScene load_gltf(const std::filesystem::path& file, const GltfLimits& limits = {});
+
+// The same from the file's bytes in memory; `file` names it in messages and locates relative URIs.
+GltfScene parse_gltf(std::string_view bytes, const std::filesystem::path& file, const GltfLimits& limits = {});
+
+// Whether a file name is a glTF file's (.gltf or .glb, any case).
+bool is_gltf_path(const std::filesystem::path& file);
+
+}  // namespace vkray

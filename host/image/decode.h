@@ -1,0 +1,33 @@
+// PNG and JPEG files decoded to 8-bit RGBA: the pictures textures are made of. libpng and
+// libjpeg-turbo (TurboJPEG) do the decoding; a picture's size is read from its header and checked
+// against vkray's limits before any pixel memory is allocated.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace vkray {
+
+// The largest picture vkray decodes: 16384 on a side (every GPU's texture limit, too), and at most
+// 2^26 pixels (a 8192 x 8192 picture), which as half-float RGBA take 512 MiB on the device.
+constexpr uint32_t kMaxPictureSide = 16384;
+constexpr uint64_t kMaxPicturePixels = uint64_t(1) << 26;
+
+struct Picture {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::vector<uint8_t> rgba;  // 4 bytes a pixel, row-major, top row first, as stored (sRGB for colour)
+};
+
+// Whether the bytes start like a PNG or a JPEG file (by their signature, not a name's extension).
+bool is_png(std::string_view bytes);
+bool is_jpeg(std::string_view bytes);
+
+// Decodes a PNG (any bit depth and colour type; 16-bit samples are rounded to 8) or a JPEG (greyscale,
+// YCbCr or RGB; CMYK is refused). Greyscale becomes grey RGB; a missing alpha is 255. Throws SceneError
+// "<name>: <why>": an unknown format, a damaged file, a size past the limits above.
+Picture decode_picture(std::string_view bytes, const std::string& name);
+
+}  // namespace vkray

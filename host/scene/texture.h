@@ -1,0 +1,50 @@
+// Textures as a scene holds them: pictures decoded to linear half-float RGBA, shared by the
+// materials that use them, and how a material samples one (glTF's sampler: wrap modes and filter).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace vkray {
+
+struct Picture;
+
+// The values are the shader's (VKRAY_WRAP_* and VKRAY_FILTER_* in shaders/shared/scene_layout.h).
+enum class TextureWrap : uint32_t { repeat = 0, clamp_to_edge = 1, mirrored_repeat = 2 };
+enum class TextureFilter : uint32_t { linear = 0, nearest = 1 };
+
+struct Texture {
+  std::string name;  // where it came from, for messages: "meshes/crate.png", "box.glb: images[0]"
+  uint32_t width = 0;
+  uint32_t height = 0;
+  // Half floats, 4 a texel (RGBA), row-major, top row first: the colour decoded from sRGB to linear,
+  // alpha as stored. Both renderers read these same values (the GPU as an RGBA16F texel buffer).
+  std::vector<uint16_t> texels;
+
+  // Texel (x, y) as floats.
+  glm::vec4 texel(uint32_t x, uint32_t y) const;
+};
+
+// A picture's colour decoded from sRGB (`srgb`, as base-colour and emissive textures are) or taken as
+// linear, rounded to half floats.
+Texture make_texture(const Picture& picture, std::string name, bool srgb = true);
+
+// A PNG or JPEG file read and decoded (image/decode.h). Throws SceneError naming the file.
+Texture load_texture(const std::filesystem::path& file, bool srgb = true);
+
+// How a material samples a texture; `texture` is an index into Scene::textures, -1 for none.
+struct TextureRef {
+  int32_t texture = -1;
+  TextureWrap wrap_s = TextureWrap::repeat;  // along u (the picture's rows)
+  TextureWrap wrap_t = TextureWrap::repeat;  // along v (its columns)
+  TextureFilter filter = TextureFilter::linear;
+
+  bool present() const { return texture >= 0; }
+  bool operator==(const TextureRef&) const = default;
+};
+
+}  // namespace vkray

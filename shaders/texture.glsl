@@ -1,0 +1,63 @@
+// Texture lookups (layout in shared/scene_layout.h): bilinear or nearest, with glTF's wrap modes
+// (OpenGL's rules: texel centres at half-integer coordinates, (0, 0) the picture's top left corner).
+// host/cpu/texture.cpp does the same for the CPU reference, written again.
+#ifndef VKRAY_TEXTURE_GLSL
+#define VKRAY_TEXTURE_GLSL
+
+#include "resources.glsl"
+
+// A coordinate reduced to one period of its wrap mode, exactly (u - 2 floor(u / 2) rounds nothing),
+// so that texel indices stay small whatever the coordinate.
+float reduce_coordinate(float u, uint wrap) {
+  if (wrap == VKRAY_WRAP_CLAMP_TO_EDGE) return clamp(u, 0.0, 1.0);
+  if (wrap == VKRAY_WRAP_MIRRORED_REPEAT) return u - 2.0 * floor(u * 0.5);
+  return u - floor(u);
+}
+
+// Texel index i (from -1 to two periods) wrapped into [0, size).
+int wrap_texel(int i, int size, uint wrap) {
+  if (wrap == VKRAY_WRAP_CLAMP_TO_EDGE) return clamp(i, 0, size - 1);
+  if (wrap == VKRAY_WRAP_MIRRORED_REPEAT) {
+    int period = 2 * size;
+    int m = (i + period) % period;
+    return m < size ? m : period - 1 - m;
+  }
+  return (i + size) % size;
+}
+
+vec3 texture_fetch(TextureHeader t, int x, int y) {
+  return texelFetch(textures, int(t.first + uint(y) * t.width + uint(x))).rgb;
+}
+
+// The texture a material texel names (texture_texel), at texture coordinate uv.
+vec3 sample_texture(vec4 header_texel, vec2 uv) {
+  TextureHeader t = texture_header(header_texel);
+  uint wrap_s = texture_wrap_s(t.mode), wrap_t = texture_wrap_t(t.mode);
+  int width = int(t.width), height = int(t.height);
+  float x = reduce_coordinate(uv.x, wrap_s) * float(width), y = reduce_coordinate(uv.y, wrap_t) * float(height);
+  if (texture_filter(t.mode) == VKRAY_FILTER_NEAREST)
+    return texture_fetch(t, wrap_texel(int(floor(x)), width, wrap_s), wrap_texel(int(floor(y)), height, wrap_t));
+  // Bilinear: the four texels whose centres surround (x, y), weighed by distance.
+  x -= 0.5;
+  y -= 0.5;
+  float x0 = floor(x), y0 = floor(y);
+  float ax = x - x0, ay = y - y0;
+  int i0 = wrap_texel(int(x0), width, wrap_s), i1 = wrap_texel(int(x0) + 1, width, wrap_s);
+  int j0 = wrap_texel(int(y0), height, wrap_t), j1 = wrap_texel(int(y0) + 1, height, wrap_t);
+  vec3 top = (1.0 - ax) * texture_fetch(t, i0, j0) + ax * texture_fetch(t, i1, j0);
+  vec3 bottom = (1.0 - ax) * texture_fetch(t, i0, j1) + ax * texture_fetch(t, i1, j1);
+  return (1.0 - ay) * top + ay * bottom;
+}
+
+// Whether a material texel names a texture (its width is not 0).
+bool has_texture(vec4 header_texel) { return floatBitsToUint(header_texel.y) != 0u; }
+
+// The texture coordinate at barycentrics (b1, b2) of the triangle in primitive slot `prim`.
+vec2 triangle_texcoord(uint prim, vec2 b) {
+  int base = int(prim) * VKRAY_TEXELS_PER_TEXCOORDS;
+  vec4 first = texelFetch(texcoords, base);
+  vec2 uv2 = texelFetch(texcoords, base + 1).xy;
+  return (1.0 - b.x - b.y) * first.xy + b.x * first.zw + b.y * uv2;
+}
+
+#endif
