@@ -198,6 +198,7 @@ class GltfReader {
   }
 
   void check_glb(std::string_view bytes) const;
+  void check_image_views(const nlohmann::json& doc) const;
   void check_extensions();
   AccessorView accessor(int index, const std::string& where, std::initializer_list<int> types,
                         std::initializer_list<int> component_types) const;
@@ -241,6 +242,40 @@ void GltfReader::check_glb(std::string_view bytes) const {
   if (bin_at + 8 <= word(8)) {
     const uint64_t bin_length = word(size_t(bin_at));
     if (bin_at + 8 + bin_length > word(8)) fail("", "the binary chunk (" + std::to_string(bin_length) + " bytes) runs past the file's end");
+  }
+}
+
+// tinygltf 2.7.0 hands a picture in a buffer view to the image callback without checking that the
+// view lies inside its buffer (tiny_gltf.h, LoadFromString: &buffer.data[byteOffset], byteLength),
+// which fuzz_gltf found as a heap overflow. So the views pictures use are checked here first,
+// against the buffers' declared byteLength, which tinygltf holds each buffer's data to exactly.
+void GltfReader::check_image_views(const nlohmann::json& doc) const {
+  const auto array = [&](const char* key) {
+    static const nlohmann::json empty = nlohmann::json::array();
+    return doc.contains(key) && doc[key].is_array() ? doc[key] : empty;
+  };
+  const auto whole = [](const nlohmann::json& object, const char* key, bool required, uint64_t& out) {
+    if (!object.contains(key)) return !required;
+    if (!object[key].is_number_unsigned()) return false;
+    out = object[key].get<uint64_t>();
+    return true;
+  };
+  const nlohmann::json &images = array("images"), &views = array("bufferViews"), &buffers = array("buffers");
+  for (size_t i = 0; i < images.size(); ++i) {
+    if (!images[i].is_object() || !images[i].contains("bufferView")) continue;
+    const std::string where = element("images", i) + ".bufferView";
+    uint64_t view = 0, buffer = 0, offset = 0, length = 0, size = 0;
+    if (!whole(images[i], "bufferView", true, view) || view >= views.size() || !views[view].is_object())
+      fail(where, "not the index of a buffer view (the file has " + std::to_string(views.size()) + ")");
+    const std::string view_name = element("bufferViews", view);
+    if (!whole(views[view], "buffer", true, buffer) || buffer >= buffers.size() || !buffers[buffer].is_object())
+      fail(view_name + ".buffer", "not the index of a buffer (the file has " + std::to_string(buffers.size()) + ")");
+    if (!whole(views[view], "byteOffset", false, offset) || !whole(views[view], "byteLength", true, length))
+      fail(view_name, "byteOffset and byteLength must be whole numbers");
+    if (!whole(buffers[buffer], "byteLength", true, size)) fail(element("buffers", buffer) + ".byteLength", "must be a whole number");
+    if (offset > size || length > size - offset)
+      fail(view_name, "bytes " + std::to_string(offset) + " + " + std::to_string(length) + " run past the end of buffers[" +
+                          std::to_string(buffer) + "] (" + std::to_string(size) + " bytes)");
   }
 }
 
@@ -688,14 +723,17 @@ GltfScene GltfReader::read(std::string_view bytes) {
   const bool binary = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
   // The JSON is checked by vkray's own reader first (syntax with line and column, nesting depth,
   // duplicate keys), so that what reaches tinygltf is well-formed and shallow.
+  nlohmann::json doc;
   if (binary) {
     check_glb(bytes);
     uint32_t json_length;
     std::memcpy(&json_length, bytes.data() + 12, 4);
-    parse_json_document(bytes.substr(20, json_length), file_);
+    doc = parse_json_document(bytes.substr(20, json_length), file_);
   } else {
-    parse_json_document(bytes, file_);
+    doc = parse_json_document(bytes, file_);
   }
+  if (!doc.is_object()) fail("", "the JSON is not an object");
+  check_image_views(doc);
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(keep_encoded, nullptr);
   loader.SetFsCallbacks(tinygltf::FsCallbacks{file_exists, expand_path, read_whole_file, write_whole_file, &access_});

@@ -605,7 +605,8 @@ std::vector<uint32_t> SceneParser::mesh_materials(const Value& where, const std:
     if (found == defined.end())
       throw MeshError(file_.string() + ": " + where.path + ": " + mesh_file.filename().string() + ": usemtl " + printable(name) +
                       ": no material library it names (mtllib) defines it");
-    const auto& [mtl, library] = found->second;
+    const MtlMaterial& mtl = found->second.first;
+    const std::filesystem::path& library = found->second.second;
     Material material;
     material.name = mesh_file.filename().string() + ": " + name;
     material.albedo = mtl.diffuse;
