@@ -103,27 +103,10 @@ INSTANTIATE_TEST_SUITE_P(Integrators, AovTest, ::testing::Bool(),
 
 // A shader whose normal pass is turned to face the ray (a plausible slip: the shading code does
 // that) must fail parity on the passes alone: the image is unchanged.
-class BrokenNormalPassTest : public ParityTest {
+class BrokenNormalPassTest : public BrokenShaderParityTest {
  protected:
-  BrokenNormalPassTest() {
-    std::filesystem::copy(VKRAY_SHADER_DIR, shaders_.path(), std::filesystem::copy_options::recursive);
-    std::ifstream in(shaders_.path() / "aovs.glsl");
-    std::string text((std::istreambuf_iterator<char>(in)), {});
-    const std::string good = "first_hits.normal += s.shading_normal;";
-    const size_t at = text.find(good);
-    if (at == std::string::npos) return;
-    std::ofstream(shaders_.path() / "aovs.glsl") << text.replace(at, good.size(), "first_hits.normal += abs(s.shading_normal);");
-    broken_ = true;
-  }
-  void SetUp() override {
-    ParityTest::SetUp();
-    if (!broken_) FAIL() << "aovs.glsl no longer adds the normal as the test expects: the test breaks nothing";
-  }
-  std::filesystem::path shader_dir() const override { return shaders_.path(); }
-
- private:
-  TempDir shaders_;
-  bool broken_ = false;
+  BrokenNormalPassTest()
+      : BrokenShaderParityTest("aovs.glsl", "first_hits.normal += s.shading_normal;", "first_hits.normal += abs(s.shading_normal);") {}
 };
 
 TEST_F(BrokenNormalPassTest, FailsParity) {

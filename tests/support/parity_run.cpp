@@ -1,6 +1,8 @@
 #include "support/parity_run.h"
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 
 #include "image/image.h"
@@ -23,6 +25,22 @@ void ParityTest::expect_parity(const ParityResult& run, const std::string& name)
   ADD_FAILURE() << name << ": parity tolerance (" << describe_tolerance(run.tolerance) << ") does not hold:\n"
                 << "  " << describe_metrics(m) << "\n"
                 << "  heatmap (1 to " << max_steps << " steps): " << (dir / (name + ".png")).string();
+}
+
+BrokenShaderParityTest::BrokenShaderParityTest(const std::string& file, const std::string& good, const std::string& bad)
+    : file_(file), good_(good) {
+  std::filesystem::copy(VKRAY_SHADER_DIR, shaders_.path(), std::filesystem::copy_options::recursive);
+  std::ifstream in(shaders_.path() / file);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const size_t at = text.find(good);
+  if (at == std::string::npos) return;
+  std::ofstream(shaders_.path() / file) << text.replace(at, good.size(), bad);
+  broken_ = true;
+}
+
+void BrokenShaderParityTest::SetUp() {
+  ParityTest::SetUp();
+  if (!broken_) FAIL() << file_ << " no longer holds \"" << good_ << "\": the test breaks nothing";
 }
 
 }  // namespace vkray::test

@@ -7,6 +7,7 @@
 
 #include "session/parity.h"
 #include "support/gpu_fixture.h"
+#include "support/temp_dir.h"
 
 namespace vkray {
 // For test names and messages.
@@ -23,6 +24,21 @@ class ParityTest : public GpuTest {
   // Fails the test when the tolerance does not hold, naming the metrics and the heatmap written to
   // <build>/tests/parity-failures/<name>.png.
   void expect_parity(const ParityResult& run, const std::string& name);
+};
+
+// Parity with a copy of the shaders in which one line is broken on purpose (`good` replaced by
+// `bad` in `file`), to show that parity notices that mistake. Fails at SetUp when `good` is no
+// longer in the file, so that the test never passes by breaking nothing.
+class BrokenShaderParityTest : public ParityTest {
+ protected:
+  BrokenShaderParityTest(const std::string& file, const std::string& good, const std::string& bad);
+  void SetUp() override;
+  std::filesystem::path shader_dir() const override { return shaders_.path(); }
+
+ private:
+  TempDir shaders_;
+  std::string file_, good_;
+  bool broken_ = false;
 };
 
 }  // namespace vkray::test

@@ -1,0 +1,86 @@
+// Textures rendered: both renderers show a texture where it belongs, with each wrap mode and filter,
+// under both integrators and as emission; parity holds on textured scenes; and parity notices a
+// shader that samples a texture wrongly.
+#include <gtest/gtest.h>
+
+#include "support/parity_run.h"
+#include "support/temp_dir.h"
+#include "support/test_assets.h"
+
+namespace vkray::test {
+namespace {
+
+// A quad filling most of the view, textured with the four colours (red, green / blue, white), its
+// texture coordinates running from -0.5 to 1.5 so that each wrap mode shows; lit by a point light at
+// the camera (direct) or a white sky (path).
+Scene textured_quad(const nlohmann::json& sampler, bool path, bool emissive = false) {
+  GltfBuilder b;
+  const int texture = b.texture(test::png_bytes(four_colours()), sampler);
+  nlohmann::json material = {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", texture}}}, {"metallicFactor", 0}}}};
+  if (emissive) material["emissiveTexture"] = {{"index", texture}}, material["emissiveFactor"] = {2, 2, 2};
+  b.quad(b.material(material));
+  b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = b.accessor({-0.5f, 1.5f, 1.5f, 1.5f, 1.5f, -0.5f, -0.5f, -0.5f}, "VEC2");
+  TempDir dir;
+  write_file(dir / "quad.glb", b.glb());
+  const std::string integrator = path ? R"({"type": "path", "max_depth": 3})" : R"({"type": "direct"})";
+  write_file(dir / "scene.json", R"({"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "vertical_fov": 40},
+    "integrator": )" + integrator + R"(, "background": )" + (path && !emissive ? "[1, 1, 1]" : "[0, 0, 0]") + R"(,
+    "lights": [)" + (path ? "" : R"({"type": "point", "position": [0, 0, 3], "intensity": [9, 9, 9]})") + R"(],
+    "objects": [{"type": "gltf", "file": "quad.glb"}]})");
+  return load_scene(dir / "scene.json");
+}
+
+struct Sampling {
+  const char* name;
+  nlohmann::json sampler;
+};
+
+class TextureParityTest : public ParityTest, public ::testing::WithParamInterface<std::tuple<Sampling, bool>> {};
+
+TEST_P(TextureParityTest, BothRenderersShowTheTextureAlike) {
+  const auto& [sampling, path] = GetParam();
+  const Scene scene = textured_quad(sampling.sampler, path);
+  const ParityResult r = run(scene, {96, 96, path ? 16u : 4u});
+  expect_parity(r, std::string("texture-") + sampling.name + (path ? "-path" : "-direct"));
+  // The middle of the quad's texture coordinates, (0.5, 0.5), is at the image's centre; a quarter
+  // of the way in from the centre toward the top left lies (0.25, 0.25) of the texture: red.
+  for (const Image* image : {&r.gpu.image, &r.cpu.image}) {
+    const glm::vec3 top_left = image->at(40, 40), bottom_left = image->at(40, 56);
+    EXPECT_GT(top_left.r, 2.0f * top_left.g) << sampling.name << (image == &r.gpu.image ? " GPU" : " CPU");
+    EXPECT_GT(bottom_left.b, 2.0f * bottom_left.r) << sampling.name << (image == &r.gpu.image ? " GPU" : " CPU");
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Samplers, TextureParityTest,
+    ::testing::Combine(::testing::Values(Sampling{"default", nullptr}, Sampling{"nearest", {{"magFilter", 9728}}},
+                                         Sampling{"clamp", {{"wrapS", 33071}, {"wrapT", 33071}}},
+                                         Sampling{"mirrored", {{"wrapS", 33648}, {"wrapT", 33648}, {"magFilter", 9728}}}),
+                       ::testing::Bool()),
+    [](const auto& p) { return std::string(std::get<0>(p.param).name) + (std::get<1>(p.param) ? "Path" : "Direct"); });
+
+TEST_F(ParityTest, AnEmissiveTextureLightsTheSceneAlike) {
+  const Scene scene = textured_quad(nullptr, true, true);
+  const ParityResult r = run(scene, {96, 96, 16});
+  expect_parity(r, "texture-emissive");
+  const glm::vec3 red = r.gpu.image.at(37, 37);  // texture coordinate (0.25, 0.25): the red texel's centre, emitting 2
+  EXPECT_GT(red.r, 1.5f);
+  EXPECT_LT(red.g, 0.2f);
+}
+
+// A shader that reads textures upside down (v where it should read 1 - v: the slip between OBJ's and
+// glTF's conventions) must fail parity.
+class UpsideDownTextureTest : public BrokenShaderParityTest {
+ protected:
+  UpsideDownTextureTest()
+      : BrokenShaderParityTest("texture.glsl", "y = reduce_coordinate(uv.y, wrap_t)", "y = reduce_coordinate(1.0 - uv.y, wrap_t)") {}
+};
+
+TEST_F(UpsideDownTextureTest, FailsParity) {
+  const ParityResult r = run(textured_quad({{"magFilter", 9728}}, false), {96, 96, 1});
+  EXPECT_FALSE(r.metrics.pass);
+  EXPECT_GT(r.metrics.interior_over_1, 100u);
+}
+
+}  // namespace
+}  // namespace vkray::test
