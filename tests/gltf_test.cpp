@@ -1,6 +1,8 @@
 // glTF 2.0 files: what each part of a file becomes in a scene (meshes through the node hierarchy,
 // materials and textures, the camera, lights), both ways in (an object of a vkray scene, the file as
 // the scene), and every way a file can be wrong.
+#include <set>
+
 #include <gtest/gtest.h>
 
 #include "base/errors.h"
@@ -256,10 +258,14 @@ TEST_F(GltfFileTest, AnObjectOfAVkraySceneIsPlacedByItsTransform) {
     "lights": [{"type": "point", "position": [0, 0, 10], "intensity": [50, 50, 50]}],
     "materials": {"grey": {"albedo": [0.5, 0.5, 0.5]}},
     "objects": [{"type": "sphere", "center": [0, 0, -5], "radius": 1, "material": "grey"},
-                {"type": "gltf", "file": "quad.glb", "transform": {"translate": [3, 0, 0], "scale": 2}}]})");
+                {"type": "gltf", "file": "quad.glb", "transform": {"translate": [3, 0, 0], "scale": 2}},
+                {"type": "gltf", "file": "quad.glb", "transform": {"translate": [-3, 0, 0], "rotate": [0, 30, 0]}}]})");
   const Scene s = load_scene(dir_ / "scene.json");
-  ASSERT_EQ(s.triangles.size(), 2u);
-  EXPECT_EQ(s.materials.size(), 2u);
+  ASSERT_EQ(s.triangles.size(), 4u);
+  EXPECT_EQ(s.materials.size(), 2u);  // the file placed twice, its material and texture the scene's once
+  EXPECT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.triangles[2].material, 1u);
+  EXPECT_EQ(s.triangles[2].object, 2u);
   EXPECT_EQ(s.triangles[0].material, 1u);
   EXPECT_EQ(s.triangles[0].object, 1u);
   EXPECT_EQ(s.materials[1].albedo_texture.texture, 0);
@@ -296,6 +302,33 @@ TEST_F(GltfFileTest, TheFileAsAWholeSceneGetsACameraAndLight) {
   EXPECT_EQ(lit.image.width, 768u);  // 512 high, 1.5 wide
   EXPECT_EQ(lit.image.height, 512u);
   EXPECT_TRUE(lit.lights.empty());  // it emits: no light added
+}
+
+// The shipped Khronos models: what each file holds, as their READMEs describe them.
+TEST(ShippedGltfTest, KhronosModelsLoadAsDescribed) {
+  const std::filesystem::path dir = std::filesystem::path(VKRAY_SCENE_DIR) / "gltf";
+  for (const char* form : {"BoxTextured/glTF/BoxTextured.gltf", "BoxTextured/glTF-Binary/BoxTextured.glb",
+                           "BoxTextured/glTF-Embedded/BoxTextured.gltf"}) {
+    const GltfScene box = load_gltf(dir / form);
+    EXPECT_EQ(box.triangles.size(), 12u) << form;
+    ASSERT_EQ(box.textures.size(), 1u) << form;
+    EXPECT_EQ(box.textures[0]->width, box.textures[0]->height) << form;  // the square Cesium logo
+    // The root's matrix turns the box from z-up to y-up: a unit cube either way.
+    for (const Triangle& t : box.triangles)
+      for (const glm::vec3& v : t.v) EXPECT_NEAR(std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}), 0.5f, 1e-6f) << form;
+  }
+  const GltfScene truck = load_gltf(dir / "CesiumMilkTruck/glTF/CesiumMilkTruck.gltf");
+  EXPECT_EQ(truck.materials.size(), 4u);
+  ASSERT_EQ(truck.textures.size(), 1u);  // the progressive JPEG
+  EXPECT_EQ(truck.textures[0]->width, 2048u);
+  const GltfScene settings = load_gltf(dir / "TextureSettingsTest/glTF/TextureSettingsTest.gltf");
+  std::set<std::pair<TextureWrap, TextureWrap>> wraps;
+  for (const Material& m : settings.materials)
+    if (m.albedo_texture.present()) wraps.insert({m.albedo_texture.wrap_s, m.albedo_texture.wrap_t});
+  EXPECT_GE(wraps.size(), 4u);  // clamp, repeat and mirror, per axis
+  const GltfScene cameras = load_gltf(dir / "Cameras/glTF/Cameras.gltf");
+  ASSERT_TRUE(cameras.camera);  // the perspective one
+  EXPECT_NEAR(cameras.camera->focal_length, 0.5f / std::tan(0.35f), 1e-5f);  // yfov 0.7
 }
 
 }  // namespace

@@ -82,5 +82,27 @@ TEST_F(UpsideDownTextureTest, FailsParity) {
   EXPECT_GT(r.metrics.interior_over_1, 100u);
 }
 
+// Every shipped glTF sample model, as the scene it makes by itself, renders alike on both
+// renderers: their textures (PNG with a palette, a progressive JPEG), samplers and hierarchies.
+class ShippedModelTest : public ParityTest, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(ShippedModelTest, HoldsParity) {
+  const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "gltf" / GetParam());
+  EXPECT_FALSE(scene.triangles.empty());
+  expect_parity(run(scene, {96, 96, 1}), std::filesystem::path(GetParam()).stem().string());
+}
+
+INSTANTIATE_TEST_SUITE_P(Khronos, ShippedModelTest,
+                         ::testing::Values("BoxTextured/glTF/BoxTextured.gltf", "BoxTextured/glTF-Binary/BoxTextured.glb",
+                                           "BoxTextured/glTF-Embedded/BoxTextured.gltf", "CesiumMilkTruck/glTF/CesiumMilkTruck.gltf",
+                                           "TextureSettingsTest/glTF/TextureSettingsTest.gltf",
+                                           "TextureCoordinateTest/glTF/TextureCoordinateTest.gltf", "Cameras/glTF/Cameras.gltf"),
+                         [](const auto& p) {
+                           std::string name = std::filesystem::path(p.param).parent_path().string();
+                           for (char& c : name)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return name;
+                         });
+
 }  // namespace
 }  // namespace vkray::test

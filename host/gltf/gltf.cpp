@@ -199,7 +199,8 @@ class GltfReader {
 
   void check_glb(std::string_view bytes) const;
   void check_image_views(const nlohmann::json& doc) const;
-  void check_extensions();
+  void check_required_extensions(const nlohmann::json& doc) const;
+  void warn_used_extensions();
   AccessorView accessor(int index, const std::string& where, std::initializer_list<int> types,
                         std::initializer_list<int> component_types) const;
   dmat4 local_transform(size_t node) const;
@@ -279,9 +280,16 @@ void GltfReader::check_image_views(const nlohmann::json& doc) const {
   }
 }
 
-void GltfReader::check_extensions() {
-  for (const std::string& name : model_.extensionsRequired)
-    if (!kReadExtensions.count(name)) fail("extensionsRequired", "the file requires " + printable(name) + ", which vkray does not read");
+// Before tinygltf, which would otherwise report what the extension changes (a Draco-compressed
+// accessor has no buffer view) instead of the extension.
+void GltfReader::check_required_extensions(const nlohmann::json& doc) const {
+  if (!doc.contains("extensionsRequired") || !doc["extensionsRequired"].is_array()) return;
+  for (const auto& name : doc["extensionsRequired"])
+    if (name.is_string() && !kReadExtensions.count(name.get<std::string>()))
+      fail("extensionsRequired", "the file requires " + printable(name.get<std::string>()) + ", which vkray does not read");
+}
+
+void GltfReader::warn_used_extensions() {
   for (const std::string& name : model_.extensionsUsed)
     if (!kReadExtensions.count(name))
       warn_once("extension " + name, "extensionsUsed", printable(name) + " is not read; what it adds is not rendered");
@@ -734,6 +742,7 @@ GltfScene GltfReader::read(std::string_view bytes) {
   }
   if (!doc.is_object()) fail("", "the JSON is not an object");
   check_image_views(doc);
+  check_required_extensions(doc);
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(keep_encoded, nullptr);
   loader.SetFsCallbacks(tinygltf::FsCallbacks{file_exists, expand_path, read_whole_file, write_whole_file, &access_});
@@ -749,7 +758,7 @@ GltfScene GltfReader::read(std::string_view bytes) {
     fail("", printable(message, 400));
   }
   scene_.files = access_.read;
-  check_extensions();
+  warn_used_extensions();
   walk_nodes();
   return std::move(scene_);
 }

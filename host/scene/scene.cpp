@@ -155,6 +155,11 @@ class SceneParser {
   MeshCache& meshes_;  // each file loaded once, however often it is used
   std::set<std::filesystem::path> referenced_;  // the files in scene_.referenced_files
   std::map<std::pair<std::filesystem::path, bool>, int32_t> texture_files_;  // (file, sRGB) -> Scene::textures
+  struct LoadedGltf {
+    GltfScene gltf;
+    uint32_t material_offset = 0;  // where its materials start in Scene::materials
+  };
+  std::map<std::filesystem::path, LoadedGltf> gltf_files_;
   uint32_t object_ = 0;  // the index in "objects" of the object being parsed
 };
 
@@ -462,29 +467,37 @@ void SceneParser::parse_object(const Value& v) {
 
 std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where, const std::filesystem::path& file,
                                                               const glm::mat4& transform) {
-  GltfScene gltf;
-  try {
-    gltf = load_gltf(file);
-  } catch (const SceneError& e) {
-    if (!where) throw;
-    throw SceneError(file_.string() + ": " + where->path + ": " + e.what());
+  // A file placed several times is read once: its materials and textures are the scene's once, and
+  // its warnings said once.
+  auto loaded = gltf_files_.find(file);
+  if (loaded == gltf_files_.end()) {
+    LoadedGltf entry;
+    try {
+      entry.gltf = load_gltf(file);
+    } catch (const SceneError& e) {
+      if (!where) throw;
+      throw SceneError(file_.string() + ": " + where->path + ": " + e.what());
+    }
+    reference(file);
+    for (const auto& f : entry.gltf.files) reference(f);
+    for (const std::string& w : entry.gltf.warnings) {
+      if (where) warn(*where, w);
+      else scene_.warnings.push_back(w);
+    }
+    entry.material_offset = uint32_t(scene_.materials.size());
+    const auto texture_offset = int32_t(scene_.textures.size());
+    for (Material m : entry.gltf.materials) {
+      for (TextureRef* ref : {&m.albedo_texture, &m.emission_texture})
+        if (ref->present()) ref->texture += texture_offset;
+      scene_.materials.push_back(std::move(m));
+    }
+    for (const auto& t : entry.gltf.textures) scene_.textures.push_back(t);
+    loaded = gltf_files_.emplace(file, std::move(entry)).first;
   }
+  GltfScene gltf = loaded->second.gltf;  // its triangles and lights placed below
+  const uint32_t material_offset = loaded->second.material_offset;
   const Value root{json(), ""};
   const Value& at = where ? *where : root;
-  reference(file);
-  for (const auto& f : gltf.files) reference(f);
-  for (const std::string& w : gltf.warnings) {
-    if (where) warn(*where, w);
-    else scene_.warnings.push_back(w);
-  }
-  const auto material_offset = uint32_t(scene_.materials.size());
-  const auto texture_offset = int32_t(scene_.textures.size());
-  for (Material m : gltf.materials) {
-    for (TextureRef* ref : {&m.albedo_texture, &m.emission_texture})
-      if (ref->present()) ref->texture += texture_offset;
-    scene_.materials.push_back(std::move(m));
-  }
-  for (auto& t : gltf.textures) scene_.textures.push_back(std::move(t));
   // The object's transform on top of the file's own: normals by the inverse transpose, and the
   // winding turned around where it mirrors.
   const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(transform)));
