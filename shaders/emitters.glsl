@@ -46,7 +46,8 @@ LightPoint sample_area_light(inout uint stream) {
   light.radiance = emission;
   if (SCENE_HAS_TEXTURES) {
     vec4 emission_texture = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION_TEXTURE);
-    if (has_texture(emission_texture)) light.radiance *= sample_texture(emission_texture, triangle_texcoord(prim, w.yz));
+    bool sphere = SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u;  // spheres have no texture coordinates
+    if (!sphere && has_texture(emission_texture)) light.radiance *= sample_texture(emission_texture, triangle_texcoord(prim, w.yz));
   }
   return light;
 }

@@ -1,6 +1,7 @@
 // glTF 2.0 files: what each part of a file becomes in a scene (meshes through the node hierarchy,
 // materials and textures, the camera, lights), both ways in (an object of a vkray scene, the file as
 // the scene), and every way a file can be wrong.
+#include <cstring>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -85,13 +86,14 @@ TEST(GltfTest, NodeTransformsComposeDownTheHierarchy) {
   GltfBuilder b;
   const int quad = b.quad();
   b.doc["scenes"][0]["nodes"] = {1};
-  b.doc["nodes"][quad]["scale"] = {2, 2, 2};
+  b.doc["nodes"][quad]["scale"] = {2, 3, 1};
   // A parent at x = 10, turned 90 degrees about z, that holds the scaled quad.
   b.doc["nodes"].push_back({{"translation", {10, 0, 0}}, {"rotation", {0, 0, 0.7071067811865476, 0.7071067811865476}}, {"children", {quad}}});
   const GltfScene s = parse(b.gltf());
   ASSERT_EQ(s.triangles.size(), 2u);
-  // Quad corner (1, -1, 0), scaled to (2, -2, 0), turned to (2, 2, 0), moved to (12, 2, 0).
-  EXPECT_NEAR(s.triangles[0].v[1].x, 12.0f, 1e-5f);
+  // Quad corner (1, -1, 0), scaled to (2, -3, 0), turned to (3, 2, 0), moved to (13, 2, 0): scale
+  // first, then rotation, then translation (T R S), and the parent's after the child's.
+  EXPECT_NEAR(s.triangles[0].v[1].x, 13.0f, 1e-5f);
   EXPECT_NEAR(s.triangles[0].v[1].y, 2.0f, 1e-5f);
   // A matrix (column-major) in place of the TRS: a mirror in x turns the winding around, so the front stays +z.
   b.doc["nodes"][1].erase("translation");
@@ -101,6 +103,47 @@ TEST(GltfTest, NodeTransformsComposeDownTheHierarchy) {
   EXPECT_NEAR(m.triangles[0].v[0].z, 5.0f, 1e-6f);
   const Triangle& t = m.triangles[0];
   EXPECT_GT(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0]).z, 0.0f);
+}
+
+TEST(GltfTest, AFlatteningScaleKeepsWhatStaysInThePlane) {
+  GltfBuilder b;
+  const int quad = b.quad();
+  b.doc["nodes"][quad]["scale"] = {1, 1, 0};  // the quad lies in z = 0: unchanged
+  b.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = b.accessor({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3");
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_TRUE(s.triangles[0].smooth);
+  EXPECT_EQ(s.triangles[0].normals[0], glm::vec3(0, 0, 1));
+}
+
+TEST(GltfTest, ARotatedCameraLooksDownItsLocalMinusZ) {
+  GltfBuilder b;
+  b.quad();
+  b.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}}};
+  // Turned 90 degrees about y: its -z becomes -x, its +y stays up; tilted by its parent 90 about x.
+  b.doc["nodes"].push_back({{"camera", 0}, {"rotation", {0, 0.7071067811865476, 0, 0.7071067811865476}}});
+  b.doc["nodes"].push_back({{"children", {1}}, {"rotation", {0.7071067811865476, 0, 0, 0.7071067811865476}}});
+  b.doc["scenes"][0]["nodes"].push_back(2);
+  const GltfScene s = parse(b.gltf());
+  ASSERT_TRUE(s.camera);
+  EXPECT_NEAR(glm::distance(s.camera->forward, glm::vec3(-1, 0, 0)), 0.0f, 1e-6f);
+  EXPECT_NEAR(glm::distance(s.camera->up, glm::vec3(0, 0, 1)), 0.0f, 1e-6f);  // +y turned by the parent to +z
+}
+
+TEST(GltfTest, PicturesAreDecodedOnceAndWithinTheTexelBudget) {
+  GltfBuilder b;
+  const int texture = b.texture(test::png_bytes(test::four_colours()));
+  b.doc["images"].push_back(b.doc["images"][0]);  // two more images of the same buffer view
+  b.doc["images"].push_back(b.doc["images"][0]);
+  b.doc["textures"].push_back({{"source", 1}});
+  b.doc["textures"].push_back({{"source", 2}});
+  for (int t = 0; t < 3; ++t) b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", texture + t}}}}}}));
+  const GltfScene s = parse(b.gltf());
+  EXPECT_EQ(s.textures.size(), 1u);
+  GltfLimits tight;
+  tight.max_texels = 3;  // the 2 x 2 picture needs 4
+  const std::string message = error_of([&] { parse_gltf(b.gltf(), "test.gltf", tight); });
+  EXPECT_NE(message.find("test.gltf: images[0]: a 2 x 2 picture would bring the scene's textures past"), std::string::npos) << message;
 }
 
 TEST(GltfTest, TheFirstCameraDepthFirstAndPointLights) {
@@ -216,6 +259,22 @@ TEST(GltfTest, BrokenFilesNameTheElement) {
     GltfBuilder b = textured_quad();
     b.doc["nodes"][0]["mesh"] = 5;
     expect_error(b, "nodes[0].mesh: meshes[5] does not exist");
+  }
+  {
+    GltfBuilder b;  // no buffer of its own: the one below stands
+    b.doc["buffers"] = {{{"byteLength", 0}}};
+    const std::string empty = error_of([&] { parse_gltf(b.glb(), "empty.glb"); });
+    EXPECT_NE(empty.find("empty.glb: buffers[0].byteLength: expected a whole number of bytes, at least 1"), std::string::npos) << empty;
+  }
+  {
+    // A JSON chunk not padded to 4 bytes.
+    std::string glb = textured_quad().glb();
+    uint32_t json_length;
+    std::memcpy(&json_length, glb.data() + 12, 4);
+    json_length -= 1;
+    std::memcpy(glb.data() + 12, &json_length, 4);
+    const std::string unpadded = error_of([&] { parse_gltf(glb, "unpadded.glb"); });
+    EXPECT_NE(unpadded.find("is not a multiple of 4"), std::string::npos) << unpadded;
   }
   // A .glb cut short: its header's length is past the end.
   std::string glb = textured_quad().glb();

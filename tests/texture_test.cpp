@@ -204,6 +204,26 @@ TEST_F(ObjMaterialTest, BadLibrariesAndTexturesNameTheFileAndLine) {
   EXPECT_NE(undefined.find("usemtl plain: no material library it names (mtllib) defines it"), std::string::npos) << undefined;
 }
 
+TEST_F(ObjMaterialTest, RepeatingCoordinatesAreMovedNearZeroWholePeriodsAtATime) {
+  // A floor tiled thousands of times: both renderers then interpolate small numbers (float and
+  // double would otherwise sample it half a texel apart). Clamped axes stay where they are.
+  write("far.obj", "mtllib far.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 5000.25 -3001.5\nvt 5001.75 -3001\nvt 5000.5 -2999\n"
+                   "usemtl repeat\nf 1/1 2/2 3/3\nusemtl clamp\nf 1/1 2/2 3/3\n");
+  write("far.mtl", "newmtl repeat\nmap_Kd four.png\nnewmtl clamp\nmap_Kd -clamp on four.png\n");
+  test::write_file(dir_ / "four.png", test::png_bytes(four_colours()));
+  const Scene scene = load(R"({"type": "mesh", "file": "far.obj"})");
+  ASSERT_EQ(scene.triangles.size(), 2u);
+  // u: 5000.25 - 5000; v (flipped: 1 - v, so 3002.5 ...): minus 3000.
+  EXPECT_EQ(scene.triangles[0].uv[0], glm::vec2(0.25f, 2.5f));
+  EXPECT_EQ(scene.triangles[0].uv[1], glm::vec2(1.75f, 2.0f));
+  EXPECT_EQ(scene.triangles[1].uv[0], glm::vec2(5000.25f, 3002.5f));
+  const std::string past = error_of([&] {
+    write("far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 2e9 0\nf 1/1 2/1 3/1\n");
+    load(R"({"type": "mesh", "file": "far.obj", "material": "grey"})");
+  });
+  EXPECT_NE(past.find("far.obj:4: texture coordinate"), std::string::npos) << past;
+}
+
 TEST_F(ObjMaterialTest, WhatIsNotRenderedIsNamedOnce) {
   write("quad.obj", kTexturedQuad);
   write("quad.mtl", "newmtl checker\nd 0.5\nmap_Bump b.png\nbump b.png\nnewmtl plain\nd 0.3\n");

@@ -201,8 +201,10 @@ class GltfReader {
   void check_image_views(const nlohmann::json& doc) const;
   void check_required_extensions(const nlohmann::json& doc) const;
   void warn_used_extensions();
+  // `integers`: whether integer components may be read as they are (indices); otherwise an integer
+  // component must be normalized (texture coordinates).
   AccessorView accessor(int index, const std::string& where, std::initializer_list<int> types,
-                        std::initializer_list<int> component_types) const;
+                        std::initializer_list<int> component_types, bool integers = false) const;
   dmat4 local_transform(size_t node) const;
   void walk_nodes();
   void add_mesh(size_t mesh_index, const dmat4& world);
@@ -222,6 +224,8 @@ class GltfReader {
   std::map<int, uint32_t> materials_;     // glTF material (-1: the default) -> scene_.materials
   std::map<int, int> texcoord_sets_;      // glTF material -> the TEXCOORD_n its textures use
   std::map<int, int32_t> image_textures_;  // glTF image -> scene_.textures
+  std::map<std::string, int32_t> sources_;  // where a picture's bytes are ("view 3", "file /x/y.png") -> scene_.textures
+  uint64_t texels_ = 0;                     // in scene_.textures so far
   bool camera_found_ = false;
 };
 
@@ -238,6 +242,8 @@ void GltfReader::check_glb(std::string_view bytes) const {
     fail("", "the header gives a length of " + std::to_string(word(8)) + " bytes, the file has " + std::to_string(bytes.size()));
   const uint64_t json_length = word(12);
   if (word(16) != 0x4E4F534Au) fail("", "the first chunk is not JSON");
+  // Chunks are padded to 4 bytes (glTF 4.4.3); tinygltf looks for the binary chunk at the unpadded end.
+  if (json_length % 4 != 0) fail("", "the JSON chunk's length (" + std::to_string(json_length) + ") is not a multiple of 4");
   if (20 + json_length > word(8)) fail("", "the JSON chunk (" + std::to_string(json_length) + " bytes) runs past the file's end");
   const uint64_t bin_at = 20 + ((json_length + 3) & ~uint64_t(3));
   if (bin_at + 8 <= word(8)) {
@@ -251,9 +257,10 @@ void GltfReader::check_glb(std::string_view bytes) const {
 // which fuzz_gltf found as a heap overflow. So the views pictures use are checked here first,
 // against the buffers' declared byteLength, which tinygltf holds each buffer's data to exactly.
 void GltfReader::check_image_views(const nlohmann::json& doc) const {
-  const auto array = [&](const char* key) {
+  const auto array = [&](const char* key) -> const nlohmann::json& {
     static const nlohmann::json empty = nlohmann::json::array();
-    return doc.contains(key) && doc[key].is_array() ? doc[key] : empty;
+    const auto found = doc.find(key);
+    return found != doc.end() && found->is_array() ? *found : empty;
   };
   const auto whole = [](const nlohmann::json& object, const char* key, bool required, uint64_t& out) {
     if (!object.contains(key)) return !required;
@@ -262,6 +269,13 @@ void GltfReader::check_image_views(const nlohmann::json& doc) const {
     return true;
   };
   const nlohmann::json &images = array("images"), &views = array("bufferViews"), &buffers = array("buffers");
+  // A buffer of no bytes is invalid glTF (byteLength's minimum is 1), and tinygltf 2.7.0 indexes the
+  // first byte of a .glb's empty buffer: refused here.
+  for (size_t b = 0; b < buffers.size(); ++b) {
+    uint64_t length = 0;
+    if (!buffers[b].is_object() || !whole(buffers[b], "byteLength", true, length) || length == 0)
+      fail(element("buffers", b) + ".byteLength", "expected a whole number of bytes, at least 1");
+  }
   for (size_t i = 0; i < images.size(); ++i) {
     if (!images[i].is_object() || !images[i].contains("bufferView")) continue;
     const std::string where = element("images", i) + ".bufferView";
@@ -296,7 +310,7 @@ void GltfReader::warn_used_extensions() {
 }
 
 AccessorView GltfReader::accessor(int index, const std::string& where, std::initializer_list<int> types,
-                                  std::initializer_list<int> component_types) const {
+                                  std::initializer_list<int> component_types, bool integers) const {
   if (index < 0 || size_t(index) >= model_.accessors.size())
     fail(where, "accessors[" + std::to_string(index) + "] does not exist (the file has " + std::to_string(model_.accessors.size()) + ")");
   const tinygltf::Accessor& a = model_.accessors[size_t(index)];
@@ -306,10 +320,10 @@ AccessorView GltfReader::accessor(int index, const std::string& where, std::init
     for (const int t : types) expected += (expected.empty() ? "" : " or ") + std::string(type_name(t));
     fail(name, std::string("expected ") + expected + ", got " + type_name(a.type));
   }
-  if (std::find(component_types.begin(), component_types.end(), a.componentType) == component_types.end() ||
-      (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT &&
-       !a.normalized && types.size() != 1))
+  if (std::find(component_types.begin(), component_types.end(), a.componentType) == component_types.end())
     fail(name, "componentType " + std::to_string(a.componentType) + " is not one glTF allows here");
+  if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && !integers && !a.normalized)
+    fail(name, "integer components here must be normalized (KHR_mesh_quantization is not read)");
   if (a.sparse.isSparse) throw Skip{"sparse", name + ": sparse accessors are not read"};
   AccessorView view;
   view.count = a.count;
@@ -468,7 +482,7 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
       uvs = accessor(at->second, where + ".attributes." + uv_name, {TINYGLTF_TYPE_VEC2},
                      {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
     else
-      warn_once("no " + uv_name, where + ".attributes", "no " + uv_name + " for its material's texture: it shows the texture's top left texel");
+      warn_once("no " + uv_name, where + ".attributes", "no " + uv_name + " for its material's texture: every point takes the texture's value at (0, 0)");
   }
   for (const auto* a : {normals ? &*normals : nullptr, uvs ? &*uvs : nullptr})
     if (a && a->count != vertices)
@@ -478,7 +492,8 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
   std::optional<AccessorView> indices;
   if (p.indices >= 0)
     indices = accessor(p.indices, where + ".indices", {TINYGLTF_TYPE_SCALAR},
-                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
+                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
+                       true);
   const size_t corners = indices ? indices->count : vertices;
   const auto corner = [&](size_t i) -> uint32_t {
     if (!indices) return uint32_t(i);
@@ -499,12 +514,15 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
     throw LimitError(file_.string() + ": " + where + ": the file places more than " + std::to_string(limits_.max_triangles) +
                      " triangles; vkray renders at most that many");
 
-  // Positions and normals in world space: normals by the inverse transpose. A negative determinant
-  // mirrors the mesh, which turns its front faces' winding around (glTF 3.7.2.1).
+  // Positions and normals in world space: normals by the inverse transpose, here the cofactor matrix
+  // (the inverse transpose times the determinant: columns b x c, c x a, a x b) turned by the
+  // determinant's sign, which also serves a transform that flattens the mesh (a zero scale keeps the
+  // triangles in the remaining plane; those it collapses are left out as degenerate). A negative
+  // determinant mirrors the mesh, which turns its front faces' winding around (glTF 3.7.2.1).
   const glm::dmat3 linear(world);
   const double det = glm::determinant(linear);
-  if (!(det != 0.0) || !std::isfinite(det)) return;  // scaled to nothing (or past a double): not visible
-  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
+  const glm::dmat3 cofactor(glm::cross(linear[1], linear[2]), glm::cross(linear[2], linear[0]), glm::cross(linear[0], linear[1]));
+  const glm::dmat3 normal_matrix = det < 0 ? -cofactor : cofactor;
   const bool mirrored = det < 0;
   const auto position = [&](uint32_t v) {
     const dvec3 p_local(positions.get(v, 0), positions.get(v, 1), positions.get(v, 2));
@@ -640,10 +658,15 @@ int32_t GltfReader::image_texture(int image, const std::string& where) {
   if (size_t(image) >= model_.images.size())
     fail(where, "images[" + std::to_string(image) + "] does not exist (the file has " + std::to_string(model_.images.size()) + ")");
   const tinygltf::Image& img = model_.images[size_t(image)];
+  // Where its bytes are: a buffer view, a file (tinygltf keeps the URI of a file and reads none), or
+  // a data: URI that tinygltf decoded. The same view or file named by several images is decoded once.
+  const bool in_file = img.bufferView < 0 && img.image.empty();
+  const std::string source = img.bufferView >= 0 ? "view " + std::to_string(img.bufferView) : in_file ? "file " + img.uri : "";
+  if (const auto found = sources_.find(source); !source.empty() && found != sources_.end()) return image_textures_[image] = found->second;
   std::string name = file_.string() + ": " + element("images", size_t(image));
   std::string_view bytes(reinterpret_cast<const char*>(img.image.data()), img.image.size());
   InputFile external;
-  if (img.image.empty()) {  // a file beside the glTF file (tinygltf keeps its URI)
+  if (in_file) {
     if (img.uri.empty()) fail(element("images", size_t(image)), "no picture (neither a uri nor a bufferView with data)");
     const std::filesystem::path path = (file_.parent_path() / percent_decoded(img.uri)).lexically_normal();
     name += " (" + printable(img.uri, 200) + ")";
@@ -653,10 +676,19 @@ int32_t GltfReader::image_texture(int image, const std::string& where) {
     scene_.files.push_back(path);
     bytes = external.text;
   }
+  // Its size from its header, against what the scene's textures may take together, before decoding.
+  const PictureSize size = picture_size(bytes, name);
+  const uint64_t texels = uint64_t(size.width) * size.height;
+  if (texels > limits_.max_texels - std::min(limits_.max_texels, texels_))
+    throw LimitError(name + ": a " + std::to_string(size.width) + " x " + std::to_string(size.height) +
+                     " picture would bring the scene's textures past " + std::to_string(limits_.max_texels >> 20) +
+                     "M texels, vkray's limit (README, \"Limits\")");
+  texels_ += texels;
   auto texture = std::make_shared<const Texture>(make_texture(decode_picture(bytes, name), name, true));
   const auto index = int32_t(scene_.textures.size());
   scene_.textures.push_back(std::move(texture));
   image_textures_[image] = index;
+  if (!source.empty()) sources_[source] = index;
   return index;
 }
 
@@ -750,8 +782,16 @@ GltfScene GltfReader::read(std::string_view bytes) {
   const std::string base_dir = file_.parent_path().string();
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   const auto size = static_cast<unsigned int>(bytes.size());
-  const bool ok = binary ? loader.LoadBinaryFromMemory(&model_, &err, &warn, data, size, base_dir)
-                         : loader.LoadASCIIFromString(&model_, &err, &warn, bytes.data(), size, base_dir);
+  doc = nlohmann::json();  // its copy of the file is not needed while tinygltf makes its own
+  bool ok = false;
+  try {
+    ok = binary ? loader.LoadBinaryFromMemory(&model_, &err, &warn, data, size, base_dir)
+                : loader.LoadASCIIFromString(&model_, &err, &warn, bytes.data(), size, base_dir);
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {  // tinygltf's own slips (std::out_of_range from .at()): the file's fault
+    fail("", std::string("tinygltf could not read the file: ") + e.what());
+  }
   if (!ok) {
     std::string message = err.empty() ? "tinygltf could not read the file" : err;
     std::replace(message.begin(), message.end(), '\n', ' ');

@@ -33,6 +33,9 @@ struct GltfScene {
 struct GltfLimits {
   // The most triangles a file may place (instancing multiplies a mesh's): more throws LimitError.
   size_t max_triangles = kMaxScenePrimitives;
+  // The most texels its pictures may decode to together (each picture's size is read from its
+  // header first): more throws LimitError.
+  uint64_t max_texels = kMaxSceneTexels;
   // Whether buffers and pictures outside the file are read (the fuzz target reads none).
   bool read_files = true;
 };

@@ -25,6 +25,14 @@ struct Picture {
 bool is_png(std::string_view bytes);
 bool is_jpeg(std::string_view bytes);
 
+// The size a PNG or JPEG file's header gives, read without decoding any pixel and checked against
+// the limits above. Throws SceneError or LimitError as decode_picture does.
+struct PictureSize {
+  uint32_t width = 0;
+  uint32_t height = 0;
+};
+PictureSize picture_size(std::string_view bytes, const std::string& name);
+
 // Decodes a PNG (any bit depth and colour type; 16-bit samples are rounded to 8) or a JPEG (greyscale,
 // YCbCr or RGB; CMYK is refused). Greyscale becomes grey RGB; a missing alpha is 255. Throws SceneError
 // "<name>: <why>": an unknown format, a damaged file, a size past the limits above.

@@ -97,11 +97,12 @@ void compare_aovs(const Aovs& gpu, const Aovs& reference, const std::vector<uint
       const float ref_albedo = std::max({1.0f, reference.albedo[i].r, reference.albedo[i].g, reference.albedo[i].b});
       const bool depth_agrees = std::isinf(reference.depth[i]) ? std::isinf(gpu.depth[i]) && gpu.depth[i] > 0
                                                                : std::abs(double(gpu.depth[i]) - reference.depth[i]) <= length_tolerance;
-      // Albedo is judged as the image is, by 8-bit sRGB steps (and relatively past 1, where the
-      // encoding clips): a texture makes it a function of the texture coordinate, which each
+      // With textures, albedo is judged as the image is, by 8-bit sRGB steps (and relatively past 1,
+      // where the encoding clips): it is then a function of the texture coordinate, which each
       // renderer interpolates with its own rounding.
-      const bool albedo_differs = srgb_step_difference(gpu.albedo[i], reference.albedo[i]) > 1 ||
-                                  !close(gpu.albedo[i], reference.albedo[i], 1e-2 * ref_albedo);
+      const bool albedo_differs = tolerance.textured ? srgb_step_difference(gpu.albedo[i], reference.albedo[i]) > 1 ||
+                                                           !close(gpu.albedo[i], reference.albedo[i], 1e-2 * ref_albedo)
+                                                     : !close(gpu.albedo[i], reference.albedo[i], 1e-4 * ref_albedo);
       const bool differs[kAllAovs.size()] = {
           albedo_differs, !close(gpu.normal[i], reference.normal[i], 1e-3),
           !close(gpu.position[i], reference.position[i], length_tolerance), !depth_agrees, gpu.object[i] != reference.object[i]};

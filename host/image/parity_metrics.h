@@ -29,6 +29,9 @@ struct ParityTolerance {
   uint64_t max_interior_over_1 = 0;     // such pixels away from edges
   double max_share_over_1 = 0.005;      // stochastic: pixels differing by more than 1 step, of all
   double max_mean_relative = 0.002;     // stochastic: |mean GPU - mean CPU| / mean CPU, per channel
+  // The albedo pass is exact but for float rounding (10^-4 of the value), unless a texture makes it
+  // depend on the interpolated texture coordinate: then it is judged by 8-bit sRGB steps, as the image is.
+  bool textured = false;
 };
 
 struct ParityMetrics {

@@ -57,6 +57,8 @@ class ObjParser {
         ++lists_[kNormal].count;
       } else if (keyword == "vt") {
         numbers("texture coordinate", 1, 3);
+        for (const float c : coordinates_)  // the bound of world coordinates, which keeps interpolation finite
+          if (!(std::abs(c) <= 1e9f)) fail("texture coordinate " + std::to_string(c) + " is past +-1e9");
         // OBJ's v runs up from the bottom of the picture, glTF's (vkray's) down from its top.
         texcoords_.push_back({coordinates_[0], 1.0f - (coordinates_.size() > 1 ? coordinates_[1] : 0.0f)});
         ++lists_[kTexture].count;

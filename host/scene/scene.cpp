@@ -36,6 +36,28 @@ constexpr float kMaxFocalLength = 1e6f;
 // The largest index of refraction: past every real material (diamond is 2.4), so that a typo shows.
 constexpr float kMaxIor = 100.0f;
 
+// Moves each textured triangle's texture coordinates by a whole number of periods toward [0, 2)
+// along each axis its textures repeat (an even number, so that a mirrored repeat reads the same):
+// exact in float, and the texture reads the same, but both renderers then interpolate small
+// numbers, so that a floor tiled 5000 times is not sampled half a texel apart by float and double.
+void recentre_texture_coordinates(Scene& scene) {
+  for (Triangle& t : scene.triangles) {
+    const Material& m = scene.materials[t.material];
+    if (!m.textured()) continue;
+    const auto repeats = [&](bool s) {
+      for (const TextureRef* ref : {&m.albedo_texture, &m.emission_texture})
+        if (ref->present() && (s ? ref->wrap_s : ref->wrap_t) == TextureWrap::clamp_to_edge) return false;
+      return true;
+    };
+    for (int axis = 0; axis < 2; ++axis) {
+      if (!repeats(axis == 0)) continue;
+      const float lowest = std::min({t.uv[0][axis], t.uv[1][axis], t.uv[2][axis]});
+      const float shift = 2.0f * std::floor(lowest / 2.0f);
+      for (glm::vec2& uv : t.uv) uv[axis] -= shift;
+    }
+  }
+}
+
 
 // A JSON value together with its JSON-pointer path, so every message can say where it is.
 struct Value {
@@ -136,6 +158,12 @@ class SceneParser {
   glm::mat4 parse_transform(const Value& v);
   uint32_t material_ref(const Value& v) const;
   void parse_mesh(const Value& v, const glm::mat4& transform);
+  // The texels of the scene's textures so far.
+  uint64_t scene_texels() const {
+    uint64_t texels = 0;
+    for (const auto& t : scene_.textures) texels += uint64_t(t->width) * t->height;
+    return texels;
+  }
   // Adds a file the scene reads to Scene::referenced_files, once.
   void reference(const std::filesystem::path& file);
   // The index in Scene::textures of a texture file, read the first time it is named.
@@ -472,8 +500,13 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
   auto loaded = gltf_files_.find(file);
   if (loaded == gltf_files_.end()) {
     LoadedGltf entry;
+    GltfLimits limits;
+    limits.max_texels = kMaxSceneTexels - std::min(kMaxSceneTexels, scene_texels());
     try {
-      entry.gltf = load_gltf(file);
+      entry.gltf = load_gltf(file, limits);
+    } catch (const LimitError& e) {
+      if (!where) throw;
+      throw LimitError(file_.string() + ": " + where->path + ": " + e.what());
     } catch (const SceneError& e) {
       if (!where) throw;
       throw SceneError(file_.string() + ": " + where->path + ": " + e.what());
@@ -494,7 +527,7 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
     for (const auto& t : entry.gltf.textures) scene_.textures.push_back(t);
     loaded = gltf_files_.emplace(file, std::move(entry)).first;
   }
-  GltfScene gltf = loaded->second.gltf;  // its triangles and lights placed below
+  const GltfScene& gltf = loaded->second.gltf;
   const uint32_t material_offset = loaded->second.material_offset;
   const Value root{json(), ""};
   const Value& at = where ? *where : root;
@@ -503,7 +536,8 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
   const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(transform)));
   const bool mirrors = glm::determinant(glm::mat3(transform)) < 0.0f;
   const bool moved = transform != glm::mat4(1.0f);
-  for (Triangle& t : gltf.triangles) {
+  std::vector<Triangle> placed = gltf.triangles;
+  for (Triangle& t : placed) {
     t.material += material_offset;
     t.object = object_;
     if (!moved) continue;
@@ -519,18 +553,19 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
       std::swap(t.uv[1], t.uv[2]);
     }
   }
-  add_triangles(at, gltf.triangles);
+  add_triangles(at, placed);
   for (PointLight light : gltf.lights) {
     light.position = transform_point(transform, light.position);
     check_coordinates(at, light.position, "a light of the glTF file");
     scene_.lights.push_back(light);
   }
-  if (gltf.camera && moved) {
-    gltf.camera->position = transform_point(transform, gltf.camera->position);
-    gltf.camera->forward = glm::normalize(glm::mat3(transform) * gltf.camera->forward);
-    gltf.camera->up = glm::normalize(glm::mat3(transform) * gltf.camera->up);
+  std::optional<Camera> camera = gltf.camera;
+  if (camera && moved) {
+    camera->position = transform_point(transform, camera->position);
+    camera->forward = glm::normalize(glm::mat3(transform) * camera->forward);
+    camera->up = glm::normalize(glm::mat3(transform) * camera->up);
   }
-  return {gltf.camera, gltf.aspect_ratio};
+  return {camera, gltf.aspect_ratio};
 }
 
 void SceneParser::check_coordinates(const Value& where, const glm::vec3& p, const char* what) const {
@@ -581,9 +616,15 @@ int32_t SceneParser::texture_file(const Value& where, const std::filesystem::pat
   std::shared_ptr<const Texture> texture;
   try {
     texture = std::make_shared<const Texture>(load_texture(file, srgb));
+  } catch (const LimitError& e) {
+    throw LimitError(file_.string() + ": " + where.path + ": " + e.what());
   } catch (const SceneError& e) {
     throw SceneError(file_.string() + ": " + where.path + ": " + e.what());
   }
+  const uint64_t texels = uint64_t(texture->width) * texture->height;
+  if (texels > kMaxSceneTexels - std::min(kMaxSceneTexels, scene_texels()))
+    throw LimitError(file_.string() + ": " + where.path + ": " + file.string() + ": it brings the scene's textures past " +
+                     std::to_string(kMaxSceneTexels >> 20) + "M texels, vkray's limit (README, \"Limits\")");
   const auto index = int32_t(scene_.textures.size());
   scene_.textures.push_back(std::move(texture));
   texture_files_[key] = index;
@@ -693,7 +734,7 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
   if (mesh.corner_uvs.empty() &&
       std::any_of(triangles.begin(), triangles.end(), [&](const Triangle& t) { return scene_.materials[t.material].textured(); }))
     warn(file_value, file.filename().string() + ": a textured material on faces without texture coordinates (vt): "
-                                                "they show the texture's top left texel");
+                                                "every point takes the texture's value at (0, 0)");
   if (smooth) {
     if (!mesh.corner_normals.empty()) {
       // Normals transform by the inverse transpose.
@@ -805,6 +846,7 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& file,
   scene.name = file.stem().string();
   MeshCache this_scene;
   SceneParser(file, scene, meshes ? *meshes : this_scene).parse(root);
+  recentre_texture_coordinates(scene);
   return scene;
 }
 
@@ -846,6 +888,8 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
   SceneParser parser(file, scene, meshes ? *meshes : this_scene);
   const auto [camera, aspect] = parser.add_gltf(nullptr, file, glm::mat4(1.0f));
   scene.camera = camera ? *camera : framing_camera(scene);
+  if (!(glm::all(glm::lessThanEqual(glm::abs(scene.camera.position), glm::vec3(kMaxCoordinate)))))
+    throw LimitError(file.string() + ": the camera vkray frames the model with would stand past +-1e9 (README, \"Limits\")");
   if (!camera) scene.warnings.push_back(file.string() + ": no perspective camera: vkray frames the scene from the front");
   if (aspect > 0.0f)
     scene.image.width = uint32_t(std::clamp(std::lround(double(scene.image.height) * aspect), 1l, long(kMaxImageSide)));
@@ -863,6 +907,7 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
     scene.lights.push_back(PointLight{scene.camera.position, glm::vec3(glm::pi<float>() * distance * distance)});
     scene.warnings.push_back(file.string() + ": the file brings no light: vkray adds a point light at the camera");
   }
+  recentre_texture_coordinates(scene);
   return scene;
 }
 

@@ -14,6 +14,10 @@ namespace vkray {
 struct Picture;
 
 // The values are the shader's (VKRAY_WRAP_* and VKRAY_FILTER_* in shaders/shared/scene_layout.h).
+// All the textures of a scene together: 2^28 texels, 2 GiB as half-float RGBA. Checked from each
+// picture's header before it is decoded.
+constexpr uint64_t kMaxSceneTexels = uint64_t(1) << 28;
+
 enum class TextureWrap : uint32_t { repeat = 0, clamp_to_edge = 1, mirrored_repeat = 2 };
 enum class TextureFilter : uint32_t { linear = 0, nearest = 1 };
 

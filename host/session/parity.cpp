@@ -27,6 +27,7 @@ ParityTolerance parity_tolerance(const Scene& scene) {
   const bool glass = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.type == MaterialType::glass; });
   const bool emitters = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissive(); });
   tolerance.stochastic = scene.integrator.type == Integrator::Type::path || glass || emitters || scene.camera.aperture_radius > 0;
+  tolerance.textured = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.textured(); });
   return tolerance;
 }
 
