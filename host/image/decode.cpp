@@ -30,9 +30,18 @@ class PngReader {
   PngReader(std::string_view bytes, const std::string& name) {
     std::memset(&image, 0, sizeof image);
     image.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size()))
-      fail(name, std::string("not a readable PNG file: ") + image.message);
-    check_size(name, image.width, image.height);
+    // A constructor that throws runs no destructor: the struct is freed here on every failure.
+    if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size())) {
+      const std::string message = image.message;
+      png_image_free(&image);
+      fail(name, "not a readable PNG file: " + message);
+    }
+    try {
+      check_size(name, image.width, image.height);
+    } catch (...) {
+      png_image_free(&image);
+      throw;
+    }
   }
   ~PngReader() { png_image_free(&image); }
   PngReader(const PngReader&) = delete;
