@@ -529,7 +529,8 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
   }
   const GltfScene& gltf = loaded->second.gltf;
   const uint32_t material_offset = loaded->second.material_offset;
-  const Value root{json(), ""};
+  static const json kNothing;
+  const Value root{kNothing, ""};  // where messages point when the file is the scene itself
   const Value& at = where ? *where : root;
   // The object's transform on top of the file's own: normals by the inverse transpose, and the
   // winding turned around where it mirrors.
