@@ -24,5 +24,6 @@ Command add_check_command(CLI::App& app);
 Command add_watch_command(CLI::App& app);
 Command add_bench_command(CLI::App& app);
 Command add_devices_command(CLI::App& app);
+Command add_merge_command(CLI::App& app);
 
 }  // namespace vkray::cli

@@ -30,6 +30,26 @@ void add_scene_flags(CLI::App& command, SceneFlags& flags) {
                      "independent and can be averaged");
 }
 
+void add_region_flag(CLI::App& command, SceneFlags& flags) {
+  command
+      .add_option_function<std::string>(
+          "--region", [&flags](const std::string& text) { flags.region = parse_region(text); },
+          "Render only part of the image, as a part for `vkray merge` (.exr or .pfm): X0,Y0,X1,Y1 (pixel bounds in the "
+          "full image, half-open) or I/N (band I of N bands of whole rows of about equal work, from 0). Each pixel is "
+          "the same as in the full render")
+      ->option_text("X0,Y0,X1,Y1|I/N")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            try {
+              parse_region(text);
+              return "";
+            } catch (const UsageError& e) {
+              return e.what();
+            }
+          },
+          ""));
+}
+
 void add_device_flags(CLI::App& command, DeviceFlags& flags, bool validate) {
   command.add_option("--device", flags.device, "Vulkan device: index or part of its name (see `vkray devices`)");
   command.add_option("--shader-dir", flags.shader_dir, "Folder with trace.comp and its includes");
@@ -98,6 +118,7 @@ RenderOptions render_options(const SceneFlags* scene, const GpuFlags* gpu, const
     options.height = scene->height;
     options.samples_per_pixel = scene->spp;
     options.seed = scene->seed;
+    options.region = scene->region;
   }
   if (gpu) {
     options.tile_timeout = std::chrono::milliseconds(gpu->tile_timeout_ms);

@@ -13,10 +13,11 @@
 
 namespace vkray::cli {
 
-// SCENE [--width W] [--height H] [--spp N] [--seed S]
+// SCENE [--width W] [--height H] [--spp N] [--seed S] [--region X0,Y0,X1,Y1|I/N]
 struct SceneFlags {
   std::filesystem::path scene;  // empty: the default scene
   std::optional<uint32_t> width, height, spp, seed;
+  std::optional<RegionRequest> region;  // offered by add_region_flag
 };
 // [--device D] [--validate] [--shader-dir DIR]
 struct DeviceFlags {
@@ -35,6 +36,7 @@ struct CpuFlags {
 };
 
 void add_scene_flags(CLI::App& command, SceneFlags& flags);
+void add_region_flag(CLI::App& command, SceneFlags& flags);
 // `validate`: whether the command offers --validate (`vkray bench` measures without the layer).
 void add_device_flags(CLI::App& command, DeviceFlags& flags, bool validate = true);
 // `inline_scene`: whether the command offers --inline-scene (`vkray check` runs both paths).

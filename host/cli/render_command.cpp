@@ -13,6 +13,7 @@
 #include "image/exr.h"
 #include "image/image.h"
 #include "session/cpu_render.h"
+#include "session/parts.h"
 #include "session/session.h"
 
 namespace vkray::cli {
@@ -43,12 +44,13 @@ int run_render(const RenderArgs& args) {
   content.full_float = args.exr_float;
   if (!args.aovs.empty()) content.passes = parse_aov_list(args.aovs);
   check_render_image(output, content);
+  if (args.scene.region) check_part_file(output);
   RenderOptions options = render_options(&args.scene, &args.gpu, &args.cpu);
   options.aovs = !content.passes.empty();
   const ImageSettings image = image_settings(*loaded.scene, options);
 
   RenderResult result;
-  std::string phases;
+  std::string phases, device = kCpuReferenceDevice;
   if (args.renderer == "cpu") {
     log("renderer CPU reference, " + std::to_string(cpu_threads(options)) + " threads");
     log(describe(*loaded.scene, image));
@@ -61,10 +63,13 @@ int run_render(const RenderArgs& args) {
     // The BVH is built while the device opens and the shaders compile, which need one thread.
     BackgroundBvh bvh(loaded.scene);
     Session session(session_options(args.device));
-    log("device " + session.device_description() + (args.device.validate ? ", validation on" : ""));
+    device = session.device_description();
+    log("device " + device + (args.device.validate ? ", validation on" : ""));
     double compile_seconds = session.compile_shaders().seconds, upload_seconds = 0;
     {
       const Bvh built = bvh.get();
+      // A band's bounds come from a small render on the CPU, which takes the BVH built here.
+      if (options.region) options.region = resolve_region(*loaded.scene, image, *options.region, &built);
       const auto on_device = session.upload(loaded.scene, &built);
       upload_seconds = on_device.upload_seconds();
       // The scene's pipeline compiled now, so that the compile phase counts it (a small scene's own
@@ -86,7 +91,9 @@ int run_render(const RenderArgs& args) {
   }
 
   const auto start = Clock::now();
-  write_render_image(output, result.image, result.aovs ? &*result.aovs : nullptr, content);
+  if (is_part(result)) log("pixels " + to_string(result.region) + " of " + std::to_string(image.width) + " x " +
+                           std::to_string(image.height) + ": a part for `vkray merge`");
+  write_render(output, *loaded.scene, result, content, device);
   log(phases + " | write " + format_ms(ms_since(start)));
   log(std::to_string(result.stats.rays) + " rays (camera + shadow), " +
       format_rate(result.stats.rays, result.stats.trace_seconds) + "; total " + format_ms(ms_since(total_start)));
@@ -100,6 +107,7 @@ Command add_render_command(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* command = app.add_subcommand("render", "Render a scene to a PNG or PFM image.");
   add_scene_flags(*command, args->scene);
+  add_region_flag(*command, args->scene);
   command->add_option("-o,--output", args->output, "Output image, .png (8-bit sRGB), .pfm (float, linear) or .exr "
                                                    "(half float, linear); default: <scene name>.png in the current folder");
   command->add_option("--aov", args->aovs, "First-hit passes to add to an .exr as layers, comma-separated: albedo, normal, "

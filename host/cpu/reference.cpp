@@ -22,9 +22,14 @@ namespace vkray::cpu {
 ReferenceResult render_reference(const Scene& scene, const ImageSettings& settings, const ReferenceOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   ReferenceResult result;
-  result.image = Image(settings.width, settings.height);
-  result.signatures.assign(size_t(settings.width) * settings.height, 0);
-  if (options.aovs) result.aovs.emplace(settings.width, settings.height);
+  const PixelRegion region = options.region.empty() ? full_region(settings.width, settings.height) : options.region;
+  if (!region.within(settings.width, settings.height))
+    throw InternalError("a CPU render of pixels " + to_string(region) + " outside its image");
+  result.region = region;
+  result.image = Image(region.width(), region.height());
+  result.signatures.assign(region.pixels(), 0);
+  result.rays_per_row.assign(region.height(), 0);
+  if (options.aovs) result.aovs.emplace(region.width(), region.height());
 
   Bvh built;
   if (options.use_bvh && !options.bvh) {
@@ -49,8 +54,10 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
   uint32_t rows_done = 0;
   auto worker = [&] {
     uint64_t rays = 0;
-    for (uint32_t j; !cancelled && (j = next_row++) < settings.height;) {
-      for (uint32_t i = 0; i < settings.width; ++i) {
+    for (uint32_t row; !cancelled && (row = next_row++) < region.height();) {
+      const uint32_t j = region.y0 + row;
+      uint64_t row_rays = 0;
+      for (uint32_t i = region.x0; i < region.x1; ++i) {
         if (interrupt_requested()) {  // per pixel: a row of many samples can take seconds
           cancelled = true;
           break;
@@ -78,15 +85,18 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
           }
           sum += path ? path_radiance(tracer, lights, ray, state) : direct_radiance(tracer, lights, ray, state);
           signature = state.signature;
-          rays += 1 + state.rays;
+          row_rays += 1 + state.rays;
         }
-        result.image.pixels[index] = glm::vec3(sum / double(settings.samples_per_pixel));
-        result.signatures[index] = signature;
-        if (options.aovs) result.aovs->set(i, j, first_hits);
+        const size_t out = size_t(row) * region.width() + (i - region.x0);
+        result.image.pixels[out] = glm::vec3(sum / double(settings.samples_per_pixel));
+        result.signatures[out] = signature;
+        if (options.aovs) result.aovs->set(i - region.x0, row, first_hits);
       }
+      result.rays_per_row[row] = row_rays;
+      rays += row_rays;
       if (options.progress && !cancelled) {
         std::lock_guard lock(progress_mutex);
-        options.progress(++rows_done, settings.height);
+        options.progress(++rows_done, region.height());
       }
     }
     total_rays += rays;

@@ -12,6 +12,7 @@
 
 #include "image/aovs.h"
 #include "image/image.h"
+#include "image/region.h"
 #include "scene/scene.h"
 
 namespace vkray {
@@ -26,18 +27,23 @@ struct ReferenceOptions {
   const Bvh* bvh = nullptr;  // a BVH already built for this scene; null: build one
   bool shadows = true;   // false: no shadow rays, every light counts as visible (benchmarks)
   bool aovs = false;     // also the first-hit passes (image/aovs.h)
+  // Only these pixels of the image (empty: all of them); each pixel's samples are the same as in a
+  // render of the whole image.
+  PixelRegion region;
   std::function<void(uint32_t rows_done, uint32_t rows)> progress;  // called under a lock
   // On an interrupt request (base/interrupt.h) the threads stop and render_reference throws
   // Cancelled.
 };
 
 struct ReferenceResult {
-  Image image;
+  Image image;  // the region's pixels
+  PixelRegion region;  // the pixels rendered, in the image's coordinates
   std::optional<Aovs> aovs;  // when ReferenceOptions::aovs asked for them
   // Per pixel, a hash of what each sample saw (the primitive hit and the lights that lit it). Two
   // neighbouring pixels with different signatures straddle a silhouette or shadow edge.
   std::vector<uint64_t> signatures;
   uint64_t rays = 0;  // camera rays + shadow rays
+  std::vector<uint64_t> rays_per_row;  // the same for each row of the region, top first
   double seconds = 0;       // tracing, BVH build included
   double bvh_seconds = 0;   // building the BVH
 };

@@ -152,6 +152,9 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   TraceStats stats;
   const vk::raii::Device& device = ctx_->device();
   const ImageSettings& image = request.image;
+  const PixelRegion region = request.region.empty() ? full_region(image.width, image.height) : request.region;
+  if (!region.within(image.width, image.height))
+    throw InternalError("a render of pixels " + to_string(region) + " outside its image");
 
   // ---- per-frame data: uniforms, output, descriptors ----
   auto start = Clock::now();
@@ -165,10 +168,10 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   // The larger of the two outputs per pixel bounds a slot: the AOVs' when asked for.
   const uint64_t pixel_bytes = (aovs ? VKRAY_TEXELS_PER_AOV_PIXEL : 1) * sizeof(glm::vec4);
   const uint64_t slot_limit = ctx_->limits().maxStorageBufferRange / (kSlots * pixel_bytes);
-  const uint64_t image_pixels = uint64_t(image.width) * image.height;
+  const uint64_t image_pixels = region.pixels();
   const bool fixed_tiles = request.tile_side > 0;
   uint32_t side = request.tile_side;
-  const auto square_pixels = [&] { return uint64_t(std::min(side, image.width)) * std::min(side, image.height); };
+  const auto square_pixels = [&] { return uint64_t(std::min(side, region.width())) * std::min(side, region.height()); };
   while (fixed_tiles && side > kGranule && square_pixels() > slot_limit) side -= kGranule;
   // The least a slot must hold: the square asked for, or the smallest piece a submission may be.
   const uint64_t needed = fixed_tiles ? square_pixels() : std::min<uint64_t>(image_pixels, kGranule * kGranule);
@@ -178,8 +181,8 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   const uint64_t slot_pixels =
       fixed_tiles ? needed : std::min({kMostSlotPixels, slot_limit, std::max<uint64_t>(image_pixels, kGranule * kGranule)});
   const vk::DeviceSize output_bytes = kSlots * slot_pixels * sizeof(glm::vec4);
-  Image result(image.width, image.height);  // the host's copy, filled tile by tile
-  if (aovs) *aovs_out = Aovs(image.width, image.height);
+  Image result(region.width(), region.height());  // the host's copy, filled tile by tile
+  if (aovs) *aovs_out = Aovs(region.width(), region.height());
   auto frame = std::make_unique<Frame>();
   frame->trace_pipeline = std::move(trace_pipeline);
   frame->scene = std::move(scene);
@@ -208,7 +211,7 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   abandoned_.reserve(abandoned_.size() + 1);  // nor keeping the frame when the device still runs it
   const vk::PipelineLayout layout = *frame->trace_pipeline->layout();
   uint32_t samples_per_dispatch = samples_in_one_dispatch(frame->scene->scene());
-  TileCursor cursor(image.width, image.height, kGranule);
+  TileCursor cursor(region.width(), region.height(), kGranule);  // in the region's coordinates
   // The first submission is the size the cost model gives; the sizer takes over from the second's
   // time on.
   const uint64_t first = first_submission_pixels(frame->scene->scene(), image);
@@ -238,7 +241,11 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   // Submits the next tile, or `again` (one whose loops were cut short).
   const auto submit = [&](std::optional<TileRect> again = std::nullopt) {
     const uint32_t index = submitted++;
-    const TileRect rect = again ? *again : fixed_tiles ? cursor.next_square(side) : cursor.next(sizer.next());
+    TileRect rect = again ? *again : fixed_tiles ? cursor.next_square(side) : cursor.next(sizer.next());
+    if (!again) {  // to the image's coordinates, which the shader's sample pattern takes
+      rect.x0 += region.x0;
+      rect.y0 += region.y0;
+    }
     slots[index % kSlots] = {rect, Clock::now()};
     TileConstants tile = tile_constants(index);
     const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
@@ -296,7 +303,7 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
     for (uint32_t y = 0; y < tile.height; ++y)
       for (uint32_t x = 0; x < tile.width; ++x) {
         const glm::vec4& texel = texels[size_t(y) * tile.width + x];
-        result.at(tile.x0 + x, tile.y0 + y) = glm::vec3(texel);
+        result.at(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y) = glm::vec3(texel);
         stats.rays += std::bit_cast<uint32_t>(texel.w);
       }
     if (aovs) {
@@ -312,7 +319,7 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
           sums.object = std::bit_cast<int32_t>(t[1].w);
           sums.position = glm::vec3(t[2]);
           sums.depth = t[2].w;
-          aovs_out->set(tile.x0 + x, tile.y0 + y, sums);
+          aovs_out->set(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y, sums);
         }
     }
     pixels_done += done.rect.pixels();

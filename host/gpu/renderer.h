@@ -15,12 +15,15 @@
 #include "gpu/pipeline.h"
 #include "image/aovs.h"
 #include "image/image.h"
+#include "image/region.h"
 #include "scene/scene.h"
 
 namespace vkray::gpu {
 
 struct TraceRequest {
   ImageSettings image;  // the resolution and sample count rendered
+  // Only these pixels (empty: the whole image), each the same as in a render of the whole image.
+  PixelRegion region;
   ShaderVariant variant;
   // Longest one tile may run before the render fails with TimeoutError.
   std::chrono::milliseconds tile_timeout{60000};
@@ -47,8 +50,8 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Renders `scene` with `pipeline`'s variant for the request; with request.variant.aovs, also the
-  // first-hit passes, into `aovs`. Throws TimeoutError when a tile
+  // Renders `scene` with `pipeline`'s variant for the request (the region's pixels); with
+  // request.variant.aovs, also the first-hit passes, into `aovs`. Throws TimeoutError when a tile
   // outlives request.tile_timeout (its work may go on: what it uses is kept until it finishes, and
   // the next render first waits up to its own tile timeout for it), Cancelled on an interrupt
   // request (a tile still running is kept the same way), and DeviceError or vk::SystemError for

@@ -79,13 +79,25 @@ std::pair<char*, size_t> pass_values(Aovs& aovs, Aov pass, int c) {
 
 }  // namespace
 
-void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content) {
+void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content,
+               const ExrWindow* window) {
   if (!content.passes.empty() && (!aovs || aovs->width != image.width || aovs->height != image.height))
     throw InternalError(file.string() + ": first-hit passes asked for without passes of the image's size");
   if (image.width == 0 || image.height == 0) throw OutputError(file.string() + ": an EXR image cannot be empty");
-  Imf::Header header(int(image.width), int(image.height));
+  const PixelRegion region = window ? window->region : full_region(image.width, image.height);
+  if (window && (region.width() != image.width || region.height() != image.height || !region.within(window->full_width, window->full_height)))
+    throw InternalError(file.string() + ": a part's pixels do not fit its region");
+  const auto box = [](const PixelRegion& r) {
+    return Imath::Box2i(Imath::V2i(int(r.x0), int(r.y0)), Imath::V2i(int(r.x1) - 1, int(r.y1) - 1));
+  };
+  Imf::Header header(window ? box(full_region(window->full_width, window->full_height)) : box(region), box(region));
   header.compression() = Imf::ZIP_COMPRESSION;
   header.insert("software", Imf::StringAttribute("vkray"));
+  if (window && !window->part_record.empty()) header.insert("vkray.part", Imf::StringAttribute(window->part_record));
+  // Slices are addressed as if the buffer started at the display window's origin.
+  const auto at_origin = [&](char* base, size_t stride) {
+    return base - (int64_t(region.x0) + int64_t(region.y0) * int64_t(image.width)) * int64_t(stride);
+  };
   // Each channel in a plane of its own, of the type it has in the file (OpenEXR converts types when
   // it reads, not when it writes).
   const size_t pixels = image.pixels.size();
@@ -99,12 +111,14 @@ void write_exr(const std::filesystem::path& file, const Image& image, const Aovs
       std::vector<float>& plane = floats.emplace_back(pixels);
       for (size_t i = 0; i < pixels; ++i) plane[i] = value(i);
       header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-      frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(plane.data()), sizeof(float), sizeof(float) * image.width));
+      frame.insert(name, Imf::Slice(Imf::FLOAT, at_origin(reinterpret_cast<char*>(plane.data()), sizeof(float)), sizeof(float),
+                                    sizeof(float) * image.width));
     } else {
       std::vector<Imath::half>& plane = halves.emplace_back(pixels);
       for (size_t i = 0; i < pixels; ++i) plane[i] = Imath::half(value(i));
       header.channels().insert(name, Imf::Channel(Imf::HALF));
-      frame.insert(name, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(plane.data()), sizeof(Imath::half), sizeof(Imath::half) * image.width));
+      frame.insert(name, Imf::Slice(Imf::HALF, at_origin(reinterpret_cast<char*>(plane.data()), sizeof(Imath::half)),
+                                    sizeof(Imath::half), sizeof(Imath::half) * image.width));
     }
   };
   for (int c = 0; c < 3; ++c) add(std::string(1, "RGB"[c]), content.full_float, [&](size_t i) { return image.pixels[i][c]; });
@@ -177,6 +191,15 @@ ExrFile read_exr(const std::filesystem::path& file) {
     if (w <= 0 || h <= 0 || w > 65536 || h > 65536)
       throw InputError(file.string() + ": an EXR data window of " + std::to_string(w) + " x " + std::to_string(h) +
                        " pixels (vkray reads up to 65536 on a side)");
+    const Imath::Box2i display = exr.header().displayWindow();
+    if (display.min.x == 0 && display.min.y == 0 && window.min.x >= 0 && window.min.y >= 0 && display.max.x < 65536 &&
+        display.max.y < 65536) {
+      result.window.full_width = uint32_t(display.max.x + 1);
+      result.window.full_height = uint32_t(display.max.y + 1);
+      result.window.region = {uint32_t(window.min.x), uint32_t(window.min.y), uint32_t(window.max.x + 1), uint32_t(window.max.y + 1)};
+    }
+    if (const auto* record = exr.header().findTypedAttribute<Imf::StringAttribute>("vkray.part"))
+      result.window.part_record = record->value();
     const Imf::ChannelList& channels = exr.header().channels();
     for (const char* name : {"R", "G", "B"})
       if (!channels.findChannel(name)) throw InputError(file.string() + ": no channel " + name);

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "image/aovs.h"
 #include "image/image.h"
+#include "image/region.h"
 
 namespace vkray {
 
@@ -19,10 +21,20 @@ struct ExrContent {
   std::vector<Aov> passes;  // the layers written after R, G, B, in this order
 };
 
+// Where an image lies in a larger one, for a part of a render (image/part.h): the pixels are `region`
+// (the EXR data window) of a full_width x full_height display window, and `part_record` is the
+// string attribute "vkray.part".
+struct ExrWindow {
+  uint32_t full_width = 0, full_height = 0;
+  PixelRegion region;
+  std::string part_record;
+};
+
 // Writes `image` and the `content.passes` of `aovs` (which must then be given, of the same size),
-// ZIP-compressed scan lines, top row first. Like write_image, under a temporary name renamed into
-// place. Throws OutputError.
-void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content);
+// ZIP-compressed scan lines, top row first; with `window`, as that part of a larger image. Like
+// write_image, under a temporary name renamed into place. Throws OutputError.
+void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content,
+               const ExrWindow* window = nullptr);
 
 // What a face calls to write a render: write_exr for a ".exr" file, write_image otherwise. Throws
 // UsageError when passes or 32-bit floats are asked of another type, OutputError.
@@ -34,9 +46,12 @@ bool is_exr(const std::filesystem::path& file);
 void check_render_image(const std::filesystem::path& file, const ExrContent& content);
 
 struct ExrFile {
-  Image image;
+  Image image;  // the data window's pixels
   Aovs aovs;  // the passes the file has; the others keep Aovs' defaults
   ExrContent content;  // full_float: whether R is 32-bit
+  // The display window's size and the data window within it (when both lie in the first quadrant;
+  // zero otherwise), and the "vkray.part" attribute, as written.
+  ExrWindow window;
 };
 
 // Reads a file written by write_exr (or any scan-line or tiled EXR with R, G, B). Throws InputError

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <memory>
 #include <string>
@@ -249,15 +250,24 @@ void write_image(const Image& image, const std::filesystem::path& file) {
 }
 
 Image read_pfm(const std::filesystem::path& file) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(file, error)) throw InputError(file.string() + ": not found, or not a regular file");
+  const uintmax_t file_bytes = std::filesystem::file_size(file, error);
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open");
+  if (!in || error) throw InputError(file.string() + ": cannot open");
   std::string magic;
   uint32_t width = 0, height = 0;
   float scale = 0.0f;
-  in >> magic >> width >> height >> scale;
+  in >> std::setw(2) >> magic >> width >> height >> scale;
   in.get();  // the single whitespace byte after the header
   if (!in || magic != "PF" || scale >= 0.0f || width == 0 || height == 0)
     throw InputError(file.string() + ": not a little-endian RGB PFM file");
+  // The header's size must be the file's, before anything that large is allocated.
+  const uint64_t data_bytes = uint64_t(width) * height * sizeof(glm::vec3);
+  const std::streamoff header_bytes = in.tellg();
+  if (width > 65536 || height > 65536 || header_bytes < 0 || file_bytes != uint64_t(header_bytes) + data_bytes)
+    throw InputError(file.string() + ": a PFM header of " + std::to_string(width) + " x " + std::to_string(height) +
+                     " pixels in a file of " + std::to_string(file_bytes) + " bytes");
   Image image(width, height);
   for (uint32_t row = height; row-- > 0;)
     in.read(reinterpret_cast<char*>(&image.at(0, row)), std::streamsize(sizeof(glm::vec3) * width));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <thread>
 
+#include "bvh/bvh.h"
 #include "cpu/reference.h"
 
 namespace vkray {
@@ -20,8 +21,17 @@ RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, con
   reference_options.aovs = options.aovs;
   if (options.progress)
     reference_options.progress = [&options](uint32_t done, uint32_t total) { options.progress("rows", done, total); };
-  cpu::ReferenceResult reference = cpu::render_reference(scene, image_settings(scene, options), reference_options);
+  const ImageSettings settings = image_settings(scene, options);
+  Bvh built;  // one BVH for a band's probe and the render
+  if (options.region && std::holds_alternative<Band>(*options.region) && !bvh) {
+    built = build_bvh(primitive_boxes(scene), reference_options.threads);
+    reference_options.bvh = bvh = &built;
+  }
+  if (options.region) reference_options.region = resolve_region(scene, settings, *options.region, bvh);
+  cpu::ReferenceResult reference = cpu::render_reference(scene, settings, reference_options);
   RenderResult result;
+  result.settings = settings;
+  result.region = reference.region;
   result.image = std::move(reference.image);
   result.aovs = std::move(reference.aovs);
   result.stats.trace_seconds = reference.seconds;

@@ -12,6 +12,7 @@
 #include "image/aovs.h"
 #include "image/image.h"
 #include "scene/scene.h"
+#include "session/regions.h"
 
 namespace vkray {
 
@@ -36,6 +37,10 @@ struct RenderOptions {
   bool shadows = true;
   // Also the first-hit passes (image/aovs.h): RenderResult::aovs.
   bool aovs = false;
+  // Only these pixels (session/regions.h), each as in a render of the whole image; the result holds
+  // just them. A band is computed at the render (a caller that has the scene's BVH may resolve it
+  // first with resolve_region).
+  std::optional<RegionRequest> region;
   // GPU: how a small scene is traced; the longest one submission (a tile) may run; square tiles of
   // this side in pixels (0: submissions sized by the time they take, gpu/tiling.h).
   InlineScene inline_scene = InlineScene::automatic;
@@ -64,8 +69,10 @@ struct RenderStats {
 };
 
 struct RenderResult {
-  Image image;  // linear radiance, top row first
+  Image image;  // linear radiance, top row first: the region's pixels
   std::optional<Aovs> aovs;  // when RenderOptions::aovs asked for them
+  ImageSettings settings;    // the full image's, overrides applied
+  PixelRegion region;        // the pixels rendered, in the full image's coordinates
   RenderStats stats;
 };
 

@@ -142,6 +142,8 @@ DeviceScene Session::upload_changes(const DeviceScene& previous, std::shared_ptr
 
 namespace {
 
+// By the whole image's camera rays, never a region's: the parts of a render must trace the same code
+// as the whole render, or they would not assemble into it bit for bit.
 bool use_inline_scene(const gpu::GpuScene& scene, const ImageSettings& image, InlineScene policy) {
   if (policy == InlineScene::never || scene.inline_scene().empty()) return false;
   if (policy == InlineScene::always) return true;
@@ -187,6 +189,8 @@ double Session::prepare(const DeviceScene& scene, const RenderOptions& options) 
 RenderResult Session::render(const DeviceScene& scene, const RenderOptions& options) {
   gpu::TraceRequest request;
   request.image = image_settings(scene.scene(), options);
+  request.region = options.region ? resolve_region(scene.scene(), request.image, *options.region)
+                                  : full_region(request.image.width, request.image.height);
   request.variant = shader_variant(own(scene), options);
   request.tile_timeout = options.tile_timeout;
   request.tile_side = options.tile_side;
@@ -200,6 +204,8 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
     return renderer_->render(shaders_->pipeline, scene.scene_, request, &trace, result.aovs ? &*result.aovs : nullptr);
   });
   check_validation("render");
+  result.settings = request.image;
+  result.region = request.region;
   result.stats.upload_seconds = trace.upload_seconds;
   result.stats.trace_seconds = trace.trace_seconds;
   result.stats.readback_seconds = trace.readback_seconds;

@@ -1,0 +1,138 @@
+#include "image/merge.h"
+
+#include <algorithm>
+#include <set>
+#include <string>
+
+#include "base/errors.h"
+
+namespace vkray {
+namespace {
+
+std::string size_text(uint32_t width, uint32_t height) { return std::to_string(width) + " x " + std::to_string(height); }
+
+std::string pass_names(const ExrContent& content) {
+  std::string names;
+  for (const Aov pass : content.passes) {
+    if (!names.empty()) names += ',';
+    names += aov_name(pass);
+  }
+  return names.empty() ? "none" : names;
+}
+
+// Why `part` cannot join a render whose first part is `first`; empty when it can.
+std::string mismatch(const Part& first, const Part& part) {
+  const PartRecord &a = first.record, &b = part.record;
+  const auto differ = [](const char* what, const std::string& x, const std::string& y) {
+    return std::string(what) + " " + y + ", not " + x;
+  };
+  if (a.scene_digest != b.scene_digest) return differ("is of another scene: digest", a.scene_digest, b.scene_digest);
+  if (a.width != b.width || a.height != b.height)
+    return differ("is of an image of", size_text(a.width, a.height), size_text(b.width, b.height));
+  if (a.samples_per_pixel != b.samples_per_pixel)
+    return differ("has samples per pixel", std::to_string(a.samples_per_pixel), std::to_string(b.samples_per_pixel));
+  if (a.seed != b.seed) return differ("has seed", std::to_string(a.seed), std::to_string(b.seed));
+  if (a.version != b.version) return differ("was rendered by vkray", a.version, b.version);
+  if (first.content.passes != part.content.passes)
+    return differ("has first-hit passes", pass_names(first.content), pass_names(part.content));
+  if (first.exr != part.exr || first.content.full_float != part.content.full_float) {
+    const auto kind = [](const Part& p) { return std::string(!p.exr ? "PFM" : p.content.full_float ? "32-bit EXR" : "half-float EXR"); };
+    return differ("is a", kind(first), kind(part));
+  }
+  return "";
+}
+
+// Copies a part's pixels (and passes) into the whole image at its region.
+void place(const Part& part, MergedImage& merged) {
+  const PixelRegion& r = part.record.region;
+  const uint32_t w = merged.image.width;
+  for (uint32_t y = 0; y < r.height(); ++y) {
+    const size_t from = size_t(y) * r.width(), to = size_t(r.y0 + y) * w + r.x0;
+    std::copy_n(part.image.pixels.begin() + from, r.width(), merged.image.pixels.begin() + to);
+    if (!merged.aovs) continue;
+    const Aovs& a = *part.aovs;
+    Aovs& m = *merged.aovs;
+    std::copy_n(a.albedo.begin() + from, r.width(), m.albedo.begin() + to);
+    std::copy_n(a.normal.begin() + from, r.width(), m.normal.begin() + to);
+    std::copy_n(a.position.begin() + from, r.width(), m.position.begin() + to);
+    std::copy_n(a.depth.begin() + from, r.width(), m.depth.begin() + to);
+    std::copy_n(a.object.begin() + from, r.width(), m.object.begin() + to);
+  }
+}
+
+// Refuses overlaps and gaps. Coverage changes only at rows where a part starts or ends, so those
+// rows are the only ones checked: at each, the parts across it, left to right, must abut.
+void check_tiling(const std::vector<Part>& parts, uint32_t width, uint32_t height) {
+  std::set<uint32_t> rows{0};
+  for (const Part& p : parts) rows.insert({p.record.region.y0, p.record.region.y1});
+  std::vector<const Part*> across;
+  for (const uint32_t y : rows) {
+    if (y >= height) break;
+    across.clear();
+    for (const Part& p : parts)
+      if (p.record.region.y0 <= y && y < p.record.region.y1) across.push_back(&p);
+    std::sort(across.begin(), across.end(), [](const Part* a, const Part* b) { return a->record.region.x0 < b->record.region.x0; });
+    uint32_t x = 0;  // columns left of x are covered on row y
+    for (size_t i = 0; i < across.size(); ++i) {
+      const PixelRegion& r = across[i]->record.region;
+      if (r.x0 < x) {
+        const PixelRegion& q = across[i - 1]->record.region;
+        const PixelRegion overlap{std::max(r.x0, q.x0), std::max(r.y0, q.y0), std::min(r.x1, q.x1), std::min(r.y1, q.y1)};
+        throw InputError(across[i]->file.string() + ": its region " + to_string(r) + " overlaps region " + to_string(q) +
+                         " of " + across[i - 1]->file.string() + " (pixels " + to_string(overlap) + ")");
+      }
+      if (r.x0 > x) break;
+      x = r.x1;
+    }
+    if (x < width) {
+      uint32_t end = width;  // the gap runs to the next part on the row, or the edge
+      for (const Part* p : across)
+        if (p->record.region.x0 > x) end = std::min(end, p->record.region.x0);
+      throw InputError("no part covers pixels " + std::to_string(x) + " to " + std::to_string(end - 1) + " of row " +
+                       std::to_string(y) + " of the " + size_text(width, height) + " image");
+    }
+  }
+}
+
+}  // namespace
+
+MergedImage merge_parts(const std::vector<Part>& parts) {
+  if (parts.empty()) throw InputError("no parts to merge");
+  const Part& first = parts.front();
+  for (const Part& part : parts) {
+    const std::string why = mismatch(first, part);
+    if (!why.empty()) throw InputError(part.file.string() + ": " + why + " as " + first.file.string() + " is");
+  }
+  MergedImage merged;
+  merged.record = first.record;
+  merged.record.region = full_region(first.record.width, first.record.height);
+  merged.content = first.content;
+  for (const Part& part : parts)
+    merged.mixed_devices |= part.record.device != first.record.device;
+  check_tiling(parts, first.record.width, first.record.height);
+  merged.image = Image(first.record.width, first.record.height);
+  if (!first.content.passes.empty()) merged.aovs.emplace(first.record.width, first.record.height);
+  for (const Part& part : parts) place(part, merged);
+  return merged;
+}
+
+MergeSummary merge_part_files(const std::filesystem::path& output, const std::vector<std::filesystem::path>& files) {
+  if (!is_supported_image_path(output)) throw OutputError(output.string() + ": unknown image type (expected .png, .pfm or .exr)");
+  std::vector<Part> parts;
+  parts.reserve(files.size());
+  for (const auto& file : files) parts.push_back(read_part(file));
+  const MergedImage merged = merge_parts(parts);
+  MergeSummary summary;
+  summary.parts = parts.size();
+  summary.record = merged.record;
+  summary.mixed_devices = merged.mixed_devices;
+  if (is_exr(output)) {
+    write_exr(output, merged.image, merged.aovs ? &*merged.aovs : nullptr, merged.content);
+  } else {
+    summary.passes_dropped = !merged.content.passes.empty();
+    write_image(merged.image, output);
+  }
+  return summary;
+}
+
+}  // namespace vkray

@@ -1,0 +1,35 @@
+#include "session/parts.h"
+
+#include "base/errors.h"
+#include "scene/digest.h"
+#include "session/version.h"
+
+namespace vkray {
+
+PartRecord part_record(const Scene& scene, const RenderResult& result, const std::string& device) {
+  PartRecord record;
+  record.scene_digest = scene_digest(scene);
+  record.width = result.settings.width;
+  record.height = result.settings.height;
+  record.region = result.region;
+  record.samples_per_pixel = result.settings.samples_per_pixel;
+  record.seed = result.settings.seed;
+  record.version = version_string();
+  record.device = device;
+  return record;
+}
+
+void check_part_file(const std::filesystem::path& file) {
+  if (!is_exr(file) && file.extension() != ".pfm")
+    throw UsageError(file.string() + ": a region of a render is written as a part for `vkray merge`: name the output "
+                                     "*.exr or *.pfm");
+}
+
+void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const ExrContent& content,
+                  const std::string& device) {
+  const Aovs* aovs = result.aovs ? &*result.aovs : nullptr;
+  if (!is_part(result)) return write_render_image(file, result.image, aovs, content);
+  write_part(file, result.image, aovs, content, part_record(scene, result, device));
+}
+
+}  // namespace vkray

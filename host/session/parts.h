@@ -1,0 +1,36 @@
+// A render written to its file, whichever face asked for it: the whole image as it is, a region
+// (RenderOptions::region) as a part of the whole (image/part.h) that records what it was rendered
+// from, for `vkray merge`.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "image/exr.h"
+#include "image/part.h"
+#include "scene/scene.h"
+#include "session/options.h"
+
+namespace vkray {
+
+// The device a part rendered by the CPU reference records.
+constexpr const char* kCpuReferenceDevice = "CPU reference";
+
+// Throws the UsageError write_render would for a part, before any work is done.
+void check_part_file(const std::filesystem::path& file);
+
+// What `result`, a render of `scene`, was rendered from. `device`: Session::device_description(), or
+// kCpuReferenceDevice.
+PartRecord part_record(const Scene& scene, const RenderResult& result, const std::string& device);
+
+// Writes `result` to `file` (.png, .pfm or .exr; `content`: the passes and precision of an .exr); a
+// region of the image as a part (write_part: .exr or .pfm, else UsageError). Throws OutputError.
+void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const ExrContent& content,
+                  const std::string& device);
+
+// Whether a render of `result`'s region is a part of a larger image.
+inline bool is_part(const RenderResult& result) {
+  return !result.region.covers(result.settings.width, result.settings.height);
+}
+
+}  // namespace vkray

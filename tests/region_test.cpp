@@ -1,0 +1,305 @@
+// Regions of a render, parts and their merge, on the host: --region's forms, bands of equal work,
+// the CPU reference's regions against its whole image, the scene digest, and `vkray merge`'s rules.
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "base/errors.h"
+#include "image/merge.h"
+#include "image/part.h"
+#include "scene/digest.h"
+#include "session/cpu_render.h"
+#include "session/regions.h"
+#include "support/error_of.h"
+#include "support/temp_dir.h"
+
+namespace vkray::test {
+namespace {
+
+const std::filesystem::path kScenes = VKRAY_SCENE_DIR;
+
+// A floor plane low in the view and a sphere, the sky above: the top rows cost a camera ray each,
+// the bottom ones shadow rays and more.
+const char* const kSkyAndGround = R"({
+  "image": {"width": 48, "height": 64, "samples_per_pixel": 2},
+  "camera": {"position": [0, 1, -6], "look_at": [0, 1, 0], "focal_length": 1.2},
+  "background": [0.2, 0.3, 0.5],
+  "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}, "red": {"albedo": [0.8, 0.2, 0.2]}},
+  "lights": [{"type": "point", "position": [0, 5, -2], "power": [400, 400, 400]},
+             {"type": "point", "position": [3, 4, -3], "power": [200, 200, 200]}],
+  "objects": [
+    {"type": "triangles", "positions": [[-50, 0, -50], [50, 0, -50], [0, 0, 50]], "indices": [[0, 2, 1]], "material": "white"},
+    {"type": "sphere", "center": [0, 0.8, 0], "radius": 0.8, "material": "red"}]})";
+
+Scene sky_and_ground(const std::filesystem::path& file = "sky.json") { return parse_scene(kSkyAndGround, file); }
+
+bool same_bits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
+}
+
+std::vector<glm::vec3> crop(const Image& image, const PixelRegion& r) {
+  std::vector<glm::vec3> out;
+  for (uint32_t y = r.y0; y < r.y1; ++y)
+    for (uint32_t x = r.x0; x < r.x1; ++x) out.push_back(image.at(x, y));
+  return out;
+}
+
+// ---- --region's two forms --------------------------------------------------------------------
+
+TEST(RegionTest, ParsesPixelBoundsAndBands) {
+  EXPECT_EQ(std::get<PixelRegion>(parse_region("0,8,64,16")), (PixelRegion{0, 8, 64, 16}));
+  EXPECT_EQ(std::get<Band>(parse_region("2/4")), (Band{2, 4}));
+  EXPECT_EQ(std::get<Band>(parse_region("0/1")), (Band{0, 1}));
+}
+
+TEST(RegionTest, RefusesEverythingElseSayingWhatWasExpected) {
+  for (const char* text : {"", "1,2,3", "1,2,3,4,5", "a,b,c,d", "-1,0,4,4", "0x1,0,4,4", "1/", "/4", "1/2/3", "1.5/4",
+                           " 1,2,3,4", "99999999999,0,1,1", "0,0,4,4 "})
+    EXPECT_NE(error_of([&] { parse_region(text); }).find("expected X0,Y0,X1,Y1"), std::string::npos) << text;
+  EXPECT_NE(error_of([] { parse_region("4/4"); }).find("0 <= I < N"), std::string::npos);
+  EXPECT_NE(error_of([] { parse_region("0/0"); }).find("0 <= I < N"), std::string::npos);
+  EXPECT_NE(error_of([] { parse_region("4,0,4,8"); }).find("an empty rectangle"), std::string::npos);
+  EXPECT_NE(error_of([] { parse_region("0,9,4,8"); }).find("an empty rectangle"), std::string::npos);
+}
+
+TEST(RegionTest, ARectangleMustLieWithinTheImage) {
+  const Scene scene = sky_and_ground();
+  const ImageSettings image{48, 64, 1, 0};
+  EXPECT_EQ(resolve_region(scene, image, PixelRegion{0, 0, 48, 64}), (PixelRegion{0, 0, 48, 64}));
+  EXPECT_NE(error_of([&] { resolve_region(scene, image, PixelRegion{0, 0, 49, 64}); }).find("within the 48 x 64 image"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { resolve_region(scene, image, PixelRegion{0, 60, 8, 65}); }).find("within"), std::string::npos);
+}
+
+// ---- bands of equal work ---------------------------------------------------------------------
+
+TEST(RegionTest, BandsTileTheImageTopToBottomWithAtLeastOneRowEach) {
+  const Scene scene = sky_and_ground();
+  for (const uint32_t count : {1u, 2u, 3u, 7u, 63u, 64u}) {
+    const std::vector<PixelRegion> bands = work_bands(scene, {48, 64, 4, 0}, count);
+    ASSERT_EQ(bands.size(), count);
+    uint32_t y = 0;
+    for (const PixelRegion& b : bands) {
+      EXPECT_EQ(b.x0, 0u);
+      EXPECT_EQ(b.x1, 48u);
+      EXPECT_EQ(b.y0, y) << count;
+      EXPECT_GT(b.y1, b.y0) << count;
+      y = b.y1;
+    }
+    EXPECT_EQ(y, 64u) << count;
+  }
+  EXPECT_NE(error_of([&] { work_bands(scene, {48, 64, 1, 0}, 65); }).find("1 to 64"), std::string::npos);
+  EXPECT_NE(error_of([&] { work_bands(scene, {48, 64, 1, 0}, 0); }).find("1 to 64"), std::string::npos);
+}
+
+TEST(RegionTest, BandsFollowTheWorkNotTheRows) {
+  // The sky costs one ray a pixel, the ground three (the camera ray and two shadow rays): the bands
+  // over the sky are taller than those over the ground.
+  const Scene scene = sky_and_ground();
+  const std::vector<PixelRegion> bands = work_bands(scene, {48, 64, 1, 0}, 4);
+  EXPECT_GT(bands.front().height(), bands.back().height() + 4) << to_string(bands.front()) << " " << to_string(bands.back());
+  // Every process gets the same bands: they depend on the scene and the image, not on the call.
+  EXPECT_EQ(work_bands(scene, {48, 64, 1, 0}, 4), bands);
+  EXPECT_EQ(work_bands(sky_and_ground("elsewhere/sky.json"), {48, 64, 1, 0}, 4), bands);
+  // The image's size moves them; the sample count does not (the work a row costs scales alike).
+  EXPECT_EQ(work_bands(scene, {48, 64, 16, 0}, 4), bands);
+  EXPECT_EQ(resolve_region(scene, {48, 64, 1, 0}, Band{3, 4}), bands[3]);
+}
+
+// ---- the CPU reference's regions ---------------------------------------------------------------
+
+TEST(RegionTest, ACpuRegionIsTheWholeRenderCroppedBitForBit) {
+  const Scene scene = sky_and_ground();
+  RenderOptions options;
+  options.threads = 2;
+  options.aovs = true;
+  const RenderResult whole = render_on_cpu(scene, options);
+  for (const PixelRegion region : {PixelRegion{5, 7, 29, 40}, PixelRegion{0, 63, 48, 64}, PixelRegion{47, 0, 48, 64}}) {
+    options.region = region;
+    const RenderResult part = render_on_cpu(scene, options);
+    EXPECT_EQ(part.region, region);
+    EXPECT_EQ(part.settings.width, 48u);
+    ASSERT_EQ(part.image.width, region.width());
+    ASSERT_EQ(part.image.height, region.height());
+    EXPECT_TRUE(same_bits(part.image.pixels, crop(whole.image, region))) << to_string(region);
+    ASSERT_TRUE(part.aovs);
+    EXPECT_EQ(part.aovs->width, region.width());
+    EXPECT_EQ(part.aovs->depth[0], whole.aovs->depth[size_t(region.y0) * 48 + region.x0]);
+    EXPECT_EQ(part.aovs->object.back(), whole.aovs->object[size_t(region.y1 - 1) * 48 + region.x1 - 1]);
+  }
+}
+
+// ---- the scene digest ----------------------------------------------------------------------------
+
+TEST(RegionTest, TheDigestFollowsWhatRendersNotWhereTheFileIs) {
+  const std::string digest = scene_digest(sky_and_ground());
+  EXPECT_EQ(digest.size(), 32u);
+  EXPECT_EQ(scene_digest(sky_and_ground("/other/folder/copy.json")), digest);
+  std::string text = kSkyAndGround;
+  // A description and the image settings are not in it (a part records those beside it).
+  const std::string described = std::string(R"({"description": "the same scene",)") + (text.c_str() + 1);
+  EXPECT_EQ(scene_digest(parse_scene(described, "sky.json")), digest);
+  std::string resized = text;
+  resized.replace(resized.find("\"width\": 48"), 11, "\"width\": 50");
+  EXPECT_EQ(scene_digest(parse_scene(resized, "sky.json")), digest);
+  // Anything that can change a pixel is.
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"[0.8, 0.2, 0.2]", "[0.8, 0.2, 0.21]"}, {"[400, 400, 400]", "[400, 400, 401]"}, {"\"radius\": 0.8", "\"radius\": 0.81"},
+           {"[0, 1, -6]", "[0, 1, -6.001]"}, {"[0.2, 0.3, 0.5]", "[0.2, 0.3, 0.6]"}, {"[0, 0, 50]", "[0, 0, 51]"}}) {
+    std::string edited = text;
+    edited.replace(edited.find(from), from.size(), to);
+    EXPECT_NE(scene_digest(parse_scene(edited, "sky.json")), digest) << from << " -> " << to;
+  }
+}
+
+// ---- parts and their merge -----------------------------------------------------------------------
+
+struct Rendered {
+  Scene scene;
+  RenderResult whole;
+};
+
+// The sky scene on the CPU, whole and as parts cut by `regions`, each written to `dir` as `suffix`.
+std::vector<std::filesystem::path> write_parts(const Rendered& r, const std::vector<PixelRegion>& regions,
+                                               const std::filesystem::path& dir, const std::string& suffix,
+                                               const ExrContent& content = {}) {
+  std::vector<std::filesystem::path> files;
+  for (size_t i = 0; i < regions.size(); ++i) {
+    RenderOptions options;
+    options.threads = 2;
+    options.aovs = !content.passes.empty();
+    options.region = regions[i];
+    const RenderResult part = render_on_cpu(r.scene, options);
+    PartRecord record{scene_digest(r.scene), 48, 64, regions[i], 2, 0, "test", "CPU reference"};
+    files.push_back(dir / ("part" + std::to_string(i) + suffix));
+    write_part(files.back(), part.image, part.aovs ? &*part.aovs : nullptr, content, record);
+  }
+  return files;
+}
+
+Rendered rendered(bool aovs = false) {
+  Rendered r{sky_and_ground(), {}};
+  RenderOptions options;
+  options.threads = 2;
+  options.aovs = aovs;
+  r.whole = render_on_cpu(r.scene, options);
+  return r;
+}
+
+const std::vector<PixelRegion> kQuarters{{0, 0, 20, 30}, {20, 0, 48, 30}, {0, 30, 48, 50}, {0, 50, 48, 64}};
+
+std::string file_bytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(MergeTest, PfmPartsMergeIntoTheBytesOfTheWholeImage) {
+  TempDir dir;
+  const Rendered r = rendered();
+  const auto files = write_parts(r, kQuarters, dir.path(), ".pfm");
+  for (const auto& f : files) EXPECT_TRUE(std::filesystem::exists(sidecar_of(f))) << f;
+  const Part part = read_part(files[1]);
+  EXPECT_EQ(part.record.region, kQuarters[1]);
+  EXPECT_EQ(part.record.scene_digest, scene_digest(r.scene));
+  const MergeSummary summary = merge_part_files(dir / "merged.pfm", {files[3], files[0], files[2], files[1]});  // any order
+  EXPECT_EQ(summary.parts, 4u);
+  EXPECT_FALSE(summary.mixed_devices);
+  write_image(r.whole.image, dir / "whole.pfm");
+  EXPECT_EQ(file_bytes(dir / "merged.pfm"), file_bytes(dir / "whole.pfm"));
+}
+
+TEST(MergeTest, ExrPartsCarryTheirDataWindowAndPassesAndMergeExactly) {
+  TempDir dir;
+  const Rendered r = rendered(true);
+  ExrContent content;
+  content.passes = {Aov::albedo, Aov::depth, Aov::object};
+  const auto files = write_parts(r, kQuarters, dir.path(), ".exr", content);
+  const ExrFile exr = read_exr(files[1]);
+  EXPECT_EQ(exr.window.full_width, 48u);
+  EXPECT_EQ(exr.window.full_height, 64u);
+  EXPECT_EQ(exr.window.region, kQuarters[1]);
+  EXPECT_NE(exr.window.part_record.find("\"scene_digest\""), std::string::npos);
+  merge_part_files(dir / "merged.exr", files);
+  write_exr(dir / "whole.exr", r.whole.image, &*r.whole.aovs, content);
+  EXPECT_EQ(file_bytes(dir / "merged.exr"), file_bytes(dir / "whole.exr"));
+  // To a PNG, the passes are dropped, and said to be.
+  EXPECT_TRUE(merge_part_files(dir / "merged.png", files).passes_dropped);
+}
+
+TEST(MergeTest, RefusesOverlapsAndGapsNamingThePixels) {
+  TempDir dir;
+  const Rendered r = rendered();
+  const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 31, 48, 64}, {0, 32, 40, 64}}, dir.path(), ".pfm");
+  const std::string overlap = error_of([&] { merge_part_files(dir / "m.pfm", {files[0], files[1]}); });
+  EXPECT_NE(overlap.find("part1.pfm: its region 0,31,48,64 overlaps region 0,0,48,32"), std::string::npos) << overlap;
+  EXPECT_NE(overlap.find("pixels 0,31,48,32"), std::string::npos) << overlap;
+  const std::string gap = error_of([&] { merge_part_files(dir / "m.pfm", {files[0], files[2]}); });
+  EXPECT_NE(gap.find("no part covers pixels 40 to 47 of row 32"), std::string::npos) << gap;
+  const std::string missing = error_of([&] { merge_part_files(dir / "m.pfm", {files[2]}); });
+  EXPECT_NE(missing.find("no part covers pixels 0 to 47 of row 0"), std::string::npos) << missing;
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.pfm"));
+}
+
+TEST(MergeTest, RefusesPartsOfAnotherRenderNamingWhatDiffers) {
+  TempDir dir;
+  const Rendered r = rendered();
+  const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm");
+  // Each field of the second part's record changed in turn.
+  const std::string record = file_bytes(sidecar_of(files[1]));
+  for (const auto& [from, to, says] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {scene_digest(r.scene), std::string(32, 'f'), "of another scene"},
+           {"\"width\":48", "\"width\":49", "of an image of 49 x 64, not 48 x 64"},
+           {"\"spp\":2", "\"spp\":3", "samples per pixel 3, not 2"},
+           {"\"seed\":0", "\"seed\":7", "seed 7, not 0"},
+           {"\"vkray_version\":\"test\"", "\"vkray_version\":\"other\"", "rendered by vkray other, not test"}}) {
+    std::string edited = record;
+    edited.replace(edited.find(from), from.size(), to);
+    std::ofstream(sidecar_of(files[1]), std::ios::trunc) << edited;
+    const std::string message = error_of([&] { merge_part_files(dir / "m.pfm", files); });
+    EXPECT_NE(message.find("part1.pfm"), std::string::npos) << message;
+    EXPECT_NE(message.find(says), std::string::npos) << message;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.pfm"));
+}
+
+TEST(MergeTest, RefusesFilesThatAreNotPartsNamingThem) {
+  TempDir dir;
+  const Rendered r = rendered();
+  const auto files = write_parts(r, {{0, 0, 48, 64}}, dir.path(), ".pfm");
+  write_image(r.whole.image, dir / "whole.exr");
+  write_image(r.whole.image, dir / "whole.png");
+  EXPECT_NE(error_of([&] { read_part(dir / "whole.exr"); }).find("no \"vkray.part\" attribute"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_part(dir / "whole.png"); }).find("parts are the .exr or .pfm files"), std::string::npos);
+  std::filesystem::remove(sidecar_of(files[0]));
+  EXPECT_NE(error_of([&] { read_part(files[0]); }).find("part0.pfm.json: not found"), std::string::npos);
+  for (const char* bad : {"{", "[]", R"({"scene_digest": 1})", R"({"scene_digest": "x", "width": -1, "height": 64, "region": [0,0,1,1], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d"})",
+                          R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,49,1], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d"})"}) {
+    std::ofstream(sidecar_of(files[0]), std::ios::trunc) << bad;
+    const std::string message = error_of([&] { read_part(files[0]); });
+    EXPECT_NE(message.find("part0.pfm.json: the part's record"), std::string::npos) << bad << ": " << message;
+  }
+  // A record whose region is not the picture's size.
+  std::ofstream(sidecar_of(files[0]), std::ios::trunc)
+      << R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,48,32], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d"})";
+  EXPECT_NE(error_of([&] { read_part(files[0]); }).find("48 x 64 pixels, but its record names region 0,0,48,32"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { merge_parts({}); }).find("no parts"), std::string::npos);
+}
+
+TEST(MergeTest, APfmWhoseHeaderIsNotItsSizeIsRefusedBeforeAnythingIsAllocated) {
+  TempDir dir;
+  std::ofstream(dir / "huge.pfm", std::ios::binary) << "PF\n65536 65536\n-1\n" << std::string(12, '\0');
+  EXPECT_NE(error_of([&] { read_pfm(dir / "huge.pfm"); }).find("a PFM header of 65536 x 65536 pixels in a file of"),
+            std::string::npos);
+  std::ofstream(dir / "long.pfm", std::ios::binary) << "PF\n1 1\n-1\n" << std::string(13, '\0');
+  EXPECT_NE(error_of([&] { read_pfm(dir / "long.pfm"); }).find("in a file of 23 bytes"), std::string::npos);
+  std::ofstream(dir / "word.pfm", std::ios::binary) << std::string(1 << 20, 'P');
+  EXPECT_NE(error_of([&] { read_pfm(dir / "word.pfm"); }).find("not a little-endian RGB PFM"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace vkray::test
