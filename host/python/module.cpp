@@ -21,11 +21,15 @@
 #include "base/interrupt.h"
 #include "base/timing.h"
 #include "image/aovs.h"
+#include "image/exr.h"
+#include "image/merge.h"
 #include "session/cpu_render.h"
 #include "session/failure.h"
 #include "session/parity.h"
 #include "session/parity_report.h"
+#include "session/parts.h"
 #include "session/paths.h"
+#include "session/regions.h"
 #include "session/session.h"
 #include "session/version.h"
 
@@ -99,6 +103,16 @@ std::shared_ptr<const Scene> load(const SceneSource& source, MeshCache* meshes) 
   return std::make_shared<const Scene>(source.text ? parse_scene(*source.text, source.file, meshes) : load_scene(source.file, meshes));
 }
 
+// What a render is asked for from Python: the overrides, the passes, a region ("X0,Y0,X1,Y1" or
+// "I/N"), and for a render to a file, the file and its precision.
+struct Request {
+  std::optional<uint32_t> width, height, spp, seed;
+  std::vector<std::string> aovs;
+  std::optional<std::string> region;
+  std::optional<std::filesystem::path> output;
+  bool exr_float = false;
+};
+
 RenderOptions render_options(std::optional<uint32_t> width, std::optional<uint32_t> height, std::optional<uint32_t> spp,
                              std::optional<uint32_t> seed, bool aovs) {
   RenderOptions options;
@@ -147,6 +161,29 @@ py::object to_numpy(const RenderResult& result, const std::vector<Aov>& passes) 
   return py::object(out);
 }
 
+RenderOptions options_of(const Request& request, bool aovs) {
+  RenderOptions options = render_options(request.width, request.height, request.spp, request.seed, aovs);
+  if (request.region) options.region = parse_region(*request.region);
+  return options;
+}
+
+// The file's content, checked before any work: passes and 32-bit floats only in an .exr, a region
+// only as a part (.exr or .pfm).
+ExrContent output_content(const Request& request, const std::vector<Aov>& passes) {
+  ExrContent content;
+  content.passes = passes;
+  content.full_float = request.exr_float;
+  if (!request.output) {
+    if (request.exr_float) throw UsageError("exr_float is for a render to an .exr file");
+    return content;
+  }
+  if (!is_supported_image_path(*request.output))
+    throw OutputError(request.output->string() + ": unknown image type (expected .png, .pfm or .exr)");
+  check_render_image(*request.output, content);
+  if (request.region) check_part_file(*request.output);
+  return content;
+}
+
 std::vector<Aov> parse_passes(const std::vector<std::string>& names) {
   std::string list;
   for (const auto& name : names) list += (list.empty() ? "" : ",") + name;
@@ -193,9 +230,10 @@ class Renderer {
     }
   }
 
-  py::object render(const SceneSource& source, std::optional<uint32_t> width, std::optional<uint32_t> height,
-                    std::optional<uint32_t> spp, std::optional<uint32_t> seed, const std::vector<std::string>& aov_names) {
-    const std::vector<Aov> passes = parse_passes(aov_names);
+  // Renders `source`: returns the image (and passes) as numpy arrays, or with request.output writes
+  // the file as `vkray render -o` does (a region as a part) and returns None.
+  py::object render(const SceneSource& source, const Request& request) {
+    const std::vector<Aov> passes = parse_passes(request.aovs);
     auto lock = lock_without_gil();
     if (!session_) raise_failure(std::make_exception_ptr(UsageError("the renderer is closed")));
     struct Done {
@@ -205,11 +243,12 @@ class Renderer {
       bool reused;
     };
     Done done = run_interruptibly([&] {
+      const ExrContent content = output_content(request, passes);
       const auto start = Clock::now();
       auto scene = load(source, &meshes_);
       meshes_.keep_only(scene->referenced_files);
       const double load_seconds = seconds_since(start);
-      RenderOptions options = render_options(width, height, spp, seed, !passes.empty());
+      RenderOptions options = options_of(request, !passes.empty());
       image_settings(*scene, options);  // a bad override fails before any upload
       // The last scene goes first when this one needs a new upload, so that both are never on the device.
       std::optional<DeviceScene> on_device;
@@ -218,11 +257,14 @@ class Renderer {
       if (!on_device) on_device = session_->upload(scene);
       last_ = on_device;
       RenderResult result = session_->render(*on_device, options);
+      if (request.output) write_render(*request.output, *scene, result, content, session_->device_description());
       return Done{std::move(result), scene, load_seconds, on_device->upload_seconds(), on_device->shares_geometry()};
     });
     last_stats_ = stats_dict(done.result.stats, done.load_seconds, done.upload_seconds, done.reused);
+    last_stats_["region"] = py::make_tuple(done.result.region.x0, done.result.region.y0, done.result.region.x1, done.result.region.y1);
     lock.unlock();  // a warning's handler may use this renderer
     warn_about(*done.scene);
+    if (request.output) return py::none();
     return to_numpy(done.result, passes);
   }
 
@@ -267,22 +309,55 @@ class Renderer {
   py::object last_stats_ = py::none();
 };
 
-py::object render_cpu(const SceneSource& source, std::optional<uint32_t> width, std::optional<uint32_t> height,
-                      std::optional<uint32_t> spp, std::optional<uint32_t> seed, const std::vector<std::string>& aov_names,
-                      unsigned threads) {
-  const std::vector<Aov> passes = parse_passes(aov_names);
+py::object render_cpu(const SceneSource& source, const Request& request, unsigned threads) {
+  const std::vector<Aov> passes = parse_passes(request.aovs);
   struct Done {
     RenderResult result;
     std::shared_ptr<const Scene> scene;
   };
   Done done = run_interruptibly([&] {
+    const ExrContent content = output_content(request, passes);
     auto scene = load(source, nullptr);
-    RenderOptions options = render_options(width, height, spp, seed, !passes.empty());
+    RenderOptions options = options_of(request, !passes.empty());
     options.threads = threads;
-    return Done{render_on_cpu(*scene, options), scene};
+    RenderResult result = render_on_cpu(*scene, options);
+    if (request.output) write_render(*request.output, *scene, result, content, kCpuReferenceDevice);
+    return Done{std::move(result), scene};
   });
   warn_about(*done.scene);
+  if (request.output) return py::none();
   return to_numpy(done.result, passes);
+}
+
+// The bands `vkray render --region I/N` renders, all of them (session/regions.h).
+py::list bands(const SceneSource& source, uint32_t count, std::optional<uint32_t> width, std::optional<uint32_t> height) {
+  struct Done {
+    std::vector<PixelRegion> bands;
+    std::shared_ptr<const Scene> scene;
+  };
+  Done done = run_interruptibly([&] {
+    auto scene = load(source, nullptr);
+    const ImageSettings image = image_settings(*scene, render_options(width, height, std::nullopt, std::nullopt, false));
+    return Done{work_bands(*scene, image, count), scene};
+  });
+  warn_about(*done.scene);
+  py::list out;
+  for (const PixelRegion& r : done.bands) out.append(py::make_tuple(r.x0, r.y0, r.x1, r.y1));
+  return out;
+}
+
+py::dict merge(const std::filesystem::path& output, const std::vector<std::filesystem::path>& parts) {
+  const MergeSummary summary = run_interruptibly([&] { return merge_part_files(output, parts); });
+  py::dict out;
+  out["parts"] = summary.parts;
+  out["width"] = summary.record.width;
+  out["height"] = summary.record.height;
+  out["spp"] = summary.record.samples_per_pixel;
+  out["seed"] = summary.record.seed;
+  out["scene_digest"] = summary.record.scene_digest;
+  out["mixed_devices"] = summary.mixed_devices;
+  out["passes_dropped"] = summary.passes_dropped;
+  return out;
 }
 
 std::string parity(const SceneSource& source, std::optional<uint32_t> width, std::optional<uint32_t> height,
@@ -354,16 +429,26 @@ PYBIND11_MODULE(_vkray, m) {
       .def(py::init([](std::filesystem::path file, std::optional<std::string> text) { return vp::SceneSource{std::move(file), std::move(text)}; }),
            py::arg("file"), py::arg("text") = py::none());
 
+  py::class_<vp::Request>(m, "_Request")
+      .def(py::init([](std::optional<uint32_t> width, std::optional<uint32_t> height, std::optional<uint32_t> spp,
+                       std::optional<uint32_t> seed, std::vector<std::string> aovs, std::optional<std::string> region,
+                       std::optional<std::filesystem::path> output, bool exr_float) {
+             return vp::Request{width, height, spp, seed, std::move(aovs), std::move(region), std::move(output), exr_float};
+           }),
+           py::arg("width") = py::none(), py::arg("height") = py::none(), py::arg("spp") = py::none(), py::arg("seed") = py::none(),
+           py::arg("aovs") = std::vector<std::string>{}, py::arg("region") = py::none(), py::arg("output") = py::none(),
+           py::arg("exr_float") = false);
+
   py::class_<vp::Renderer>(m, "_Renderer")
       .def(py::init<const std::optional<std::string>&, bool, const std::optional<std::filesystem::path>&>(), py::arg("device"),
            py::arg("validate"), py::arg("shader_dir"))
-      .def("render", &vp::Renderer::render, py::arg("source"), py::arg("width"), py::arg("height"), py::arg("spp"),
-           py::arg("seed"), py::arg("aovs"))
+      .def("render", &vp::Renderer::render, py::arg("source"), py::arg("request"))
       .def("close", &vp::Renderer::close)
       .def_property_readonly("device", &vp::Renderer::device)
       .def_property_readonly("last_stats", &vp::Renderer::last_stats);
-  m.def("render_cpu", &vp::render_cpu, py::arg("source"), py::arg("width"), py::arg("height"), py::arg("spp"), py::arg("seed"),
-        py::arg("aovs"), py::arg("threads"));
+  m.def("render_cpu", &vp::render_cpu, py::arg("source"), py::arg("request"), py::arg("threads"));
+  m.def("bands", &vp::bands, py::arg("source"), py::arg("count"), py::arg("width"), py::arg("height"));
+  m.def("merge", &vp::merge, py::arg("output"), py::arg("parts"));
   m.def("parity", &vp::parity, py::arg("source"), py::arg("width"), py::arg("height"), py::arg("spp"), py::arg("seed"),
         py::arg("device"), py::arg("validate"), py::arg("threads"));
   m.def("devices", &vp::devices);

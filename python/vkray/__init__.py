@@ -39,7 +39,9 @@ __all__ = [
     "Renderer",
     "SceneError",
     "UsageError",
+    "bands",
     "devices",
+    "merge",
     "parity",
     "render",
     "__version__",
@@ -49,6 +51,7 @@ __all__ = [
 AOVS = ("albedo", "normal", "position", "depth", "object")
 
 Scene = Union[str, "os.PathLike[str]", Mapping[str, Any]]
+Region = Union[str, tuple[int, int, int, int]]
 Image = np.ndarray
 RenderOutput = Union[np.ndarray, dict[str, np.ndarray]]
 
@@ -86,6 +89,25 @@ def _pass_names(aovs: Union[str, Iterable[str]]) -> list[str]:
     return [n for name in names for n in name.split(",")] if names else []
 
 
+def _region_text(region: Optional[Region]) -> Optional[str]:
+    if region is None or isinstance(region, str):
+        return region
+    try:
+        x0, y0, x1, y1 = (int(v) for v in region)
+    except (TypeError, ValueError):
+        raise UsageError(f"a region is (x0, y0, x1, y1) or 'I/N', not {region!r}") from None
+    if min(x0, y0, x1, y1) < 0:
+        raise UsageError(f"region {region!r}: pixel bounds are not negative")
+    return f"{x0},{y0},{x1},{y1}"
+
+
+def _request(width: Optional[int], height: Optional[int], spp: Optional[int], seed: Optional[int],
+             aovs: Union[str, Iterable[str]], region: Optional[Region], output: Any = None,
+             exr_float: bool = False) -> Any:
+    return _vkray._Request(width, height, spp, seed, _pass_names(aovs), _region_text(region),
+                           None if output is None else os.fspath(output), exr_float)
+
+
 class Renderer:
     """A Vulkan device kept open for any number of renders.
 
@@ -111,9 +133,20 @@ class Renderer:
 
     def render(self, scene: Scene, *, width: Optional[int] = None, height: Optional[int] = None,
                spp: Optional[int] = None, seed: Optional[int] = None, aovs: Union[str, Iterable[str]] = (),
+               region: Optional[Region] = None,
                base_dir: Optional[Union[str, "os.PathLike[str]"]] = None) -> RenderOutput:
         """Renders ``scene`` (see ``vkray.render``) on this renderer's device."""
-        return self._renderer.render(_source(scene, base_dir), width, height, spp, seed, _pass_names(aovs))
+        return self._renderer.render(_source(scene, base_dir), _request(width, height, spp, seed, aovs, region))
+
+    def render_to_file(self, scene: Scene, output: Union[str, "os.PathLike[str]"], *, width: Optional[int] = None,
+                       height: Optional[int] = None, spp: Optional[int] = None, seed: Optional[int] = None,
+                       aovs: Union[str, Iterable[str]] = (), region: Optional[Region] = None, exr_float: bool = False,
+                       base_dir: Optional[Union[str, "os.PathLike[str]"]] = None) -> None:
+        """Renders ``scene`` and writes ``output`` (.png, .pfm or .exr) as ``vkray render -o`` does: the
+        first-hit passes ``aovs`` as EXR layers, 32-bit channels with ``exr_float``, and a ``region``
+        as a part for ``vkray.merge`` (.exr, or .pfm with its .pfm.json record). The file is written
+        whole or not at all."""
+        self._renderer.render(_source(scene, base_dir), _request(width, height, spp, seed, aovs, region, output, exr_float))
 
     @property
     def device(self) -> str:
@@ -139,8 +172,8 @@ class Renderer:
 
 def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] = None, spp: Optional[int] = None,
            seed: Optional[int] = None, renderer: str = "gpu", device: Optional[str] = None,
-           aovs: Union[str, Iterable[str]] = (), base_dir: Optional[Union[str, "os.PathLike[str]"]] = None,
-           threads: int = 0) -> RenderOutput:
+           aovs: Union[str, Iterable[str]] = (), region: Optional[Region] = None,
+           base_dir: Optional[Union[str, "os.PathLike[str]"]] = None, threads: int = 0) -> RenderOutput:
     """Renders a scene and returns linear radiance as a float32 array of shape (height, width, 3).
 
     Args:
@@ -154,6 +187,9 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
             string). With any, the result is a dict: "color" and each pass; "albedo", "normal",
             "position" are (height, width, 3) float32, "depth" (height, width) float32 (infinite
             where nothing was hit), "object" (height, width) int32 (-1 where nothing was hit).
+        region: only these pixels: (x0, y0, x1, y1), bounds in the full image (half-open), or "I/N",
+            band I of N bands of about equal work (``vkray.bands``). Each pixel is the same as in the
+            full render; the arrays hold the region alone.
         threads: for "cpu": threads to use; 0, one per hardware thread.
 
     Raises:
@@ -164,11 +200,12 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
     """
     if renderer == "gpu":
         with Renderer(device) as r:
-            return r.render(scene, width=width, height=height, spp=spp, seed=seed, aovs=aovs, base_dir=base_dir)
+            return r.render(scene, width=width, height=height, spp=spp, seed=seed, aovs=aovs, region=region,
+                            base_dir=base_dir)
     if renderer == "cpu":
         if device is not None:
             raise UsageError("device is for renderer='gpu'; the CPU reference runs on the host")
-        return _vkray.render_cpu(_source(scene, base_dir), width, height, spp, seed, _pass_names(aovs), threads)
+        return _vkray.render_cpu(_source(scene, base_dir), _request(width, height, spp, seed, aovs, region), threads)
     raise UsageError(f"renderer is 'gpu' or 'cpu', not {renderer!r}")
 
 
@@ -181,6 +218,23 @@ def parity(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
     ``result["pass"]`` says whether they agree within the tolerance (``result["tolerance"]``)."""
     return json.loads(_vkray.parity(_source(scene, base_dir), width, height, spp, seed,
                                     None if device is None else str(device), validate, threads))
+
+
+def bands(scene: Scene, count: int, *, width: Optional[int] = None, height: Optional[int] = None,
+          base_dir: Optional[Union[str, "os.PathLike[str]"]] = None) -> list[tuple[int, int, int, int]]:
+    """The ``count`` bands of whole rows, (x0, y0, x1, y1) from the top, that ``region="I/N"`` and
+    ``vkray render --region I/N`` render: each about the same work, estimated by a small render of
+    the scene with the CPU reference. Every process computes the same bands for the same scene."""
+    return [tuple(b) for b in _vkray.bands(_source(scene, base_dir), count, width, height)]
+
+
+def merge(output: Union[str, "os.PathLike[str]"], parts: Iterable[Union[str, "os.PathLike[str]"]]) -> dict[str, Any]:
+    """Assembles the parts of a render (files written with a ``region``) into ``output``, as
+    ``vkray merge`` does; raises SceneError when they are not the parts of one render or do not tile
+    the image. Returns what was merged: parts, width, height, spp, seed, scene_digest,
+    mixed_devices (parts of several devices agree within parity, not bit for bit) and
+    passes_dropped (only an .exr output keeps first-hit passes)."""
+    return _vkray.merge(os.fspath(output), [os.fspath(p) for p in parts])
 
 
 def devices() -> list[dict[str, Any]]:

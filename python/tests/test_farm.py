@@ -1,0 +1,195 @@
+"""python3 -m vkray.farm against a real Dask cluster on this machine: a scheduler and two workers,
+each a process of its own on 127.0.0.1 (started and stopped here), that declare a GPU as Dask
+resource, as workers on GPU machines would. The farm's output is compared byte for byte with a single
+`vkray render`; a worker is killed in the middle of a job, and a worker whose device fails fails the
+job cleanly."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import vkray
+from conftest import run
+
+import distributed
+
+# Every test renders the Cornell box with paths: cheap, and noisy, so that any wrong sample shows.
+RENDER = ["--width", "64", "--height", "48", "--spp", "8"]
+
+
+class Cluster:
+    """A scheduler and workers, each its own process, as `dask scheduler` and `dask worker` start them."""
+
+    def __init__(self, folder: Path):
+        self.folder = folder
+        self.file = folder / "scheduler.json"
+        self.processes: list[subprocess.Popen] = []
+        self.workers: list[subprocess.Popen] = []
+        self.scheduler = self._start("scheduler", [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host",
+                                                   "127.0.0.1", "--port", "0", "--no-dashboard", "--scheduler-file",
+                                                   str(self.file)])
+        deadline = time.monotonic() + 60
+        while not self.file.exists() or not self.file.read_text().strip().endswith("}"):
+            assert self.scheduler.poll() is None, self.log("scheduler")
+            assert time.monotonic() < deadline, "the scheduler did not start within 60 s"
+            time.sleep(0.1)
+        import json
+        self.address = json.loads(self.file.read_text())["address"]
+
+    def _start(self, name: str, command: list[str], env: dict = None) -> subprocess.Popen:
+        log = open(self.folder / f"{name}.log", "w")
+        process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
+        self.processes.append(process)
+        return process
+
+    def log(self, name: str) -> str:
+        return (self.folder / f"{name}.log").read_text()
+
+    def add_worker(self, name: str, **env: str) -> subprocess.Popen:
+        # --no-nanny: the worker is the process; killing it loses the worker, as a crashed machine would.
+        worker = self._start(name, [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads",
+                                    "1", "--no-nanny", "--no-dashboard", "--resources", "GPU=1", "--name", name],
+                             env={**os.environ, **env})
+        self.workers.append(worker)
+        return worker
+
+    def wait_for_workers(self, count: int) -> None:
+        with distributed.Client(self.address, timeout="30s") as client:
+            client.wait_for_workers(count, timeout=60)
+
+    def close(self) -> None:
+        for process in reversed(self.processes):
+            if process.poll() is None:
+                os.killpg(process.pid, signal.SIGTERM)
+        for process in self.processes:
+            try:
+                process.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                os.killpg(process.pid, signal.SIGKILL)
+                process.wait()
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    c = Cluster(tmp_path)
+    yield c
+    c.close()
+
+
+def farm(*args: str, **kwargs) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "vkray.farm", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, **kwargs)
+
+
+def single_render(vkray_command, scene, out: Path, *extra: str) -> bytes:
+    run(vkray_command, "render", str(scene), *RENDER, *extra, "-o", str(out), "-q")
+    return out.read_bytes()
+
+
+def test_four_regions_on_two_workers_merge_into_the_bytes_of_one_render(cluster, scenes, vkray_command, tmp_path):
+    cluster.add_worker("worker-a")
+    cluster.add_worker("worker-b")
+    cluster.wait_for_workers(2)
+    scene = scenes / "cornell-path.json"
+    out = tmp_path / "farm.exr"
+    job = farm(str(scene), *RENDER, "--aov", "albedo,depth", "-o", str(out), "--regions", "4", "--scheduler",
+               cluster.address)
+    _, err = job.communicate(timeout=300)
+    assert job.returncode == 0, err
+    assert "4/4 parts" in err and f"wrote {out}" in err, err
+    assert out.read_bytes() == single_render(vkray_command, scene, tmp_path / "single.exr", "--aov", "albedo,depth")
+    # Both workers took parts, and no part file was left beside the output.
+    assert "by worker-a on" in err and "by worker-b on" in err, err
+    assert list(tmp_path.glob(".farm*")) == []
+
+
+def test_a_worker_killed_mid_job_has_its_part_rendered_elsewhere(cluster, scenes, vkray_command, tmp_path):
+    victim = cluster.add_worker("victim")
+    cluster.add_worker("survivor")
+    cluster.wait_for_workers(2)
+    scene = scenes / "cornell-path.json"
+    out = tmp_path / "farm.pfm"
+    heavy = ["--width", "64", "--height", "48", "--spp", "96"]
+    job = farm(str(scene), *heavy, "-o", str(out), "--regions", "6", "--scheduler", cluster.address)
+    # Kill the victim once it is rendering a part.
+    with distributed.Client(cluster.address, timeout="30s") as client:
+        deadline = time.monotonic() + 120
+        while True:
+            busy = {client.scheduler_info()["workers"][w]["name"]: keys for w, keys in client.processing().items()
+                    if w in client.scheduler_info()["workers"]}
+            if busy.get("victim"):
+                break
+            assert job.poll() is None, job.communicate()[1]
+            assert time.monotonic() < deadline, "the victim never got a part"
+            time.sleep(0.05)
+    victim.send_signal(signal.SIGKILL)
+    _, err = job.communicate(timeout=300)
+    assert job.returncode == 0, err
+    assert "6/6 parts" in err and "by survivor on" in err, err
+    single = tmp_path / "single.pfm"
+    run(vkray_command, "render", str(scene), *heavy, "-o", str(single), "-q")
+    assert out.read_bytes() == single.read_bytes()
+
+
+def test_a_part_that_fails_fails_the_job_with_vkrays_message_and_writes_nothing(cluster, scenes, tmp_path):
+    # The worker's device does not exist: every part it takes fails as `vkray render --device` would.
+    cluster.add_worker("broken", VKRAY_DEVICE="no-such-gpu")
+    cluster.wait_for_workers(1)
+    out = tmp_path / "farm.exr"
+    job = farm(str(scenes / "cornell.json"), *RENDER, "-o", str(out), "--regions", "3", "--scheduler", cluster.address)
+    _, err = job.communicate(timeout=300)
+    assert job.returncode == 3, err
+    assert "vkray.farm: error:" in err and "no-such-gpu" in err, err
+    assert list(tmp_path.glob("farm*")) == [] and list(tmp_path.glob(".farm*")) == []
+
+
+def test_frames_on_a_local_cluster(scenes, vkray_command, tmp_path):
+    out = tmp_path / "frame.pfm"
+    job = farm(str(scenes / "cornell.json"), "--frames", str(scenes / "cornell-spheres.json"), *RENDER, "-o", str(out),
+               "--regions", "2")
+    _, err = job.communicate(timeout=300)
+    assert job.returncode == 0, err
+    for frame, scene in enumerate(["cornell.json", "cornell-spheres.json"]):
+        single = tmp_path / f"single{frame}.pfm"
+        run(vkray_command, "render", str(scenes / scene), *RENDER, "-o", str(single), "-q")
+        assert (tmp_path / f"frame.{frame:04d}.pfm").read_bytes() == single.read_bytes(), scene
+
+
+@pytest.mark.parametrize("args, code, says", [
+    (["missing.json", "-o", "x.pfm"], 1, "missing.json"),
+    (["{scenes}/cornell.json", "-o", "x.txt"], 2, "unknown image type"),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--aov", "depth"], 2, "for an .exr output"),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--height", "8", "--regions", "9"], 2, "1 to 8"),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--scheduler", "tcp://127.0.0.1:1"], 3, "error"),
+])
+def test_bad_jobs_fail_before_any_work_with_a_message(scenes, tmp_path, args, code, says):
+    job = farm(*[a.format(scenes=scenes) for a in args], cwd=tmp_path)
+    _, err = job.communicate(timeout=120)
+    assert job.returncode == code, err
+    assert says in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bands_and_merge_from_python(scenes, tmp_path):
+    scene = scenes / "cornell.json"
+    bands = vkray.bands(scene, 3, width=64, height=48)
+    assert [b[1] for b in bands] == [0, bands[0][3], bands[1][3]] and bands[-1][3] == 48
+    with vkray.Renderer() as r:
+        parts = []
+        for i, band in enumerate(bands):
+            parts.append(tmp_path / f"p{i}.exr")
+            r.render_to_file(scene, parts[-1], width=64, height=48, region=band)
+        whole = r.render(scene, width=64, height=48)
+        assert r.render(scene, width=64, height=48, region="1/3").shape == (bands[1][3] - bands[1][1], 64, 3)
+    summary = vkray.merge(tmp_path / "m.exr", parts)
+    assert summary["parts"] == 3 and not summary["mixed_devices"]
+    with pytest.raises(vkray.SceneError, match="no part covers"):
+        vkray.merge(tmp_path / "gap.exr", parts[:2])
+    with pytest.raises(vkray.UsageError, match="expected X0,Y0,X1,Y1"):
+        vkray.render(scene, width=8, height=8, region="1-2")
+    assert whole.shape == (48, 64, 3)

@@ -1,0 +1,266 @@
+"""One render spread over a Dask cluster: ``python3 -m vkray.farm SCENE -o OUT``.
+
+The image is cut into bands of about equal work (``vkray.bands``, the bands ``vkray render --region
+I/N`` renders); each band is a Dask task that renders it on a worker's GPU as a part file, and the
+parts come back to this process, which merges them (``vkray.merge``) into OUT: byte for byte the
+image a single ``vkray render -o OUT`` gives when the workers share a build and a device type. More
+scenes after ``--frames`` are more frames, each its own set of tasks.
+
+Without ``--scheduler`` a ``LocalCluster`` of ``--workers`` processes runs here. With one, the tasks
+go to that cluster's workers that declare a GPU (``dask worker ADDRESS --resources GPU=1``), one task
+per GPU at a time; a worker uses the device named by its ``VKRAY_DEVICE`` variable (an index or part
+of a name from ``vkray devices``), or the best one. Workers read the scene by its absolute path, so
+it must be on a file system they share (as on a Slurm cluster), and import this package.
+
+A worker that is lost mid-task has its task run again elsewhere (Dask's scheduler does that, up to
+``distributed.scheduler.allowed-failures`` times); a part that fails (a bad scene, a device error)
+fails the whole job with vkray's message, and then no output is written. Exit codes are vkray's:
+0 done, 1 bad input, 2 usage, 3 device or cluster failure, 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import os
+import shutil
+import sys
+import tempfile
+import threading
+import time
+import uuid
+from pathlib import Path
+from typing import Any, Optional, Sequence
+
+import vkray
+
+# A part's file type for each output type: float parts for every output, so that the merged image is
+# the single render's exactly.
+_PART_SUFFIX = {".exr": ".exr", ".pfm": ".pfm", ".png": ".pfm"}
+
+# ---- the worker's side ----------------------------------------------------------------------------
+
+# One vkray.Renderer per worker process, kept between its tasks: the device stays open, the shaders
+# compiled and the last scene's geometry on the device, so that the next band of the same scene
+# uploads only what changed.
+_renderer: Optional[vkray.Renderer] = None
+_renderer_lock = threading.Lock()
+
+
+def _worker_name(name: Any) -> str:
+    """`dask worker --name` names a worker; a LocalCluster numbers them."""
+    return f"worker {name}" if isinstance(name, int) else str(name)
+
+
+def _render_part(scene: str, region: tuple[int, int, int, int], settings: dict[str, Any],
+                 suffix: str) -> dict[str, Any]:
+    """A Dask task: renders `region` of `scene` and returns the part file's bytes (and a PFM part's
+    record) with what it cost."""
+    global _renderer
+    import distributed
+
+    start = time.perf_counter()
+    with _renderer_lock, tempfile.TemporaryDirectory(prefix="vkray-part-") as folder:
+        try:
+            if _renderer is None:
+                _renderer = vkray.Renderer(os.environ.get("VKRAY_DEVICE") or None)
+            part = Path(folder) / f"part{suffix}"
+            _renderer.render_to_file(scene, part, region=region, **settings)
+        except vkray.DeviceError:
+            # A failed device is not used again: the next task on this worker opens it afresh.
+            renderer, _renderer = _renderer, None
+            if renderer is not None:
+                try:
+                    renderer.close()
+                except vkray.Error:
+                    pass
+            raise
+        record = part.with_name(part.name + ".json")
+        result = {
+            "data": part.read_bytes(),
+            "record": record.read_bytes() if record.exists() else None,
+            "stats": dict(_renderer.last_stats or {}),
+            "device": _renderer.device,
+            "worker": _worker_name(distributed.get_worker().name),
+        }
+    result["seconds"] = time.perf_counter() - start
+    return result
+
+
+# ---- the client's side ----------------------------------------------------------------------------
+
+def _frame_output(output: Path, frame: int, frames: int) -> Path:
+    """OUT for one frame; with several, the frame's number before the suffix: out.exr -> out.0001.exr."""
+    return output if frames == 1 else output.with_name(f"{output.stem}.{frame:04d}{output.suffix}")
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python3 -m vkray.farm",
+        description="Render a scene (or frames) as bands of about equal work, as Dask tasks, and merge them.",
+        epilog="Exit codes: 0 done, 1 bad input, 2 usage, 3 device or cluster failure, 130 interrupted.")
+    p.add_argument("scene", help="scene file (.json, .gltf, .glb), read by every worker at its absolute path")
+    p.add_argument("-o", "--output", required=True, help="the whole image: .exr, .pfm or .png; with --frames, "
+                   "frame N goes to OUT with .NNNN before the suffix")
+    p.add_argument("--regions", type=int, default=None,
+                   help="bands per frame (default: twice the workers, at least 2)")
+    p.add_argument("--frames", nargs="+", default=[], metavar="SCENE", help="more scenes, rendered as frames 1, 2, ...")
+    p.add_argument("--scheduler", help="address of a Dask scheduler (tcp://host:8786); default: a LocalCluster here")
+    p.add_argument("--workers", type=int, default=1,
+                   help="LocalCluster worker processes, each with a GPU slot (default 1; one per GPU of this machine)")
+    p.add_argument("--width", type=int)
+    p.add_argument("--height", type=int)
+    p.add_argument("--spp", type=int)
+    p.add_argument("--seed", type=int)
+    p.add_argument("--aov", default="", help="first-hit passes for an .exr output, comma-separated")
+    p.add_argument("--exr-float", action="store_true", help="32-bit float channels in an .exr output")
+    p.add_argument("-q", "--quiet", action="store_true", help="print only errors")
+    return p
+
+
+class _Usage(Exception):
+    pass
+
+
+def _log(quiet: bool, line: str) -> None:
+    if not quiet:
+        print(f"vkray.farm: {line}", file=sys.stderr, flush=True)
+
+
+def _connect(args: argparse.Namespace):  # -> (Client, cluster or None)
+    import distributed
+
+    if args.scheduler:
+        client = distributed.Client(args.scheduler, timeout="30s")
+        try:
+            client.wait_for_workers(1, timeout=60)
+        except Exception:
+            client.close()
+            raise RuntimeError(f"no worker joined the scheduler at {args.scheduler} within 60 s") from None
+        gpus = [w for w in client.scheduler_info()["workers"].values() if w.get("resources", {}).get("GPU", 0) >= 1]
+        if not gpus:
+            client.close()
+            raise RuntimeError(f"no worker of the scheduler at {args.scheduler} declares a GPU: start workers with "
+                               f"`dask worker {args.scheduler} --resources GPU=1`")
+        return client, None
+    cluster = distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                                       resources={"GPU": 1}, dashboard_address=None,
+                                       silence_logs=logging.ERROR)
+    return distributed.Client(cluster), cluster
+
+
+def run(argv: Optional[Sequence[str]] = None) -> int:
+    args = _parser().parse_args(argv)
+    output = Path(args.output)
+    suffix = _PART_SUFFIX.get(output.suffix.lower())
+    if suffix is None:
+        raise _Usage(f"{output}: unknown image type (expected .exr, .pfm or .png)")
+    if (args.aov or args.exr_float) and suffix != ".exr":
+        raise _Usage(f"{output}: first-hit passes and --exr-float are for an .exr output")
+    if not output.parent.is_dir():
+        raise _Usage(f"{output}: folder {output.parent} does not exist")
+    if args.workers < 1:
+        raise _Usage(f"--workers {args.workers}: at least 1")
+    regions = args.regions if args.regions is not None else max(2, 2 * args.workers)
+    settings = {"width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed, "aovs": args.aov,
+                "exr_float": args.exr_float}
+
+    # Every frame's bands, here, before any worker starts: a bad scene fails at once, and every part
+    # of a frame gets its bounds from one computation.
+    scenes = [str(Path(s).resolve()) for s in [args.scene, *args.frames]]
+    jobs = []  # (frame, band index, scene, region)
+    for frame, scene in enumerate(scenes):
+        for index, region in enumerate(vkray.bands(scene, regions, width=args.width, height=args.height)):
+            jobs.append((frame, index, scene, region))
+
+    import distributed
+
+    # The parts go to disk as they arrive (the client holds none for long, however many frames), in
+    # a folder beside the output, removed at the end whatever happens.
+    folder = Path(tempfile.mkdtemp(prefix=f".{output.name}.parts-", dir=output.parent))
+    try:
+        started = time.perf_counter()
+        _render_parts(args, jobs, settings, suffix, folder)
+        rendered = time.perf_counter() - started
+        # Every part is here: now, and only now, the outputs are written.
+        for frame in range(len(scenes)):
+            target = _frame_output(output, frame, len(scenes))
+            files = sorted(folder.glob(f"frame{frame:05d}-*{suffix}"))
+            summary = vkray.merge(target, files)
+            if summary["mixed_devices"]:
+                print("vkray.farm: warning: the parts were rendered on more than one device: the image agrees with a "
+                      "single render within parity, not bit for bit", file=sys.stderr)
+            _log(args.quiet, f"wrote {target}")
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    _log(args.quiet, f"{len(jobs)} parts rendered in {rendered:.2f} s, merged in "
+                     f"{time.perf_counter() - started - rendered:.2f} s")
+    return 0
+
+
+def _render_parts(args: argparse.Namespace, jobs: list, settings: dict[str, Any], suffix: str, folder: Path) -> None:
+    """Runs every job as a Dask task and writes each part to `folder` as it arrives; raises the first
+    failure (vkray's exception, or the cluster's) after cancelling the rest."""
+    import distributed
+
+    client, cluster = _connect(args)
+    try:
+        frames = len({job[0] for job in jobs})
+        _log(args.quiet, f"{len(jobs)} parts ({frames} frame{'s' if frames > 1 else ''} x {len(jobs) // frames} bands) "
+                         f"on {len(client.scheduler_info()['workers'])} workers")
+        run_id = uuid.uuid4().hex[:8]
+        # The task by its module's name, so that Dask sends a reference the workers import, not this
+        # module's code (when it runs as __main__, `python3 -m vkray.farm`).
+        task = importlib.import_module("vkray.farm")._render_part
+        futures = {}
+        for frame, index, scene, region in jobs:
+            future = client.submit(task, scene, region, settings, suffix, key=f"vkray-{run_id}-{frame}-{index}",
+                                   resources={"GPU": 1}, pure=False)
+            futures[future] = (frame, index, region)
+        done = 0
+        for future in distributed.as_completed(list(futures)):
+            frame, index, region = futures.pop(future)
+            if future.status != "finished":
+                error = future.exception()
+                for other in futures:
+                    other.cancel()
+                raise error
+            part = future.result()
+            future.release()
+            file = folder / f"frame{frame:05d}-part{index:05d}{suffix}"
+            file.write_bytes(part["data"])
+            if part["record"] is not None:
+                file.with_name(file.name + ".json").write_bytes(part["record"])
+            done += 1
+            _log(args.quiet, f"{done}/{len(jobs)} parts: frame {frame} rows {region[1]}-{region[3] - 1} in "
+                             f"{part['seconds']:.2f} s ({part['stats'].get('trace_seconds', 0):.2f} s tracing) by "
+                             f"{part['worker']} on {part['device']}")
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+# vkray's exit code for each kind of error, as the command line has them.
+_EXIT_CODES = ((_Usage, 2), (vkray.SceneError, 1), (vkray.UsageError, 2), (vkray.DeviceError, 3), (vkray.InternalError, 70))
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    try:
+        return run(argv)
+    except KeyboardInterrupt:
+        print("vkray.farm: interrupted; nothing written", file=sys.stderr)
+        return 130
+    except Exception as e:
+        for kind, code in _EXIT_CODES:
+            if isinstance(e, kind):
+                print(f"vkray.farm: error: {e}", file=sys.stderr)
+                return code
+        # The cluster's: a scheduler out of reach, a worker lost too often (KilledWorker).
+        print(f"vkray.farm: error: {type(e).__name__}: {e}", file=sys.stderr)
+        return 3
+
+
+if __name__ == "__main__":
+    sys.exit(main())
