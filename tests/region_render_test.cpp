@@ -128,6 +128,11 @@ TEST(RegionCliTest, PixelBoundsRenderJustThosePixels) {
   const CommandResult run = vkray("render " + scene + " --region 10,20,30,25 -o part.pfm", dir.path());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_TRUE(same_crop(read_pfm(dir / "part.pfm"), read_pfm(dir / "whole.pfm"), {10, 20, 30, 25}));
+  // One band of one is a part too: the whole image, with its record.
+  ASSERT_EQ(vkray("render " + scene + " --region 0/1 -o one.pfm", dir.path()).exit_code, 0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "one.pfm.json"));
+  ASSERT_EQ(vkray("merge merged.pfm one.pfm", dir.path()).exit_code, 0);
+  EXPECT_EQ(file_bytes(dir / "merged.pfm"), file_bytes(dir / "whole.pfm"));
   // The CPU reference renders regions too.
   ASSERT_EQ(vkray("render " + scene + " --renderer cpu --region 0/2 -o cpu0.pfm", dir.path()).exit_code, 0);
   ASSERT_EQ(vkray("render " + scene + " --renderer cpu --region 1/2 -o cpu1.pfm", dir.path()).exit_code, 0);

@@ -24,8 +24,9 @@ struct MergedImage {
 };
 
 // Throws InputError naming the part and what differs: no parts; a part of another scene, image
-// size, sample count, seed or vkray version than the first; different passes or file type; two parts that overlap (named, with the overlap); pixels no part covers (the first
-// such row and columns).
+// size, sample count, seed or vkray version than the first; different passes or file type; two
+// parts that overlap (both named, with the pixels they share); pixels no part covers (the first
+// such row, and its columns).
 MergedImage merge_parts(const std::vector<Part>& parts);
 
 struct MergeSummary {

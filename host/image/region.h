@@ -19,9 +19,6 @@ struct PixelRegion {
   bool within(uint32_t image_width, uint32_t image_height) const {
     return !empty() && x1 <= image_width && y1 <= image_height;
   }
-  bool covers(uint32_t image_width, uint32_t image_height) const {
-    return x0 == 0 && y0 == 0 && x1 == image_width && y1 == image_height;
-  }
   bool operator==(const PixelRegion&) const = default;
 };
 

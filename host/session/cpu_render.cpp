@@ -32,6 +32,7 @@ RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, con
   RenderResult result;
   result.settings = settings;
   result.region = reference.region;
+  result.part = options.region.has_value();
   result.image = std::move(reference.image);
   result.aovs = std::move(reference.aovs);
   result.stats.trace_seconds = reference.seconds;

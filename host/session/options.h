@@ -73,6 +73,7 @@ struct RenderResult {
   std::optional<Aovs> aovs;  // when RenderOptions::aovs asked for them
   ImageSettings settings;    // the full image's, overrides applied
   PixelRegion region;        // the pixels rendered, in the full image's coordinates
+  bool part = false;         // RenderOptions::region asked for them (even all of them): a part of a render
   RenderStats stats;
 };
 

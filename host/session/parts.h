@@ -28,9 +28,7 @@ PartRecord part_record(const Scene& scene, const RenderResult& result, const std
 void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const ExrContent& content,
                   const std::string& device);
 
-// Whether a render of `result`'s region is a part of a larger image.
-inline bool is_part(const RenderResult& result) {
-  return !result.region.covers(result.settings.width, result.settings.height);
-}
+// Whether `result` is a part of a render (RenderOptions::region), written with its record.
+inline bool is_part(const RenderResult& result) { return result.part; }
 
 }  // namespace vkray

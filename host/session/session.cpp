@@ -206,6 +206,7 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
   check_validation("render");
   result.settings = request.image;
   result.region = request.region;
+  result.part = options.region.has_value();
   result.stats.upload_seconds = trace.upload_seconds;
   result.stats.trace_seconds = trace.trace_seconds;
   result.stats.readback_seconds = trace.readback_seconds;
