@@ -219,6 +219,7 @@ def _render_parts(args: argparse.Namespace, jobs: list, settings: dict[str, Any]
                                    resources={"GPU": 1}, pure=False)
             futures[future] = (frame, index, region)
         done = 0
+        part_seconds = trace_seconds = 0.0
         for future in distributed.as_completed(list(futures)):
             frame, index, region = futures.pop(future)
             if future.status != "finished":
@@ -233,9 +234,12 @@ def _render_parts(args: argparse.Namespace, jobs: list, settings: dict[str, Any]
             if part["record"] is not None:
                 file.with_name(file.name + ".json").write_bytes(part["record"])
             done += 1
+            part_seconds += part["seconds"]
+            trace_seconds += part["stats"].get("trace_seconds", 0)
             _log(args.quiet, f"{done}/{len(jobs)} parts: frame {frame} rows {region[1]}-{region[3] - 1} in "
                              f"{part['seconds']:.2f} s ({part['stats'].get('trace_seconds', 0):.2f} s tracing) by "
                              f"{part['worker']} on {part['device']}")
+        _log(args.quiet, f"the parts took {part_seconds:.2f} s on the workers, {trace_seconds:.2f} s of it tracing")
     finally:
         client.close()
         if cluster is not None:
