@@ -11,12 +11,13 @@ import sys
 import time
 from pathlib import Path
 
+import distributed
+import numpy as np
+import OpenImageIO as oiio
 import pytest
 
 import vkray
 from conftest import run
-
-import distributed
 
 # Every test renders the Cornell box with paths: cheap, and noisy, so that any wrong sample shows.
 RENDER = ["--width", "64", "--height", "48", "--spp", "8"]
@@ -186,6 +187,16 @@ def test_bands_and_merge_from_python(scenes, tmp_path):
             r.render_to_file(scene, parts[-1], width=64, height=48, region=band)
         whole = r.render(scene, width=64, height=48)
         assert r.render(scene, width=64, height=48, region="1/3").shape == (bands[1][3] - bands[1][1], 64, 3)
+    # An EXR part is the data window of the full display window, to a reader that is not vkray's.
+    image = oiio.ImageInput.open(str(parts[1]))
+    spec = image.spec()
+    pixels = image.read_image(oiio.FLOAT)
+    image.close()
+    assert (spec.x, spec.y, spec.width, spec.height) == (0, bands[1][1], 64, bands[1][3] - bands[1][1])
+    assert (spec.full_x, spec.full_y, spec.full_width, spec.full_height) == (0, 0, 64, 48)
+    assert '"scene_digest"' in spec.get_string_attribute("vkray.part")
+    rows = whole[bands[1][1]:bands[1][3]].astype(np.float16).astype(np.float32)
+    assert np.array_equal(pixels[:, :, :3], rows)
     summary = vkray.merge(tmp_path / "m.exr", parts)
     assert summary["parts"] == 3 and not summary["mixed_devices"]
     with pytest.raises(vkray.SceneError, match="no part covers"):
