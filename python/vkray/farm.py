@@ -104,7 +104,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, help="the whole image: .exr, .pfm or .png; with --frames, "
                    "frame N goes to OUT with .NNNN before the suffix")
     p.add_argument("--regions", type=int, default=None,
-                   help="bands per frame (default: twice the workers, at least 2)")
+                   help="bands per frame (default: twice the GPUs the workers declare, at least 2)")
     p.add_argument("--frames", nargs="+", default=[], metavar="SCENE", help="more scenes, rendered as frames 1, 2, ...")
     p.add_argument("--scheduler", help="address of a Dask scheduler (tcp://host:8786); default: a LocalCluster here")
     p.add_argument("--workers", type=int, default=1,
@@ -162,26 +162,36 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         raise _Usage(f"{output}: folder {output.parent} does not exist")
     if args.workers < 1:
         raise _Usage(f"--workers {args.workers}: at least 1")
-    regions = args.regions if args.regions is not None else max(2, 2 * args.workers)
+    if args.regions is not None and args.regions < 1:
+        raise _Usage(f"--regions {args.regions}: at least 1")
     settings = {"width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed, "aovs": args.aov,
                 "exr_float": args.exr_float}
-
-    # Every frame's bands, here, before any worker starts: a bad scene fails at once, and every part
-    # of a frame gets its bounds from one computation.
+    # Every scene read here first, so that a bad one fails before any worker starts.
     scenes = [str(Path(s).resolve()) for s in [args.scene, *args.frames]]
-    jobs = []  # (frame, band index, scene, region)
-    for frame, scene in enumerate(scenes):
-        for index, region in enumerate(vkray.bands(scene, regions, width=args.width, height=args.height)):
-            jobs.append((frame, index, scene, region))
+    for scene in scenes:
+        rows = vkray.bands(scene, 1, width=args.width, height=args.height)[0][3]
+        if args.regions is not None and args.regions > rows:
+            raise _Usage(f"--regions {args.regions}: {scene} renders {rows} rows, and a band has at least one row, "
+                         f"so 1 to {rows}")
 
     import distributed
 
+    client, cluster = _connect(args)
     # The parts go to disk as they arrive (the client holds none for long, however many frames), in
     # a folder beside the output, removed at the end whatever happens.
     folder = Path(tempfile.mkdtemp(prefix=f".{output.name}.parts-", dir=output.parent))
     try:
         started = time.perf_counter()
-        _render_parts(args, jobs, settings, suffix, folder)
+        gpus = sum(int(w.get("resources", {}).get("GPU", 0)) for w in client.scheduler_info()["workers"].values())
+        regions = args.regions if args.regions is not None else max(2, 2 * gpus)
+        # Each frame's bands computed once, here, for all its parts.
+        jobs = []  # (frame, band index, scene, region)
+        for frame, scene in enumerate(scenes):
+            for index, region in enumerate(vkray.bands(scene, regions, width=args.width, height=args.height)):
+                jobs.append((frame, index, scene, region))
+        _log(args.quiet, f"{len(jobs)} parts ({len(scenes)} frame{'s' if len(scenes) > 1 else ''} x {regions} bands) on "
+                         f"{len(client.scheduler_info()['workers'])} workers with {gpus} GPU{'s' if gpus != 1 else ''}")
+        _render_parts(client, args.quiet, jobs, settings, suffix, folder)
         rendered = time.perf_counter() - started
         # Every part is here: now, and only now, the outputs are written.
         for frame in range(len(scenes)):
@@ -194,56 +204,49 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
             _log(args.quiet, f"wrote {target}")
     finally:
         shutil.rmtree(folder, ignore_errors=True)
+        client.close()
+        if cluster is not None:
+            cluster.close()
     _log(args.quiet, f"{len(jobs)} parts rendered in {rendered:.2f} s, merged in "
                      f"{time.perf_counter() - started - rendered:.2f} s")
     return 0
 
 
-def _render_parts(args: argparse.Namespace, jobs: list, settings: dict[str, Any], suffix: str, folder: Path) -> None:
+def _render_parts(client: Any, quiet: bool, jobs: list, settings: dict[str, Any], suffix: str, folder: Path) -> None:
     """Runs every job as a Dask task and writes each part to `folder` as it arrives; raises the first
     failure (vkray's exception, or the cluster's) after cancelling the rest."""
     import distributed
 
-    client, cluster = _connect(args)
-    try:
-        frames = len({job[0] for job in jobs})
-        _log(args.quiet, f"{len(jobs)} parts ({frames} frame{'s' if frames > 1 else ''} x {len(jobs) // frames} bands) "
-                         f"on {len(client.scheduler_info()['workers'])} workers")
-        run_id = uuid.uuid4().hex[:8]
-        # The task by its module's name, so that Dask sends a reference the workers import, not this
-        # module's code (when it runs as __main__, `python3 -m vkray.farm`).
-        task = importlib.import_module("vkray.farm")._render_part
-        futures = {}
-        for frame, index, scene, region in jobs:
-            future = client.submit(task, scene, region, settings, suffix, key=f"vkray-{run_id}-{frame}-{index}",
-                                   resources={"GPU": 1}, pure=False)
-            futures[future] = (frame, index, region)
-        done = 0
-        part_seconds = trace_seconds = 0.0
-        for future in distributed.as_completed(list(futures)):
-            frame, index, region = futures.pop(future)
-            if future.status != "finished":
-                error = future.exception()
-                for other in futures:
-                    other.cancel()
-                raise error
-            part = future.result()
-            future.release()
-            file = folder / f"frame{frame:05d}-part{index:05d}{suffix}"
-            file.write_bytes(part["data"])
-            if part["record"] is not None:
-                file.with_name(file.name + ".json").write_bytes(part["record"])
-            done += 1
-            part_seconds += part["seconds"]
-            trace_seconds += part["stats"].get("trace_seconds", 0)
-            _log(args.quiet, f"{done}/{len(jobs)} parts: frame {frame} rows {region[1]}-{region[3] - 1} in "
-                             f"{part['seconds']:.2f} s ({part['stats'].get('trace_seconds', 0):.2f} s tracing) by "
-                             f"{part['worker']} on {part['device']}")
-        _log(args.quiet, f"the parts took {part_seconds:.2f} s on the workers, {trace_seconds:.2f} s of it tracing")
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+    run_id = uuid.uuid4().hex[:8]
+    # The task by its module's name, so that Dask sends a reference the workers import, not this
+    # module's code (when it runs as __main__, `python3 -m vkray.farm`).
+    task = importlib.import_module("vkray.farm")._render_part
+    futures = {}
+    for frame, index, scene, region in jobs:
+        future = client.submit(task, scene, region, settings, suffix, key=f"vkray-{run_id}-{frame}-{index}",
+                               resources={"GPU": 1}, pure=False)
+        futures[future] = (frame, index, region)
+    done = 0
+    part_seconds = trace_seconds = 0.0
+    for future in distributed.as_completed(list(futures)):
+        frame, index, region = futures.pop(future)
+        if future.status != "finished":
+            error = future.exception()
+            for other in futures:
+                other.cancel()
+            raise error
+        part = future.result()
+        future.release()
+        file = folder / f"frame{frame:05d}-part{index:05d}{suffix}"
+        file.write_bytes(part["data"])
+        if part["record"] is not None:
+            file.with_name(file.name + ".json").write_bytes(part["record"])
+        done += 1
+        part_seconds += part["seconds"]
+        trace_seconds += part["stats"].get("trace_seconds", 0)
+        _log(quiet, f"{done}/{len(jobs)} parts: frame {frame} rows {region[1]}-{region[3] - 1} in {part['seconds']:.2f} s "
+                    f"({part['stats'].get('trace_seconds', 0):.2f} s tracing) by {part['worker']} on {part['device']}")
+    _log(quiet, f"the parts took {part_seconds:.2f} s on the workers, {trace_seconds:.2f} s of it tracing")
 
 
 # vkray's exit code for each kind of error, as the command line has them.
