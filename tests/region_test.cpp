@@ -110,6 +110,14 @@ TEST(RegionTest, BandsFollowTheWorkNotTheRows) {
   EXPECT_EQ(resolve_region(scene, {48, 64, 1, 0}, Band{3, 4}), bands[3]);
 }
 
+TEST(RegionTest, BandsDoNotDependOnTheSeed) {
+  // A path tracer's paths end at random: the probe that weighs the rows must not follow the seed,
+  // or `--region I/N` would name other pixels for another seed.
+  const Scene scene = load_scene(kScenes / "cornell-path.json");
+  const std::vector<PixelRegion> bands = work_bands(scene, {64, 64, 1, 0}, 8);
+  for (const uint32_t seed : {1u, 7u, 123456u}) EXPECT_EQ(work_bands(scene, {64, 64, 1, seed}, 8), bands) << seed;
+}
+
 // ---- the CPU reference's regions ---------------------------------------------------------------
 
 TEST(RegionTest, ACpuRegionIsTheWholeRenderCroppedBitForBit) {
@@ -166,7 +174,7 @@ struct Rendered {
 // The sky scene on the CPU, whole and as parts cut by `regions`, each written to `dir` as `suffix`.
 std::vector<std::filesystem::path> write_parts(const Rendered& r, const std::vector<PixelRegion>& regions,
                                                const std::filesystem::path& dir, const std::string& suffix,
-                                               const ExrContent& content = {}) {
+                                               const ExrContent& content = {}, const std::string& shader = "") {
   std::vector<std::filesystem::path> files;
   for (size_t i = 0; i < regions.size(); ++i) {
     RenderOptions options;
@@ -174,7 +182,7 @@ std::vector<std::filesystem::path> write_parts(const Rendered& r, const std::vec
     options.aovs = !content.passes.empty();
     options.region = regions[i];
     const RenderResult part = render_on_cpu(r.scene, options);
-    PartRecord record{scene_digest(r.scene), 48, 64, regions[i], 2, 0, "test", "CPU reference"};
+    PartRecord record{scene_digest(r.scene), 48, 64, regions[i], 2, 0, "test", "CPU reference", shader, ""};
     files.push_back(dir / ("part" + std::to_string(i) + suffix));
     write_part(files.back(), part.image, part.aovs ? &*part.aovs : nullptr, content, record);
   }
@@ -247,7 +255,7 @@ TEST(MergeTest, RefusesOverlapsAndGapsNamingThePixels) {
 TEST(MergeTest, RefusesPartsOfAnotherRenderNamingWhatDiffers) {
   TempDir dir;
   const Rendered r = rendered();
-  const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm");
+  const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm", {}, "spirv1");
   // Each field of the second part's record changed in turn.
   const std::string record = file_bytes(sidecar_of(files[1]));
   for (const auto& [from, to, says] : std::vector<std::tuple<std::string, std::string, std::string>>{
@@ -255,7 +263,8 @@ TEST(MergeTest, RefusesPartsOfAnotherRenderNamingWhatDiffers) {
            {"\"width\":48", "\"width\":49", "of an image of 49 x 64, not 48 x 64"},
            {"\"spp\":2", "\"spp\":3", "samples per pixel 3, not 2"},
            {"\"seed\":0", "\"seed\":7", "seed 7, not 0"},
-           {"\"vkray_version\":\"test\"", "\"vkray_version\":\"other\"", "rendered by vkray other, not test"}}) {
+           {"\"vkray_version\":\"test\"", "\"vkray_version\":\"other\"", "rendered by vkray other, not test"},
+           {"\"shader\":\"spirv1\"", "\"shader\":\"spirv2\"", "traced by other shaders: SPIR-V spirv2, not spirv1"}}) {
     std::string edited = record;
     edited.replace(edited.find(from), from.size(), to);
     std::ofstream(sidecar_of(files[1]), std::ios::trunc) << edited;
@@ -263,6 +272,36 @@ TEST(MergeTest, RefusesPartsOfAnotherRenderNamingWhatDiffers) {
     EXPECT_NE(message.find("part1.pfm"), std::string::npos) << message;
     EXPECT_NE(message.find(says), std::string::npos) << message;
   }
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.pfm"));
+}
+
+TEST(MergeTest, ACpuReferencePartJoinsGpuPartsWithAWarning) {
+  // The CPU reference has no shader: its part may join parts a GPU traced, and the merge says that
+  // the image is then the render's within parity only.
+  TempDir dir;
+  const Rendered r = rendered();
+  auto files = write_parts(r, {{0, 0, 48, 32}}, dir.path(), ".pfm", {}, "");
+  std::filesystem::create_directory(dir / "gpu");
+  const auto gpu = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir / "gpu", ".pfm", {}, "spirv1");
+  std::string record = file_bytes(sidecar_of(gpu[1]));
+  record.replace(record.find("CPU reference"), std::strlen("CPU reference"), "a GPU (driver 1)");
+  std::ofstream(sidecar_of(gpu[1]), std::ios::trunc) << record;
+  files.push_back(gpu[1]);
+  EXPECT_TRUE(merge_part_files(dir / "m.pfm", files).mixed_devices);
+}
+
+TEST(MergeTest, APfmWrittenAgainAfterItsRecordIsRefused) {
+  // The sidecar holds the hash of the pixels it was written with: another render's pixels under the
+  // same name (a rerun that failed half-way, a copy from elsewhere) do not pass for the part.
+  TempDir dir;
+  const Rendered r = rendered();
+  const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm");
+  Image other(48, 32);
+  other.at(5, 5) = glm::vec3(1.0f);
+  write_image(other, files[0]);
+  const std::string message = error_of([&] { merge_part_files(dir / "m.pfm", files); });
+  EXPECT_NE(message.find("part0.pfm: its pixels are not the ones its record part0.pfm.json was written with"),
+            std::string::npos) << message;
   EXPECT_FALSE(std::filesystem::exists(dir / "m.pfm"));
 }
 
@@ -276,15 +315,17 @@ TEST(MergeTest, RefusesFilesThatAreNotPartsNamingThem) {
   EXPECT_NE(error_of([&] { read_part(dir / "whole.png"); }).find("parts are the .exr or .pfm files"), std::string::npos);
   std::filesystem::remove(sidecar_of(files[0]));
   EXPECT_NE(error_of([&] { read_part(files[0]); }).find("part0.pfm.json: not found"), std::string::npos);
-  for (const char* bad : {"{", "[]", R"({"scene_digest": 1})", R"({"scene_digest": "x", "width": -1, "height": 64, "region": [0,0,1,1], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d"})",
-                          R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,49,1], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d"})"}) {
+  for (const char* bad : {"{", "[]", R"({"scene_digest": 1})", R"({"scene_digest": "x", "width": -1, "height": 64, "region": [0,0,1,1], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d", "shader": ""})",
+                          R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,49,1], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d", "shader": ""})",
+                          R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,48,64], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d"})",
+                          R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,48,64], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d", "shader": ""})"}) {
     std::ofstream(sidecar_of(files[0]), std::ios::trunc) << bad;
     const std::string message = error_of([&] { read_part(files[0]); });
     EXPECT_NE(message.find("part0.pfm.json: the part's record"), std::string::npos) << bad << ": " << message;
   }
   // A record whose region is not the picture's size.
   std::ofstream(sidecar_of(files[0]), std::ios::trunc)
-      << R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,48,32], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d"})";
+      << R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,48,32], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d", "shader": "", "pixels": "x"})";
   EXPECT_NE(error_of([&] { read_part(files[0]); }).find("48 x 64 pixels, but its record names region 0,0,48,32"),
             std::string::npos);
   EXPECT_NE(error_of([] { merge_parts({}); }).find("no parts"), std::string::npos);

@@ -96,7 +96,7 @@ int run_parity(const ParityArgs& args) {
   session.close();
 
   int max_steps = 0;
-  const bool diff_is_pfm = args.diff.extension() == ".pfm";
+  const bool diff_is_pfm = is_pfm(args.diff);
   if (!args.diff.empty()) max_steps = write_difference(result, args.diff);
   if (args.json) {
     nlohmann::json j = parity_json(result, loaded.scene->file.string(), device);

@@ -188,12 +188,13 @@ ExrFile read_exr(const std::filesystem::path& file) {
     Imf::InputFile exr(file.c_str());
     const Imath::Box2i window = exr.header().dataWindow();
     const int64_t w = int64_t(window.max.x) - window.min.x + 1, h = int64_t(window.max.y) - window.min.y + 1;
-    if (w <= 0 || h <= 0 || w > 65536 || h > 65536)
+    // Checked before anything is allocated for it: a small file can claim a huge window.
+    if (w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide)
       throw InputError(file.string() + ": an EXR data window of " + std::to_string(w) + " x " + std::to_string(h) +
-                       " pixels (vkray reads up to 65536 on a side)");
+                       " pixels (vkray reads up to " + std::to_string(kMaxImageSide) + " on a side)");
     const Imath::Box2i display = exr.header().displayWindow();
-    if (display.min.x == 0 && display.min.y == 0 && window.min.x >= 0 && window.min.y >= 0 && display.max.x < 65536 &&
-        display.max.y < 65536) {
+    if (display.min.x == 0 && display.min.y == 0 && window.min.x >= 0 && window.min.y >= 0 && display.max.x < int(kMaxImageSide) &&
+        display.max.y < int(kMaxImageSide) && window.max.x <= display.max.x && window.max.y <= display.max.y) {
       result.window.full_width = uint32_t(display.max.x + 1);
       result.window.full_height = uint32_t(display.max.y + 1);
       result.window.region = {uint32_t(window.min.x), uint32_t(window.min.y), uint32_t(window.max.x + 1), uint32_t(window.max.y + 1)};
@@ -205,7 +206,9 @@ ExrFile read_exr(const std::filesystem::path& file) {
       if (!channels.findChannel(name)) throw InputError(file.string() + ": no channel " + name);
     result.content.full_float = channels.findChannel("R")->type == Imf::FLOAT;
     result.image = Image(uint32_t(w), uint32_t(h));
-    result.aovs = Aovs(uint32_t(w), uint32_t(h));
+    const bool any_pass = std::any_of(kAllAovs.begin(), kAllAovs.end(),
+                                      [&](Aov pass) { return channels.findChannel(channel_name(layer_of(pass), 0)); });
+    if (any_pass) result.aovs = Aovs(uint32_t(w), uint32_t(h));
     // Slices are addressed as if the buffer started at the data window's origin.
     const auto origin = [&](char* base, size_t stride) { return base - (int64_t(window.min.x) + int64_t(window.min.y) * w) * int64_t(stride); };
     Imf::FrameBuffer frame;
@@ -213,7 +216,7 @@ ExrFile read_exr(const std::filesystem::path& file) {
     char* pixels = reinterpret_cast<char*>(result.image.pixels.data());
     for (int c = 0; c < 3; ++c)
       frame.insert(std::string(1, "RGB"[c]), Imf::Slice(Imf::FLOAT, origin(pixels + c * sizeof(float), sizeof(glm::vec3)), sizeof(glm::vec3), row));
-    std::vector<float> object_ids(size_t(w * h), -1.0f);
+    std::vector<float> object_ids(any_pass ? size_t(w * h) : 0, -1.0f);
     for (const Aov pass : kAllAovs) {
       const Layer layer = layer_of(pass);
       if (!channels.findChannel(channel_name(layer, 0))) continue;

@@ -241,6 +241,8 @@ bool is_supported_image_path(const std::filesystem::path& file) {
   return ext == ".png" || ext == ".pfm" || ext == ".exr";
 }
 
+bool is_pfm(const std::filesystem::path& file) { return lower_extension(file) == ".pfm"; }
+
 void write_image(const Image& image, const std::filesystem::path& file) {
   const std::string ext = lower_extension(file);
   if (ext == ".png") return write_png(image, file);

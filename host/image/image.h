@@ -10,6 +10,9 @@
 
 namespace vkray {
 
+// The largest side of an image vkray renders or reads: far from overflow in any size arithmetic.
+constexpr uint32_t kMaxImageSide = 16384;
+
 struct Image {
   uint32_t width = 0;
   uint32_t height = 0;
@@ -37,7 +40,8 @@ void write_image(const Image& image, const std::filesystem::path& file);
 Image read_pfm(const std::filesystem::path& file);
 Image read_png(const std::filesystem::path& file);
 
-// Whether write_image knows the file's extension.
+// Whether write_image knows the file's extension; whether it is ".pfm" (in any case).
 bool is_supported_image_path(const std::filesystem::path& file);
+bool is_pfm(const std::filesystem::path& file);
 
 }  // namespace vkray

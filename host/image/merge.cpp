@@ -33,6 +33,10 @@ std::string mismatch(const Part& first, const Part& part) {
     return differ("has samples per pixel", std::to_string(a.samples_per_pixel), std::to_string(b.samples_per_pixel));
   if (a.seed != b.seed) return differ("has seed", std::to_string(a.seed), std::to_string(b.seed));
   if (a.version != b.version) return differ("was rendered by vkray", a.version, b.version);
+  // Shaders edited between parts (a --shader-dir, `vkray watch`'s edits) make another image; a CPU
+  // reference part, which has none, may join GPU parts (within parity, as the merge then warns).
+  if (!a.shader.empty() && !b.shader.empty() && a.shader != b.shader)
+    return differ("was traced by other shaders: SPIR-V", a.shader, b.shader);
   if (first.content.passes != part.content.passes)
     return differ("has first-hit passes", pass_names(first.content), pass_names(part.content));
   if (first.exr != part.exr || first.content.full_float != part.content.full_float) {

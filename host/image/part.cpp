@@ -4,8 +4,8 @@
 
 #include "base/atomic_file.h"
 #include "base/errors.h"
+#include "base/hash.h"
 #include "base/input_file.h"
-#include "scene/scene.h"
 
 namespace vkray {
 namespace {
@@ -13,12 +13,16 @@ namespace {
 // A record is a few hundred bytes; anything much larger is not one.
 constexpr uint64_t kMaxRecordBytes = 64 << 10;
 
-const char* const kRecordKeys[] = {"scene_digest", "width", "height", "region", "spp", "seed", "vkray_version", "device"};
+const char* const kRecordKeys[] = {"scene_digest", "width", "height", "region", "spp", "seed", "vkray_version", "device", "shader"};
+
+std::string pixels_hash(const Image& image) {
+  return hash_hex(image.pixels.data(), image.pixels.size() * sizeof(glm::vec3));
+}
 
 }  // namespace
 
 std::string part_record_json(const PartRecord& r) {
-  const nlohmann::ordered_json json = {
+  nlohmann::ordered_json json = {
       {"scene_digest", r.scene_digest},
       {"width", r.width},
       {"height", r.height},
@@ -27,7 +31,9 @@ std::string part_record_json(const PartRecord& r) {
       {"seed", r.seed},
       {"vkray_version", r.version},
       {"device", r.device},
+      {"shader", r.shader},
   };
+  if (!r.pixels.empty()) json["pixels"] = r.pixels;
   return json.dump();
 }
 
@@ -58,6 +64,8 @@ PartRecord parse_part_record(const std::string& text, const std::filesystem::pat
   r.seed = number_of(json["seed"], "seed");
   r.version = text_of("vkray_version");
   r.device = text_of("device");
+  r.shader = text_of("shader");
+  if (json.contains("pixels")) r.pixels = text_of("pixels");
   if (r.width == 0 || r.height == 0 || r.width > kMaxImageSide || r.height > kMaxImageSide)
     throw InputError(where + ": an image of " + std::to_string(r.width) + " x " + std::to_string(r.height) + " pixels");
   if (!r.region.within(r.width, r.height))
@@ -78,11 +86,13 @@ void write_part(const std::filesystem::path& file, const Image& image, const Aov
     const ExrWindow window{record.width, record.height, record.region, part_record_json(record)};
     return write_exr(file, image, aovs, content, &window);
   }
-  if (file.extension() != ".pfm")
+  if (!is_pfm(file))
     throw UsageError(file.string() + ": a part of a render is an .exr or a .pfm file, so that `vkray merge` can assemble it");
   check_render_image(file, content);
+  PartRecord pfm_record = record;
+  pfm_record.pixels = pixels_hash(image);
   const std::filesystem::path sidecar = sidecar_of(file);
-  write_file_atomically(sidecar, part_record_json(record) + "\n");
+  write_file_atomically(sidecar, part_record_json(pfm_record) + "\n");
   try {
     write_image(image, file);
   } catch (...) {
@@ -101,6 +111,9 @@ Part read_part(const std::filesystem::path& file) {
       throw InputError(file.string() + ": not a part of a render (no \"vkray.part\" attribute): render parts with "
                                        "`vkray render --region`");
     part.record = parse_part_record(exr.window.part_record, file);
+    if (exr.window.full_width == 0)
+      throw InputError(file.string() + ": its display window does not start at 0,0 or does not hold its data window, "
+                                       "as a part's does");
     if (exr.window.full_width != part.record.width || exr.window.full_height != part.record.height ||
         exr.window.region != part.record.region)
       throw InputError(file.string() + ": the data window " + to_string(exr.window.region) + " of a " +
@@ -112,17 +125,22 @@ Part read_part(const std::filesystem::path& file) {
     part.content = exr.content;
     return part;
   }
-  if (file.extension() != ".pfm")
+  if (!is_pfm(file))
     throw InputError(file.string() + ": not a part of a render: parts are the .exr or .pfm files `vkray render --region` writes");
   const std::filesystem::path sidecar = sidecar_of(file);
   const InputFile record = read_input_file(sidecar, kMaxRecordBytes);
   if (!record.error.empty())
     throw InputError(sidecar.string() + ": " + record.error + " (a PFM part's record, which `vkray render --region` writes beside it)");
   part.record = parse_part_record(record.text, sidecar);
+  if (part.record.pixels.empty())
+    throw InputError(sidecar.string() + ": the part's record has no \"pixels\", which a PFM part's record has");
   part.image = read_pfm(file);
   if (part.image.width != part.record.region.width() || part.image.height != part.record.region.height())
     throw InputError(file.string() + ": " + std::to_string(part.image.width) + " x " + std::to_string(part.image.height) +
                      " pixels, but its record names region " + to_string(part.record.region));
+  if (pixels_hash(part.image) != part.record.pixels)
+    throw InputError(file.string() + ": its pixels are not the ones its record " + sidecar.filename().string() +
+                     " was written with (the image was written again, or changed, after the record)");
   return part;
 }
 

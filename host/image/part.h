@@ -25,6 +25,10 @@ struct PartRecord {
   uint32_t seed = 0;
   std::string version;   // vkray's version_string(): parts of different builds may differ in the last bit
   std::string device;    // "name (driver)", or "CPU reference": only parts of one device are bit-identical
+  std::string shader;    // the hash (base/hash.h) of the SPIR-V that traced it; empty: the CPU reference
+  // A PFM part's: the hash of its pixels as written (3 floats each, top row first), which ties the
+  // sidecar to the image beside it. Empty in an EXR part, whose record is in the image's header.
+  std::string pixels;
 };
 
 // The record as one line of JSON, and back. parse_part_record throws InputError naming `file` and
@@ -36,8 +40,8 @@ PartRecord parse_part_record(const std::string& text, const std::filesystem::pat
 std::filesystem::path sidecar_of(const std::filesystem::path& pfm);
 
 // Writes a part: an EXR (with the record and the data window; `content` as for write_exr) or a PFM
-// and its sidecar (written first, and removed again if the image cannot be written). Throws
-// UsageError for another file type, OutputError.
+// and its sidecar (with the pixels' hash; written first, and removed again if the image cannot be
+// written). Throws UsageError for another file type, OutputError.
 void write_part(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content,
                 const PartRecord& record);
 
@@ -51,7 +55,8 @@ struct Part {
 };
 
 // Reads a part written by write_part. Throws InputError naming the file: not a part (a PNG, an EXR
-// without the record, a PFM without its sidecar), a record that does not match the pixels.
+// without the record, a PFM without its sidecar), a record that does not match the pixels (their
+// region, or a PFM's pixels written after its sidecar, by another render).
 Part read_part(const std::filesystem::path& file);
 
 }  // namespace vkray

@@ -1,11 +1,8 @@
 #include "scene/digest.h"
 
-#include <cstdio>
-#include <cstring>
 #include <memory>
-#include <type_traits>
 
-#include <xxhash.h>
+#include "base/hash.h"
 
 namespace vkray {
 namespace {
@@ -21,58 +18,17 @@ static_assert(sizeof(TextureRef) == 16, "a TextureRef field is not in scene_dige
 static_assert(sizeof(Material) == 96, "a Material field is not in scene_digest");
 static_assert(sizeof(Scene) == 376, "a Scene field is not in scene_digest");
 
-// XXH3's streaming state, fed values through a buffer, so that millions of small fields cost one
-// call per 64 KiB.
-class Hasher {
+// Hasher with glm's vectors, component by component.
+class SceneHasher : public Hasher {
  public:
-  Hasher() : state_(XXH3_createState()) { XXH3_128bits_reset(state_); }
-  ~Hasher() { XXH3_freeState(state_); }
-  Hasher(const Hasher&) = delete;
-  Hasher& operator=(const Hasher&) = delete;
-
-  template <typename T>
-  void add(const T& value) {
-    static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
-    bytes(&value, sizeof(T));
-  }
-  void add(bool value) { add(uint8_t(value)); }
+  using Hasher::add;
   template <int N, typename T, glm::qualifier Q>
   void add(const glm::vec<N, T, Q>& v) {
     for (int i = 0; i < N; ++i) add(v[i]);
   }
-  void add(const std::string& text) {
-    add(uint64_t(text.size()));
-    bytes(text.data(), text.size());
-  }
-  void bytes(const void* data, size_t size) {
-    if (used_ + size > sizeof(buffer_)) flush();
-    if (size > sizeof(buffer_)) {
-      XXH3_128bits_update(state_, data, size);
-      return;
-    }
-    std::memcpy(buffer_ + used_, data, size);
-    used_ += size;
-  }
-  std::string hex() {
-    flush();
-    const XXH128_hash_t hash = XXH3_128bits_digest(state_);
-    char text[33];
-    std::snprintf(text, sizeof(text), "%016llx%016llx", static_cast<unsigned long long>(hash.high64),
-                  static_cast<unsigned long long>(hash.low64));
-    return text;
-  }
-
- private:
-  void flush() {
-    XXH3_128bits_update(state_, buffer_, used_);
-    used_ = 0;
-  }
-  XXH3_state_t* state_;
-  unsigned char buffer_[1 << 16];
-  size_t used_ = 0;
 };
 
-void add(Hasher& h, const TextureRef& t) {
+void add(SceneHasher& h, const TextureRef& t) {
   h.add(t.texture);
   h.add(t.wrap_s);
   h.add(t.wrap_t);
@@ -82,7 +38,7 @@ void add(Hasher& h, const TextureRef& t) {
 }  // namespace
 
 std::string scene_digest(const Scene& scene) {
-  auto h = std::make_unique<Hasher>();  // its buffer is too large for a thread's stack to hold lightly
+  auto h = std::make_unique<SceneHasher>();  // its buffer is too large for a thread's stack to hold lightly
   // A version of this layout: bump it when the order or the meaning of what is hashed changes.
   h->add(std::string("vkray scene digest 1"));
   const Camera& c = scene.camera;

@@ -15,13 +15,13 @@
 
 #include <glm/glm.hpp>
 
+#include "image/image.h"
 #include "scene/texture.h"
 
 namespace vkray {
 
-// Upper bounds of a scene's image settings, which keep later size arithmetic far from overflow; the
-// device's own limits are checked again before anything is allocated.
-constexpr uint32_t kMaxImageSide = 16384;
+// Upper bounds of a scene's image settings (and kMaxImageSide, image/image.h), which keep later size
+// arithmetic far from overflow; the device's own limits are checked again before anything is allocated.
 constexpr uint32_t kMaxSamplesPerPixel = 65536;
 // The largest max_depth and rr_depth a path integrator takes (-1, no limit, is allowed too).
 constexpr int32_t kMaxPathDepth = 1024;

@@ -74,6 +74,7 @@ struct RenderResult {
   ImageSettings settings;    // the full image's, overrides applied
   PixelRegion region;        // the pixels rendered, in the full image's coordinates
   bool part = false;         // RenderOptions::region asked for them (even all of them): a part of a render
+  std::string shader;        // the hash (base/hash.h) of the SPIR-V that traced it; empty: the CPU reference
   RenderStats stats;
 };
 

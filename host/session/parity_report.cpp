@@ -54,7 +54,7 @@ nlohmann::json parity_json(const ParityResult& r, const std::string& scene, cons
 
 int write_difference(const ParityResult& r, const std::filesystem::path& file) {
   int max_steps = 0;
-  write_image(file.extension() == ".pfm" ? absolute_difference(r.gpu.image, r.cpu.image)
+  write_image(is_pfm(file) ? absolute_difference(r.gpu.image, r.cpu.image)
                                          : difference_heatmap(r.gpu.image, r.cpu.image, max_steps),
               file);
   return max_steps;

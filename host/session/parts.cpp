@@ -16,11 +16,12 @@ PartRecord part_record(const Scene& scene, const RenderResult& result, const std
   record.seed = result.settings.seed;
   record.version = version_string();
   record.device = device;
+  record.shader = result.shader;
   return record;
 }
 
 void check_part_file(const std::filesystem::path& file) {
-  if (!is_exr(file) && file.extension() != ".pfm")
+  if (!is_exr(file) && !is_pfm(file))
     throw UsageError(file.string() + ": a region of a render is written as a part for `vkray merge`: name the output "
                                      "*.exr or *.pfm");
 }

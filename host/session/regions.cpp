@@ -64,6 +64,9 @@ std::vector<PixelRegion> work_bands(const Scene& scene, const ImageSettings& ima
   // units of the image height).
   probe.width = uint32_t(std::clamp(std::lround(double(image.width) * probe.height / image.height), 1l, long(kProbeMaxColumns)));
   probe.samples_per_pixel = 1;
+  // A fixed seed: the bands of a render must not change with its seed (a path's length is random),
+  // so that `--region I/N` names the same pixels for every seed, and frames of one view share them.
+  probe.seed = 0;
   cpu::ReferenceOptions options;
   options.bvh = bvh;
   // One thread: the probe is small, and the rays it counts do not depend on threads anyway.

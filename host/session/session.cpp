@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "base/errors.h"
+#include "base/hash.h"
 #include "base/timing.h"
 #include "bvh/bvh.h"
 #include "gpu/context.h"
@@ -207,6 +208,8 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
   result.settings = request.image;
   result.region = request.region;
   result.part = options.region.has_value();
+  const std::vector<uint32_t>& spirv = shaders_->pipeline->shader().spirv;
+  result.shader = hash_hex(spirv.data(), spirv.size() * sizeof(uint32_t));
   result.stats.upload_seconds = trace.upload_seconds;
   result.stats.trace_seconds = trace.trace_seconds;
   result.stats.readback_seconds = trace.readback_seconds;
