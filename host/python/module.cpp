@@ -449,6 +449,8 @@ PYBIND11_MODULE(_vkray, m) {
   m.def("render_cpu", &vp::render_cpu, py::arg("source"), py::arg("request"), py::arg("threads"));
   m.def("bands", &vp::bands, py::arg("source"), py::arg("count"), py::arg("width"), py::arg("height"));
   m.def("merge", &vp::merge, py::arg("output"), py::arg("parts"));
+  m.def("_check_passes", [](const std::vector<std::string>& names) { vp::parse_passes(names); },
+        "Raises UsageError unless `names` are first-hit passes, each once.");
   m.def("parity", &vp::parity, py::arg("source"), py::arg("width"), py::arg("height"), py::arg("spp"), py::arg("seed"),
         py::arg("device"), py::arg("validate"), py::arg("threads"));
   m.def("devices", &vp::devices);

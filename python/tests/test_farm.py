@@ -1,9 +1,10 @@
 """python3 -m vkray.farm against a real Dask cluster on this machine: a scheduler and two workers,
 each a process of its own on 127.0.0.1 (started and stopped here), that declare a GPU as Dask
 resource, as workers on GPU machines would. The farm's output is compared byte for byte with a single
-`vkray render`; a worker is killed in the middle of a job, and a worker whose device fails fails the
-job cleanly."""
+`vkray render`; a worker is killed in the middle of a job (and then the only one), and a worker whose
+device fails fails the job cleanly."""
 
+import json
 import os
 import signal
 import subprocess
@@ -34,28 +35,31 @@ class Cluster:
         self.scheduler = self._start("scheduler", [sys.executable, "-m", "distributed.cli.dask_scheduler", "--host",
                                                    "127.0.0.1", "--port", "0", "--no-dashboard", "--scheduler-file",
                                                    str(self.file)])
-        deadline = time.monotonic() + 60
-        while not self.file.exists() or not self.file.read_text().strip().endswith("}"):
-            assert self.scheduler.poll() is None, self.log("scheduler")
-            assert time.monotonic() < deadline, "the scheduler did not start within 60 s"
-            time.sleep(0.1)
-        import json
-        self.address = json.loads(self.file.read_text())["address"]
+        try:
+            deadline = time.monotonic() + 60
+            while not self.file.exists() or not self.file.read_text().strip().endswith("}"):
+                assert self.scheduler.poll() is None, self.log("scheduler")
+                assert time.monotonic() < deadline, "the scheduler did not start within 60 s"
+                time.sleep(0.1)
+            self.address = json.loads(self.file.read_text())["address"]
+        except BaseException:
+            self.close()
+            raise
 
     def _start(self, name: str, command: list[str], env: dict = None) -> subprocess.Popen:
-        log = open(self.folder / f"{name}.log", "w")
-        process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
+        with open(self.folder / f"{name}.log", "w") as log:
+            process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
         self.processes.append(process)
         return process
 
     def log(self, name: str) -> str:
         return (self.folder / f"{name}.log").read_text()
 
-    def add_worker(self, name: str, **env: str) -> subprocess.Popen:
+    def add_worker(self, name: str, gpu: bool = True, **env: str) -> subprocess.Popen:
         # --no-nanny: the worker is the process; killing it loses the worker, as a crashed machine would.
         worker = self._start(name, [sys.executable, "-m", "distributed.cli.dask_worker", self.address, "--nthreads",
-                                    "1", "--no-nanny", "--no-dashboard", "--resources", "GPU=1", "--name", name],
-                             env={**os.environ, **env})
+                                    "1", "--no-nanny", "--no-dashboard", *(["--resources", "GPU=1"] if gpu else []),
+                                    "--name", name], env={**os.environ, **env})
         self.workers.append(worker)
         return worker
 
@@ -109,40 +113,74 @@ def test_four_regions_on_two_workers_merge_into_the_bytes_of_one_render(cluster,
     assert list(tmp_path.glob(".farm*")) == []
 
 
+HEAVY = ["--width", "64", "--height", "48", "--spp", "96"]
+
+
+def kill_once_busy(cluster: Cluster, name: str, victim: subprocess.Popen, job: subprocess.Popen) -> None:
+    """Kills the worker `name` once it is rendering a part of `job`."""
+    with distributed.Client(cluster.address, timeout="30s") as client:
+        deadline = time.monotonic() + 120
+        while True:
+            workers = client.scheduler_info()["workers"]
+            busy = {workers[w]["name"]: keys for w, keys in client.processing().items() if w in workers}
+            if busy.get(name):
+                break
+            assert job.poll() is None, job.communicate()[1]
+            assert time.monotonic() < deadline, f"{name} never got a part"
+            time.sleep(0.05)
+    victim.send_signal(signal.SIGKILL)
+
+
 def test_a_worker_killed_mid_job_has_its_part_rendered_elsewhere(cluster, scenes, vkray_command, tmp_path):
     victim = cluster.add_worker("victim")
     cluster.add_worker("survivor")
     cluster.wait_for_workers(2)
     scene = scenes / "cornell-path.json"
     out = tmp_path / "farm.pfm"
-    heavy = ["--width", "64", "--height", "48", "--spp", "96"]
-    job = farm(str(scene), *heavy, "-o", str(out), "--regions", "6", "--scheduler", cluster.address)
-    # Kill the victim once it is rendering a part.
-    with distributed.Client(cluster.address, timeout="30s") as client:
-        deadline = time.monotonic() + 120
-        while True:
-            busy = {client.scheduler_info()["workers"][w]["name"]: keys for w, keys in client.processing().items()
-                    if w in client.scheduler_info()["workers"]}
-            if busy.get("victim"):
-                break
-            assert job.poll() is None, job.communicate()[1]
-            assert time.monotonic() < deadline, "the victim never got a part"
-            time.sleep(0.05)
-    victim.send_signal(signal.SIGKILL)
+    job = farm(str(scene), *HEAVY, "-o", str(out), "--regions", "6", "--scheduler", cluster.address)
+    kill_once_busy(cluster, "victim", victim, job)
     _, err = job.communicate(timeout=300)
     assert job.returncode == 0, err
     assert "6/6 parts" in err and "by survivor on" in err, err
     single = tmp_path / "single.pfm"
-    run(vkray_command, "render", str(scene), *heavy, "-o", str(single), "-q")
+    run(vkray_command, "render", str(scene), *HEAVY, "-o", str(single), "-q")
     assert out.read_bytes() == single.read_bytes()
 
 
-def test_a_part_that_fails_fails_the_job_with_vkrays_message_and_writes_nothing(cluster, scenes, tmp_path):
-    # The worker's device does not exist: every part it takes fails as `vkray render --device` would.
-    cluster.add_worker("broken", VKRAY_DEVICE="no-such-gpu")
+def test_a_job_whose_last_gpu_worker_is_lost_fails_instead_of_waiting(cluster, scenes, tmp_path):
+    # Dask keeps a task that needs a GPU waiting for one for ever; the farm gives up after
+    # --worker-timeout seconds without any.
+    victim = cluster.add_worker("only")
     cluster.wait_for_workers(1)
+    out = tmp_path / "farm.pfm"
+    job = farm(str(scenes / "cornell-path.json"), *HEAVY, "-o", str(out), "--regions", "4", "--worker-timeout", "3",
+               "--scheduler", cluster.address)
+    kill_once_busy(cluster, "only", victim, job)
+    _, err = job.communicate(timeout=120)
+    assert job.returncode == 3, err
+    assert "no worker with a GPU has been in the cluster for 3 s" in err, err
+    assert list(tmp_path.glob("farm*")) == [] and list(tmp_path.glob(".farm*")) == []
+
+
+def test_a_cluster_without_gpu_workers_is_refused(cluster, scenes, tmp_path):
+    cluster.add_worker("cpu-only", gpu=False)
+    cluster.wait_for_workers(1)
+    job = farm(str(scenes / "cornell.json"), *RENDER, "-o", str(tmp_path / "farm.pfm"), "--scheduler", cluster.address)
+    _, err = job.communicate(timeout=120)
+    assert job.returncode == 3, err
+    assert "declares a GPU" in err and "--resources GPU=1" in err, err
+    assert list(tmp_path.glob("farm*")) == []
+
+
+def test_a_part_that_fails_fails_the_job_with_vkrays_message_and_writes_nothing(cluster, scenes, tmp_path):
+    # One worker's device does not exist: every part it takes fails as `vkray render --device` would,
+    # and the job fails although the other worker renders its parts.
+    cluster.add_worker("broken", VKRAY_DEVICE="no-such-gpu")
+    cluster.add_worker("fine")
+    cluster.wait_for_workers(2)
     out = tmp_path / "farm.exr"
-    job = farm(str(scenes / "cornell.json"), *RENDER, "-o", str(out), "--regions", "3", "--scheduler", cluster.address)
+    job = farm(str(scenes / "cornell-path.json"), *HEAVY, "-o", str(out), "--regions", "6", "--scheduler",
+               cluster.address)
     _, err = job.communicate(timeout=300)
     assert job.returncode == 3, err
     assert "vkray.farm: error:" in err and "no-such-gpu" in err, err
@@ -161,12 +199,33 @@ def test_frames_on_a_local_cluster(scenes, vkray_command, tmp_path):
         assert (tmp_path / f"frame.{frame:04d}.pfm").read_bytes() == single.read_bytes(), scene
 
 
+def test_sigterm_stops_the_job_and_writes_nothing(scenes, tmp_path):
+    out = tmp_path / "farm.pfm"
+    job = farm(str(scenes / "cornell-path.json"), "--width", "128", "--height", "96", "--spp", "256", "-o", str(out),
+               "--regions", "8")
+    # The parts' folder appears once the cluster is up.
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob(".farm.pfm.parts-*")):
+        assert job.poll() is None, job.communicate()[1]
+        assert time.monotonic() < deadline, "the farm did not start"
+        time.sleep(0.05)
+    job.send_signal(signal.SIGTERM)
+    _, err = job.communicate(timeout=120)
+    assert job.returncode == 130, err
+    assert "interrupted; nothing written" in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("args, code, says", [
     (["missing.json", "-o", "x.pfm"], 1, "missing.json"),
     (["{scenes}/cornell.json", "-o", "x.txt"], 2, "unknown image type"),
     (["{scenes}/cornell.json", "-o", "x.pfm", "--aov", "depth"], 2, "for an .exr output"),
     (["{scenes}/cornell.json", "-o", "x.pfm", "--height", "8", "--regions", "9"], 2, "1 to 8"),
-    (["{scenes}/cornell.json", "-o", "x.pfm", "--scheduler", "tcp://127.0.0.1:1"], 3, "error"),
+    (["{scenes}/cornell.json", "-o", "x.exr", "--aov", "depth,shadows"], 2, 'unknown pass "shadows"'),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--seed", "-1"], 2, "--seed: -1 is not from 0"),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--spp", "many"], 2, "--spp: 'many' is not a whole number"),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--scheduler", "tcp://127.0.0.1:1", "--worker-timeout", "2"], 3,
+     "cannot reach the scheduler at tcp://127.0.0.1:1"),
 ])
 def test_bad_jobs_fail_before_any_work_with_a_message(scenes, tmp_path, args, code, says):
     job = farm(*[a.format(scenes=scenes) for a in args], cwd=tmp_path)
@@ -186,6 +245,7 @@ def test_bands_and_merge_from_python(scenes, tmp_path):
             parts.append(tmp_path / f"p{i}.exr")
             r.render_to_file(scene, parts[-1], width=64, height=48, region=band)
         whole = r.render(scene, width=64, height=48)
+        r.render_to_file(scene, tmp_path / "whole.exr", width=64, height=48)
         assert r.render(scene, width=64, height=48, region="1/3").shape == (bands[1][3] - bands[1][1], 64, 3)
     # An EXR part is the data window of the full display window, to a reader that is not vkray's.
     image = oiio.ImageInput.open(str(parts[1]))
@@ -199,6 +259,7 @@ def test_bands_and_merge_from_python(scenes, tmp_path):
     assert np.array_equal(pixels[:, :, :3], rows)
     summary = vkray.merge(tmp_path / "m.exr", parts)
     assert summary["parts"] == 3 and not summary["mixed_devices"]
+    assert (tmp_path / "m.exr").read_bytes() == (tmp_path / "whole.exr").read_bytes()
     with pytest.raises(vkray.SceneError, match="no part covers"):
         vkray.merge(tmp_path / "gap.exr", parts[:2])
     with pytest.raises(vkray.UsageError, match="expected X0,Y0,X1,Y1"):

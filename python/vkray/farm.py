@@ -13,18 +13,22 @@ of a name from ``vkray devices``), or the best one. Workers read the scene by it
 it must be on a file system they share (as on a Slurm cluster), and import this package.
 
 A worker that is lost mid-task has its task run again elsewhere (Dask's scheduler does that, up to
-``distributed.scheduler.allowed-failures`` times); a part that fails (a bad scene, a device error)
-fails the whole job with vkray's message, and then no output is written. Exit codes are vkray's:
-0 done, 1 bad input, 2 usage, 3 device or cluster failure, 130 interrupted.
+``distributed.scheduler.allowed-failures`` times); when no worker with a GPU is left for
+``--worker-timeout`` seconds, the job fails. A part that fails (a bad scene, a device error) fails
+the whole job with vkray's message, and then no output is written: the outputs of all frames are
+written only when every part of every frame is in. Exit codes are vkray's: 0 done, 1 bad input,
+2 usage, 3 device or cluster failure, 130 interrupted (Ctrl-C or SIGTERM).
 """
 
 from __future__ import annotations
 
 import argparse
+import asyncio
 import importlib
 import logging
 import os
 import shutil
+import signal
 import sys
 import tempfile
 import threading
@@ -95,6 +99,29 @@ def _frame_output(output: Path, frame: int, frames: int) -> Path:
     return output if frames == 1 else output.with_name(f"{output.stem}.{frame:04d}{output.suffix}")
 
 
+def _whole(low: int, high: int = 2**32 - 1):
+    """An argparse type: a whole number from `low` to `high`."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{value} is not from {low} to {high}")
+        return value
+    return parse
+
+
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not 0 < value < 1e6:
+        raise argparse.ArgumentTypeError(f"{value} seconds: more than 0, less than 1e6")
+    return value
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="python3 -m vkray.farm",
@@ -103,16 +130,21 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("scene", help="scene file (.json, .gltf, .glb), read by every worker at its absolute path")
     p.add_argument("-o", "--output", required=True, help="the whole image: .exr, .pfm or .png; with --frames, "
                    "frame N goes to OUT with .NNNN before the suffix")
-    p.add_argument("--regions", type=int, default=None,
-                   help="bands per frame (default: twice the GPUs the workers declare, at least 2)")
+    p.add_argument("--regions", type=_whole(1), default=None,
+                   help="bands per frame (default: twice the GPUs the workers declare, at least 2, at most the rows)")
     p.add_argument("--frames", nargs="+", default=[], metavar="SCENE", help="more scenes, rendered as frames 1, 2, ...")
     p.add_argument("--scheduler", help="address of a Dask scheduler (tcp://host:8786); default: a LocalCluster here")
-    p.add_argument("--workers", type=int, default=1,
-                   help="LocalCluster worker processes, each with a GPU slot (default 1; one per GPU of this machine)")
-    p.add_argument("--width", type=int)
-    p.add_argument("--height", type=int)
-    p.add_argument("--spp", type=int)
-    p.add_argument("--seed", type=int)
+    p.add_argument("--workers", type=_whole(1, 256), default=1,
+                   help="LocalCluster worker processes (default 1). Each opens the device VKRAY_DEVICE names, or the "
+                        "best one: more than one shares that GPU, which helps only a device that one process "
+                        "leaves idle")
+    p.add_argument("--worker-timeout", type=_seconds, default=60.0, metavar="SECONDS",
+                   help="how long to wait for the scheduler, and for a worker with a GPU when the cluster has none "
+                        "(default 60)")
+    p.add_argument("--width", type=_whole(1))
+    p.add_argument("--height", type=_whole(1))
+    p.add_argument("--spp", type=_whole(1))
+    p.add_argument("--seed", type=_whole(0))
     p.add_argument("--aov", default="", help="first-hit passes for an .exr output, comma-separated")
     p.add_argument("--exr-float", action="store_true", help="32-bit float channels in an .exr output")
     p.add_argument("-q", "--quiet", action="store_true", help="print only errors")
@@ -128,21 +160,35 @@ def _log(quiet: bool, line: str) -> None:
         print(f"vkray.farm: {line}", file=sys.stderr, flush=True)
 
 
+class _ClusterError(Exception):
+    """The cluster cannot do the job: no workers, none with a GPU, all of them lost."""
+
+
+def _gpu_workers(client: Any) -> int:
+    return sum(1 for w in client.scheduler_info()["workers"].values() if w.get("resources", {}).get("GPU", 0) >= 1)
+
+
 def _connect(args: argparse.Namespace):  # -> (Client, cluster or None)
     import distributed
 
     if args.scheduler:
-        client = distributed.Client(args.scheduler, timeout="30s")
+        import dask
+
         try:
-            client.wait_for_workers(1, timeout=60)
+            # The connection's own timeout (30 s in Dask's configuration) bounds each attempt.
+            with dask.config.set({"distributed.comm.timeouts.connect": f"{args.worker_timeout}s"}):
+                client = distributed.Client(args.scheduler, timeout=f"{args.worker_timeout}s")
+        except OSError as e:
+            raise _ClusterError(f"cannot reach the scheduler at {args.scheduler}: {e}") from None
+        try:
+            client.wait_for_workers(1, timeout=args.worker_timeout)
         except Exception:
             client.close()
-            raise RuntimeError(f"no worker joined the scheduler at {args.scheduler} within 60 s") from None
-        gpus = [w for w in client.scheduler_info()["workers"].values() if w.get("resources", {}).get("GPU", 0) >= 1]
-        if not gpus:
+            raise _ClusterError(f"no worker joined the scheduler at {args.scheduler} within {args.worker_timeout:g} s") from None
+        if not _gpu_workers(client):
             client.close()
-            raise RuntimeError(f"no worker of the scheduler at {args.scheduler} declares a GPU: start workers with "
-                               f"`dask worker {args.scheduler} --resources GPU=1`")
+            raise _ClusterError(f"no worker of the scheduler at {args.scheduler} declares a GPU: start workers with "
+                                f"`dask worker {args.scheduler} --resources GPU=1`")
         return client, None
     cluster = distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
                                        resources={"GPU": 1}, dashboard_address=None,
@@ -158,32 +204,28 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         raise _Usage(f"{output}: unknown image type (expected .exr, .pfm or .png)")
     if (args.aov or args.exr_float) and suffix != ".exr":
         raise _Usage(f"{output}: first-hit passes and --exr-float are for an .exr output")
+    if args.aov:
+        vkray._vkray._check_passes(args.aov.split(","))
     if not output.parent.is_dir():
         raise _Usage(f"{output}: folder {output.parent} does not exist")
-    if args.workers < 1:
-        raise _Usage(f"--workers {args.workers}: at least 1")
-    if args.regions is not None and args.regions < 1:
-        raise _Usage(f"--regions {args.regions}: at least 1")
     settings = {"width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed, "aovs": args.aov,
                 "exr_float": args.exr_float}
     # Every scene read here first, so that a bad one fails before any worker starts.
     scenes = [str(Path(s).resolve()) for s in [args.scene, *args.frames]]
-    for scene in scenes:
-        rows = vkray.bands(scene, 1, width=args.width, height=args.height)[0][3]
-        if args.regions is not None and args.regions > rows:
-            raise _Usage(f"--regions {args.regions}: {scene} renders {rows} rows, and a band has at least one row, "
-                         f"so 1 to {rows}")
+    rows = min(vkray.bands(scene, 1, width=args.width, height=args.height)[0][3] for scene in scenes)
+    if args.regions is not None and args.regions > rows:
+        raise _Usage(f"--regions {args.regions}: a frame renders {rows} rows, and a band has at least one row, "
+                     f"so 1 to {rows}")
 
-    import distributed
-
-    client, cluster = _connect(args)
-    # The parts go to disk as they arrive (the client holds none for long, however many frames), in
-    # a folder beside the output, removed at the end whatever happens.
-    folder = Path(tempfile.mkdtemp(prefix=f".{output.name}.parts-", dir=output.parent))
+    client = cluster = folder = None
     try:
+        client, cluster = _connect(args)
+        # The parts go to disk as they arrive (the client holds none for long, however many frames),
+        # in a folder beside the output, removed at the end whatever happens.
+        folder = Path(tempfile.mkdtemp(prefix=f".{output.name}.parts-", dir=output.parent))
         started = time.perf_counter()
-        gpus = sum(int(w.get("resources", {}).get("GPU", 0)) for w in client.scheduler_info()["workers"].values())
-        regions = args.regions if args.regions is not None else max(2, 2 * gpus)
+        gpus = _gpu_workers(client)
+        regions = args.regions if args.regions is not None else min(rows, max(2, 2 * gpus))
         # Each frame's bands computed once, here, for all its parts.
         jobs = []  # (frame, band index, scene, region)
         for frame, scene in enumerate(scenes):
@@ -191,20 +233,27 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
                 jobs.append((frame, index, scene, region))
         _log(args.quiet, f"{len(jobs)} parts ({len(scenes)} frame{'s' if len(scenes) > 1 else ''} x {regions} bands) on "
                          f"{len(client.scheduler_info()['workers'])} workers with {gpus} GPU{'s' if gpus != 1 else ''}")
-        _render_parts(client, args.quiet, jobs, settings, suffix, folder)
+        _render_parts(client, args, jobs, settings, suffix, folder)
         rendered = time.perf_counter() - started
-        # Every part is here: now, and only now, the outputs are written.
+        # Every part is here: now, and only now, the outputs are written, each merged under a name
+        # of its own in the parts' folder and then all renamed into place (one file system).
+        merged = []
         for frame in range(len(scenes)):
-            target = _frame_output(output, frame, len(scenes))
             files = sorted(folder.glob(f"frame{frame:05d}-*{suffix}"))
-            summary = vkray.merge(target, files)
+            merged.append(folder / f"merged{frame:05d}{output.suffix}")
+            summary = vkray.merge(merged[-1], files)
             if summary["mixed_devices"]:
                 print("vkray.farm: warning: the parts were rendered on more than one device: the image agrees with a "
                       "single render within parity, not bit for bit", file=sys.stderr)
+        for frame, file in enumerate(merged):
+            target = _frame_output(output, frame, len(scenes))
+            os.replace(file, target)
             _log(args.quiet, f"wrote {target}")
     finally:
-        shutil.rmtree(folder, ignore_errors=True)
-        client.close()
+        if folder is not None:
+            shutil.rmtree(folder, ignore_errors=True)
+        if client is not None:
+            client.close()
         if cluster is not None:
             cluster.close()
     _log(args.quiet, f"{len(jobs)} parts rendered in {rendered:.2f} s, merged in "
@@ -212,7 +261,8 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     return 0
 
 
-def _render_parts(client: Any, quiet: bool, jobs: list, settings: dict[str, Any], suffix: str, folder: Path) -> None:
+def _render_parts(client: Any, args: argparse.Namespace, jobs: list, settings: dict[str, Any], suffix: str,
+                  folder: Path) -> None:
     """Runs every job as a Dask task and writes each part to `folder` as it arrives; raises the first
     failure (vkray's exception, or the cluster's) after cancelling the rest."""
     import distributed
@@ -228,32 +278,58 @@ def _render_parts(client: Any, quiet: bool, jobs: list, settings: dict[str, Any]
         futures[future] = (frame, index, region)
     done = 0
     part_seconds = trace_seconds = 0.0
-    for future in distributed.as_completed(list(futures)):
-        frame, index, region = futures.pop(future)
-        if future.status != "finished":
-            error = future.exception()
-            for other in futures:
-                other.cancel()
-            raise error
-        part = future.result()
-        future.release()
-        file = folder / f"frame{frame:05d}-part{index:05d}{suffix}"
-        file.write_bytes(part["data"])
-        if part["record"] is not None:
-            file.with_name(file.name + ".json").write_bytes(part["record"])
-        done += 1
-        part_seconds += part["seconds"]
-        trace_seconds += part["stats"].get("trace_seconds", 0)
-        _log(quiet, f"{done}/{len(jobs)} parts: frame {frame} rows {region[1]}-{region[3] - 1} in {part['seconds']:.2f} s "
-                    f"({part['stats'].get('trace_seconds', 0):.2f} s tracing) by {part['worker']} on {part['device']}")
-    _log(quiet, f"the parts took {part_seconds:.2f} s on the workers, {trace_seconds:.2f} s of it tracing")
+    # A task that needs a GPU waits for one however long it takes, so a job whose GPU workers are
+    # all gone would wait for ever: the loop wakes every few seconds to see that some are left.
+    without_gpus_since = None
+    while futures:
+        try:
+            finished = distributed.wait(list(futures), timeout=2, return_when="FIRST_COMPLETED").done
+        except (TimeoutError, asyncio.TimeoutError, distributed.TimeoutError):
+            finished = set()
+        if not finished:
+            if _gpu_workers(client):
+                without_gpus_since = None
+            elif without_gpus_since is None:
+                without_gpus_since = time.monotonic()
+                _log(args.quiet, f"no worker with a GPU is left; waiting up to {args.worker_timeout:g} s for one")
+            elif time.monotonic() - without_gpus_since > args.worker_timeout:
+                raise _ClusterError(f"no worker with a GPU has been in the cluster for {args.worker_timeout:g} s; "
+                                    f"{len(futures)} of {len(jobs)} parts were not rendered")
+            continue
+        for future in sorted(finished, key=lambda f: futures[f][:2]):
+            frame, index, region = futures.pop(future)
+            if future.status != "finished":
+                error = future.exception()
+                for other in futures:
+                    other.cancel()
+                raise error
+            part = future.result()
+            future.release()
+            file = folder / f"frame{frame:05d}-part{index:05d}{suffix}"
+            file.write_bytes(part["data"])
+            if part["record"] is not None:
+                file.with_name(file.name + ".json").write_bytes(part["record"])
+            done += 1
+            part_seconds += part["seconds"]
+            trace_seconds += part["stats"].get("trace_seconds", 0)
+            _log(args.quiet, f"{done}/{len(jobs)} parts: frame {frame} rows {region[1]}-{region[3] - 1} in "
+                             f"{part['seconds']:.2f} s ({part['stats'].get('trace_seconds', 0):.2f} s tracing) by "
+                             f"{part['worker']} on {part['device']}")
+    _log(args.quiet, f"the parts took {part_seconds:.2f} s on the workers, {trace_seconds:.2f} s of it tracing")
 
 
 # vkray's exit code for each kind of error, as the command line has them.
 _EXIT_CODES = ((_Usage, 2), (vkray.SceneError, 1), (vkray.UsageError, 2), (vkray.DeviceError, 3), (vkray.InternalError, 70))
 
 
+def _interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
+    # SIGTERM (a batch system's cancel, `kill`) stops the farm as Ctrl-C does: the cluster it
+    # started is closed and nothing is written.
+    signal.signal(signal.SIGTERM, _interrupt)
     try:
         return run(argv)
     except KeyboardInterrupt:
@@ -264,6 +340,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             if isinstance(e, kind):
                 print(f"vkray.farm: error: {e}", file=sys.stderr)
                 return code
+        if isinstance(e, _ClusterError):
+            print(f"vkray.farm: error: {e}", file=sys.stderr)
+            return 3
         # The cluster's: a scheduler out of reach, a worker lost too often (KilledWorker).
         print(f"vkray.farm: error: {type(e).__name__}: {e}", file=sys.stderr)
         return 3
