@@ -264,4 +264,7 @@ def test_bands_and_merge_from_python(scenes, tmp_path):
         vkray.merge(tmp_path / "gap.exr", parts[:2])
     with pytest.raises(vkray.UsageError, match="expected X0,Y0,X1,Y1"):
         vkray.render(scene, width=8, height=8, region="1-2")
+    with pytest.raises(vkray.UsageError, match="a region is"):
+        vkray.render(scene, width=8, height=8, region=(0, 0, 4.5, 8))
+    assert vkray.render(scene, width=8, height=8, region=np.array([0, 0, 4, 8])).shape == (8, 4, 3)
     assert whole.shape == (48, 64, 3)

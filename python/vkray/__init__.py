@@ -21,6 +21,7 @@ and raises KeyboardInterrupt.
 from __future__ import annotations
 
 import json
+import operator
 import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -93,7 +94,8 @@ def _region_text(region: Optional[Region]) -> Optional[str]:
     if region is None or isinstance(region, str):
         return region
     try:
-        x0, y0, x1, y1 = (int(v) for v in region)
+        # operator.index: whole numbers (numpy's too), never a float cut down to one.
+        x0, y0, x1, y1 = (operator.index(v) for v in region)
     except (TypeError, ValueError):
         raise UsageError(f"a region is (x0, y0, x1, y1) or 'I/N', not {region!r}") from None
     if min(x0, y0, x1, y1) < 0:
