@@ -2,6 +2,7 @@
 // half precision in 16-bit), the type rules, and bad files. Other tools read the files in
 // python/tests/test_exr.py.
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <limits>
 
@@ -106,6 +107,29 @@ TEST(ExrTest, ABrokenFileIsAnInputErrorNamingIt) {
   std::filesystem::copy_file(dir / "whole.exr", dir / "cut.exr");
   std::filesystem::resize_file(dir / "cut.exr", size / 2);
   EXPECT_THROW(read_exr(dir / "cut.exr"), InputError);
+}
+
+TEST(ExrTest, AHeaderClaimingAHugeImageIsRefused) {
+  // A real file whose header says its data window is a billion pixels wide: refused by the header's
+  // check, before any line buffer for it is allocated.
+  TempDir dir;
+  const auto [image, aovs] = sample_render(8, 8);
+  write_exr(dir / "small.exr", image, nullptr, {});
+  std::ifstream in(dir / "small.exr", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The attribute: name, type, a 4-byte size of 16, then xMin, yMin, xMax, yMax.
+  const std::string attribute("dataWindow\0box2i\0", 17);
+  const size_t at = bytes.find(attribute);
+  ASSERT_NE(at, std::string::npos);
+  const int32_t x_max = 1 << 30;
+  std::memcpy(bytes.data() + at + attribute.size() + 4 + 8, &x_max, sizeof(x_max));
+  std::ofstream(dir / "huge.exr", std::ios::binary) << bytes;
+  try {
+    read_exr(dir / "huge.exr");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("huge.exr"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

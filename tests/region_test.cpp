@@ -288,6 +288,11 @@ TEST(MergeTest, ACpuReferencePartJoinsGpuPartsWithAWarning) {
   std::ofstream(sidecar_of(gpu[1]), std::ios::trunc) << record;
   files.push_back(gpu[1]);
   EXPECT_TRUE(merge_part_files(dir / "m.pfm", files).mixed_devices);
+  // The CPU part first does not let GPU parts of two shaders through.
+  std::filesystem::create_directory(dir / "other");
+  const auto other = write_parts(r, {{0, 32, 48, 48}, {0, 48, 48, 64}}, dir / "other", ".pfm", {}, "spirv2");
+  const std::string message = error_of([&] { merge_part_files(dir / "m2.pfm", {files[0], gpu[1], other[1]}); });
+  EXPECT_NE(message.find("part1.pfm: was traced by other shaders: SPIR-V spirv2, not spirv1"), std::string::npos) << message;
 }
 
 TEST(MergeTest, APfmWrittenAgainAfterItsRecordIsRefused) {
@@ -323,6 +328,11 @@ TEST(MergeTest, RefusesFilesThatAreNotPartsNamingThem) {
     const std::string message = error_of([&] { read_part(files[0]); });
     EXPECT_NE(message.find("part0.pfm.json: the part's record"), std::string::npos) << bad << ": " << message;
   }
+  // A record of an older build, which did not record the shaders: said so.
+  std::ofstream(sidecar_of(files[0]), std::ios::trunc)
+      << R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,48,64], "spp": 1, "seed": 0, "vkray_version": "0.0.9", "device": "d"})";
+  EXPECT_NE(error_of([&] { read_part(files[0]); }).find("has no \"shader\" (it was written by vkray 0.0.9: render the part again"),
+            std::string::npos);
   // A record whose region is not the picture's size.
   std::ofstream(sidecar_of(files[0]), std::ios::trunc)
       << R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,48,32], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d", "shader": "", "pixels": "x"})";

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -183,6 +184,13 @@ void check_render_image(const std::filesystem::path& file, const ExrContent& con
 }
 
 ExrFile read_exr(const std::filesystem::path& file) {
+  // OpenEXR allocates line buffers for the data window as it opens a file, before vkray sees the
+  // header: a small file claiming a huge width must be refused by OpenEXR's own header check.
+  static std::once_flag limits;
+  std::call_once(limits, [] {
+    Imf::Header::setMaxImageSize(int(kMaxImageSide), int(kMaxImageSide));
+    Imf::Header::setMaxTileSize(int(kMaxImageSide), int(kMaxImageSide));
+  });
   ExrFile result;
   try {
     Imf::InputFile exr(file.c_str());

@@ -33,10 +33,6 @@ std::string mismatch(const Part& first, const Part& part) {
     return differ("has samples per pixel", std::to_string(a.samples_per_pixel), std::to_string(b.samples_per_pixel));
   if (a.seed != b.seed) return differ("has seed", std::to_string(a.seed), std::to_string(b.seed));
   if (a.version != b.version) return differ("was rendered by vkray", a.version, b.version);
-  // Shaders edited between parts (a --shader-dir, `vkray watch`'s edits) make another image; a CPU
-  // reference part, which has none, may join GPU parts (within parity, as the merge then warns).
-  if (!a.shader.empty() && !b.shader.empty() && a.shader != b.shader)
-    return differ("was traced by other shaders: SPIR-V", a.shader, b.shader);
   if (first.content.passes != part.content.passes)
     return differ("has first-hit passes", pass_names(first.content), pass_names(part.content));
   if (first.exr != part.exr || first.content.full_float != part.content.full_float) {
@@ -106,6 +102,17 @@ MergedImage merge_parts(const std::vector<Part>& parts) {
   for (const Part& part : parts) {
     const std::string why = mismatch(first, part);
     if (!why.empty()) throw InputError(part.file.string() + ": " + why + " as " + first.file.string() + " is");
+  }
+  // Shaders edited between parts (a --shader-dir, `vkray watch`'s edits) make another image. A CPU
+  // reference part has none and may join GPU parts (within parity, as the merge then warns), so
+  // the GPU parts are held to the first of them.
+  const Part* traced = nullptr;
+  for (const Part& part : parts) {
+    if (part.record.shader.empty()) continue;
+    if (!traced) traced = &part;
+    if (part.record.shader != traced->record.shader)
+      throw InputError(part.file.string() + ": was traced by other shaders: SPIR-V " + part.record.shader + ", not " +
+                       traced->record.shader + " as " + traced->file.string() + " was");
   }
   MergedImage merged;
   merged.record = first.record;

@@ -41,8 +41,13 @@ PartRecord parse_part_record(const std::string& text, const std::filesystem::pat
   const std::string where = file.string() + ": the part's record";
   const nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (json.is_discarded() || !json.is_object()) throw InputError(where + " is not a JSON object");
+  // A part of an older build lacks what later builds record: say so, rather than only what is missing.
+  const std::string older = json.contains("vkray_version") && json["vkray_version"].is_string()
+                                ? " (it was written by vkray " + json["vkray_version"].get<std::string>() +
+                                      ": render the part again with this build)"
+                                : "";
   for (const char* key : kRecordKeys)
-    if (!json.contains(key)) throw InputError(where + " has no \"" + key + "\"");
+    if (!json.contains(key)) throw InputError(where + " has no \"" + key + "\"" + older);
   const auto text_of = [&](const char* key) {
     if (!json[key].is_string()) throw InputError(where + ": \"" + key + "\" is not a string");
     return json[key].get<std::string>();
@@ -133,7 +138,8 @@ Part read_part(const std::filesystem::path& file) {
     throw InputError(sidecar.string() + ": " + record.error + " (a PFM part's record, which `vkray render --region` writes beside it)");
   part.record = parse_part_record(record.text, sidecar);
   if (part.record.pixels.empty())
-    throw InputError(sidecar.string() + ": the part's record has no \"pixels\", which a PFM part's record has");
+    throw InputError(sidecar.string() + ": the part's record has no \"pixels\", which a PFM part's record has (it was "
+                     "written by vkray " + part.record.version + ": render the part again with this build)");
   part.image = read_pfm(file);
   if (part.image.width != part.record.region.width() || part.image.height != part.record.region.height())
     throw InputError(file.string() + ": " + std::to_string(part.image.width) + " x " + std::to_string(part.image.height) +
