@@ -87,8 +87,19 @@ def cluster(tmp_path):
 
 
 def farm(*args: str, **kwargs) -> subprocess.Popen:
+    # A session of its own, so that a farm that overstays is killed with its LocalCluster's workers.
     return subprocess.Popen([sys.executable, "-m", "vkray.farm", *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, **kwargs)
+                            stderr=subprocess.PIPE, text=True, start_new_session=True, **kwargs)
+
+
+def finish(job: subprocess.Popen, timeout: float) -> str:
+    """The farm's stderr once it ends; killed (with its processes) if it runs past `timeout` s."""
+    try:
+        return job.communicate(timeout=timeout)[1]
+    except subprocess.TimeoutExpired:
+        os.killpg(job.pid, signal.SIGKILL)
+        job.communicate()
+        raise
 
 
 def single_render(vkray_command, scene, out: Path, *extra: str) -> bytes:
@@ -104,7 +115,7 @@ def test_four_regions_on_two_workers_merge_into_the_bytes_of_one_render(cluster,
     out = tmp_path / "farm.exr"
     job = farm(str(scene), *RENDER, "--aov", "albedo,depth", "-o", str(out), "--regions", "4", "--scheduler",
                cluster.address)
-    _, err = job.communicate(timeout=300)
+    err = finish(job, 300)
     assert job.returncode == 0, err
     assert "4/4 parts" in err and f"wrote {out}" in err, err
     assert out.read_bytes() == single_render(vkray_command, scene, tmp_path / "single.exr", "--aov", "albedo,depth")
@@ -139,7 +150,7 @@ def test_a_worker_killed_mid_job_has_its_part_rendered_elsewhere(cluster, scenes
     out = tmp_path / "farm.pfm"
     job = farm(str(scene), *HEAVY, "-o", str(out), "--regions", "6", "--scheduler", cluster.address)
     kill_once_busy(cluster, "victim", victim, job)
-    _, err = job.communicate(timeout=300)
+    err = finish(job, 300)
     assert job.returncode == 0, err
     assert "6/6 parts" in err and "by survivor on" in err, err
     single = tmp_path / "single.pfm"
@@ -156,7 +167,7 @@ def test_a_job_whose_last_gpu_worker_is_lost_fails_instead_of_waiting(cluster, s
     job = farm(str(scenes / "cornell-path.json"), *HEAVY, "-o", str(out), "--regions", "4", "--worker-timeout", "3",
                "--scheduler", cluster.address)
     kill_once_busy(cluster, "only", victim, job)
-    _, err = job.communicate(timeout=120)
+    err = finish(job, 120)
     assert job.returncode == 3, err
     assert "no worker with a GPU has been in the cluster for 3 s" in err, err
     assert list(tmp_path.glob("farm*")) == [] and list(tmp_path.glob(".farm*")) == []
@@ -166,7 +177,7 @@ def test_a_cluster_without_gpu_workers_is_refused(cluster, scenes, tmp_path):
     cluster.add_worker("cpu-only", gpu=False)
     cluster.wait_for_workers(1)
     job = farm(str(scenes / "cornell.json"), *RENDER, "-o", str(tmp_path / "farm.pfm"), "--scheduler", cluster.address)
-    _, err = job.communicate(timeout=120)
+    err = finish(job, 120)
     assert job.returncode == 3, err
     assert "declares a GPU" in err and "--resources GPU=1" in err, err
     assert list(tmp_path.glob("farm*")) == []
@@ -181,7 +192,7 @@ def test_a_part_that_fails_fails_the_job_with_vkrays_message_and_writes_nothing(
     out = tmp_path / "farm.exr"
     job = farm(str(scenes / "cornell-path.json"), *HEAVY, "-o", str(out), "--regions", "6", "--scheduler",
                cluster.address)
-    _, err = job.communicate(timeout=300)
+    err = finish(job, 300)
     assert job.returncode == 3, err
     assert "vkray.farm: error:" in err and "no-such-gpu" in err, err
     assert list(tmp_path.glob("farm*")) == [] and list(tmp_path.glob(".farm*")) == []
@@ -191,7 +202,7 @@ def test_frames_on_a_local_cluster(scenes, vkray_command, tmp_path):
     out = tmp_path / "frame.pfm"
     job = farm(str(scenes / "cornell.json"), "--frames", str(scenes / "cornell-spheres.json"), *RENDER, "-o", str(out),
                "--regions", "2")
-    _, err = job.communicate(timeout=300)
+    err = finish(job, 300)
     assert job.returncode == 0, err
     for frame, scene in enumerate(["cornell.json", "cornell-spheres.json"]):
         single = tmp_path / f"single{frame}.pfm"
@@ -210,7 +221,7 @@ def test_sigterm_stops_the_job_and_writes_nothing(scenes, tmp_path):
         assert time.monotonic() < deadline, "the farm did not start"
         time.sleep(0.05)
     job.send_signal(signal.SIGTERM)
-    _, err = job.communicate(timeout=120)
+    err = finish(job, 120)
     assert job.returncode == 130, err
     assert "interrupted; nothing written" in err, err
     assert list(tmp_path.iterdir()) == []
@@ -229,10 +240,29 @@ def test_sigterm_stops_the_job_and_writes_nothing(scenes, tmp_path):
 ])
 def test_bad_jobs_fail_before_any_work_with_a_message(scenes, tmp_path, args, code, says):
     job = farm(*[a.format(scenes=scenes) for a in args], cwd=tmp_path)
-    _, err = job.communicate(timeout=120)
+    err = finish(job, 120)
     assert job.returncode == code, err
     assert says in err, err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_outputs_are_renamed_into_place_all_or_none(tmp_path):
+    # The farm's last step: frame 0 is renamed into place, frame 1 cannot be (its folder is gone), and
+    # frame 0's earlier file is back as it was.
+    from vkray.farm import _commit
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    (parts / "merged0").write_text("new 0")
+    (parts / "merged1").write_text("new 1")
+    (tmp_path / "out.0000.pfm").write_text("old 0")
+    with pytest.raises(OSError):
+        _commit([parts / "merged0", parts / "merged1"], [tmp_path / "out.0000.pfm", tmp_path / "gone" / "out.0001.pfm"],
+                parts)
+    assert (tmp_path / "out.0000.pfm").read_text() == "old 0"
+    # And when every rename succeeds, both are the new ones.
+    (parts / "merged0").write_text("new 0")
+    _commit([parts / "merged0", parts / "merged1"], [tmp_path / "out.0000.pfm", tmp_path / "out.0001.pfm"], parts)
+    assert [(tmp_path / f"out.000{i}.pfm").read_text() for i in (0, 1)] == ["new 0", "new 1"]
 
 
 def test_bands_and_merge_from_python(scenes, tmp_path):

@@ -23,7 +23,7 @@ written only when every part of every frame is in. Exit codes are vkray's: 0 don
 from __future__ import annotations
 
 import argparse
-import asyncio
+import contextlib
 import importlib
 import logging
 import os
@@ -160,6 +160,10 @@ def _log(quiet: bool, line: str) -> None:
         print(f"vkray.farm: {line}", file=sys.stderr, flush=True)
 
 
+class _CannotWrite(Exception):
+    pass
+
+
 class _ClusterError(Exception):
     """The cluster cannot do the job: no workers, none with a GPU, all of them lost."""
 
@@ -217,12 +221,20 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         raise _Usage(f"--regions {args.regions}: a frame renders {rows} rows, and a band has at least one row, "
                      f"so 1 to {rows}")
 
+    targets = [_frame_output(output, frame, len(scenes)) for frame in range(len(scenes))]
+    for target in targets:
+        if target.is_dir():
+            raise _Usage(f"{target}: is a folder")
+
     client = cluster = folder = None
     try:
-        client, cluster = _connect(args)
         # The parts go to disk as they arrive (the client holds none for long, however many frames),
         # in a folder beside the output, removed at the end whatever happens.
-        folder = Path(tempfile.mkdtemp(prefix=f".{output.name}.parts-", dir=output.parent))
+        try:
+            folder = Path(tempfile.mkdtemp(prefix=f".{output.name}.parts-", dir=output.parent))
+        except OSError as e:
+            raise _CannotWrite(f"{output.parent}: cannot write there ({e.strerror})") from None
+        client, cluster = _connect(args)
         started = time.perf_counter()
         gpus = _gpu_workers(client)
         regions = args.regions if args.regions is not None else min(rows, max(2, 2 * gpus))
@@ -245,20 +257,46 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
             if summary["mixed_devices"]:
                 print("vkray.farm: warning: the parts were rendered on more than one device: the image agrees with a "
                       "single render within parity, not bit for bit", file=sys.stderr)
-        for frame, file in enumerate(merged):
-            target = _frame_output(output, frame, len(scenes))
-            os.replace(file, target)
+        with _no_interrupts():
+            _commit(merged, targets, folder)
+        for target in targets:
             _log(args.quiet, f"wrote {target}")
     finally:
-        if folder is not None:
-            shutil.rmtree(folder, ignore_errors=True)
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
+        # A second Ctrl-C or a SIGTERM from a batch system must not leave the parts or the cluster.
+        with _no_interrupts():
+            if folder is not None:
+                shutil.rmtree(folder, ignore_errors=True)
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
     _log(args.quiet, f"{len(jobs)} parts rendered in {rendered:.2f} s, merged in "
                      f"{time.perf_counter() - started - rendered:.2f} s")
     return 0
+
+
+def _commit(merged: list[Path], targets: list[Path], folder: Path) -> None:
+    """Renames each merged image to its target, all or none: a target that was there already is
+    moved aside first and put back if a later rename fails."""
+    done = []  # (target, what it was, in `folder`, or None)
+    try:
+        for frame, (file, target) in enumerate(zip(merged, targets)):
+            previous = None
+            if os.path.lexists(target):
+                previous = folder / f"previous{frame:05d}"
+                os.replace(target, previous)
+            done.append((target, previous))
+            os.replace(file, target)
+    except BaseException:
+        for target, previous in reversed(done):
+            try:
+                if previous is not None:
+                    os.replace(previous, target)
+                else:
+                    target.unlink(missing_ok=True)
+            except OSError:
+                pass
+        raise
 
 
 def _render_parts(client: Any, args: argparse.Namespace, jobs: list, settings: dict[str, Any], suffix: str,
@@ -278,31 +316,41 @@ def _render_parts(client: Any, args: argparse.Namespace, jobs: list, settings: d
         futures[future] = (frame, index, region)
     done = 0
     part_seconds = trace_seconds = 0.0
+    arrivals = distributed.as_completed(list(futures))
     # A task that needs a GPU waits for one however long it takes, so a job whose GPU workers are
-    # all gone would wait for ever: the loop wakes every few seconds to see that some are left.
+    # all gone would wait for ever: between arrivals the loop looks every 2 s for GPUs left.
     without_gpus_since = None
+    looked = time.monotonic()
     while futures:
-        try:
-            finished = distributed.wait(list(futures), timeout=2, return_when="FIRST_COMPLETED").done
-        except (TimeoutError, asyncio.TimeoutError, distributed.TimeoutError):
-            finished = set()
-        if not finished:
+        batch = arrivals.next_batch(block=False)
+        if not batch:
+            time.sleep(0.05)
+            if time.monotonic() - looked < 2:
+                continue
+            looked = time.monotonic()
             if _gpu_workers(client):
                 without_gpus_since = None
             elif without_gpus_since is None:
-                without_gpus_since = time.monotonic()
+                without_gpus_since = looked
                 _log(args.quiet, f"no worker with a GPU is left; waiting up to {args.worker_timeout:g} s for one")
-            elif time.monotonic() - without_gpus_since > args.worker_timeout:
+            elif looked - without_gpus_since > args.worker_timeout:
                 raise _ClusterError(f"no worker with a GPU has been in the cluster for {args.worker_timeout:g} s; "
                                     f"{len(futures)} of {len(jobs)} parts were not rendered")
             continue
-        for future in sorted(finished, key=lambda f: futures[f][:2]):
-            frame, index, region = futures.pop(future)
-            if future.status != "finished":
+        for future in sorted(batch, key=lambda f: futures[f][:2]):
+            if future.status == "error":
                 error = future.exception()
-                for other in futures:
-                    other.cancel()
+                client.cancel([other for other in futures if other is not future])
                 raise error
+            if future.status == "cancelled":
+                raise _ClusterError(f"the cluster cancelled part {futures[future][1]} of frame {futures[future][0]} "
+                                    f"(was the scheduler restarted?); {len(futures)} of {len(jobs)} parts were not "
+                                    f"rendered")
+            if future.status != "finished":
+                # Its result was lost with its worker before it came here: Dask renders it again.
+                arrivals.add(future)
+                continue
+            frame, index, region = futures.pop(future)
             part = future.result()
             future.release()
             file = folder / f"frame{frame:05d}-part{index:05d}{suffix}"
@@ -322,14 +370,32 @@ def _render_parts(client: Any, args: argparse.Namespace, jobs: list, settings: d
 _EXIT_CODES = ((_Usage, 2), (vkray.SceneError, 1), (vkray.UsageError, 2), (vkray.DeviceError, 3), (vkray.InternalError, 70))
 
 
+# While set, Ctrl-C and SIGTERM are ignored: the outputs are being renamed into place (milliseconds),
+# or the parts and the cluster cleaned up.
+_shielded = False
+
+
 def _interrupt(signum: int, frame: Any) -> None:
-    raise KeyboardInterrupt
+    if not _shielded:
+        raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def _no_interrupts():
+    global _shielded
+    previous, _shielded = _shielded, True
+    try:
+        yield
+    finally:
+        _shielded = previous
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
     # SIGTERM (a batch system's cancel, `kill`) stops the farm as Ctrl-C does: the cluster it
     # started is closed and nothing is written.
-    signal.signal(signal.SIGTERM, _interrupt)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, _interrupt)
+        signal.signal(signal.SIGTERM, _interrupt)
     try:
         return run(argv)
     except KeyboardInterrupt:
@@ -340,9 +406,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             if isinstance(e, kind):
                 print(f"vkray.farm: error: {e}", file=sys.stderr)
                 return code
-        if isinstance(e, _ClusterError):
+        if isinstance(e, (_CannotWrite, _ClusterError)):
             print(f"vkray.farm: error: {e}", file=sys.stderr)
-            return 3
+            return 1 if isinstance(e, _CannotWrite) else 3
         # The cluster's: a scheduler out of reach, a worker lost too often (KilledWorker).
         print(f"vkray.farm: error: {type(e).__name__}: {e}", file=sys.stderr)
         return 3
