@@ -74,7 +74,9 @@ struct RenderResult {
   ImageSettings settings;    // the full image's, overrides applied
   PixelRegion region;        // the pixels rendered, in the full image's coordinates
   bool part = false;         // RenderOptions::region asked for them (even all of them): a part of a render
-  std::string shader;        // the hash (base/hash.h) of the SPIR-V that traced it; empty: the CPU reference
+  // The hash (base/hash.h) of the shader folder's SPIR-V (a variant with the scene compiled in is
+  // made from the same sources and the scene); empty: the CPU reference.
+  std::string shader;
   RenderStats stats;
 };
 
