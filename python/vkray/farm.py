@@ -128,24 +128,24 @@ def _parser() -> argparse.ArgumentParser:
         description="Render a scene (or frames) as bands of about equal work, as Dask tasks, and merge them.",
         epilog="Exit codes: 0 done, 1 bad input, 2 usage, 3 device or cluster failure, 130 interrupted.")
     p.add_argument("scene", help="scene file (.json, .gltf, .glb), read by every worker at its absolute path")
-    p.add_argument("-o", "--output", required=True, help="the whole image: .exr, .pfm or .png; with --frames, "
+    p.add_argument("-o", "--output", required=True, metavar="OUT", help="the whole image: .exr, .pfm or .png; with --frames, "
                    "frame N goes to OUT with .NNNN before the suffix")
-    p.add_argument("--regions", type=_whole(1), default=None,
+    p.add_argument("--regions", type=_whole(1), default=None, metavar="N",
                    help="bands per frame (default: twice the GPUs the workers declare, at least 2, at most the rows)")
     p.add_argument("--frames", nargs="+", default=[], metavar="SCENE", help="more scenes, rendered as frames 1, 2, ...")
-    p.add_argument("--scheduler", help="address of a Dask scheduler (tcp://host:8786); default: a LocalCluster here")
-    p.add_argument("--workers", type=_whole(1, 256), default=1,
+    p.add_argument("--scheduler", metavar="ADDRESS", help="address of a Dask scheduler (tcp://host:8786); default: a LocalCluster here")
+    p.add_argument("--workers", type=_whole(1, 256), default=1, metavar="K",
                    help="LocalCluster worker processes (default 1). Each opens the device VKRAY_DEVICE names, or the "
                         "best one: more than one shares that GPU, which helps only a device that one process "
                         "leaves idle")
     p.add_argument("--worker-timeout", type=_seconds, default=60.0, metavar="SECONDS",
                    help="how long to wait for the scheduler, and for a worker with a GPU when the cluster has none "
                         "(default 60)")
-    p.add_argument("--width", type=_whole(1))
-    p.add_argument("--height", type=_whole(1))
-    p.add_argument("--spp", type=_whole(1))
-    p.add_argument("--seed", type=_whole(0))
-    p.add_argument("--aov", default="", help="first-hit passes for an .exr output, comma-separated")
+    p.add_argument("--width", type=_whole(1), metavar="W", help="image width in pixels (default: the scene's)")
+    p.add_argument("--height", type=_whole(1), metavar="H", help="image height in pixels (default: the scene's)")
+    p.add_argument("--spp", type=_whole(1), metavar="N", help="samples per pixel (default: the scene's)")
+    p.add_argument("--seed", type=_whole(0), metavar="S", help="sample streams (default: the scene's)")
+    p.add_argument("--aov", default="", metavar="LIST", help="first-hit passes for an .exr output, comma-separated")
     p.add_argument("--exr-float", action="store_true", help="32-bit float channels in an .exr output")
     p.add_argument("-q", "--quiet", action="store_true", help="print only errors")
     return p
