@@ -8,7 +8,7 @@ images, the same errors with the same messages.
     >>> image.shape, image.dtype
     ((256, 256, 3), dtype('float32'))
 
-Scenes are scene files (``.json``, README "Scene files") or dicts in the same format, where numpy
+Scenes are scene files (``.json``, docs/scene-format.md) or dicts in the same format, where numpy
 arrays may stand wherever the format has lists of numbers. Images are linear radiance, float32,
 top row first, exactly what ``vkray render -o x.pfm`` writes.
 
@@ -48,7 +48,7 @@ __all__ = [
     "__version__",
 ]
 
-#: The first-hit passes a render can return beside the image (README, "First-hit passes").
+#: The first-hit passes a render can return beside the image (docs/rendering.md, "First-hit passes").
 AOVS = ("albedo", "normal", "position", "depth", "object")
 
 Scene = Union[str, "os.PathLike[str]", Mapping[str, Any]]

@@ -19,7 +19,7 @@ it as a path-traced scene; --rr-depth only applies to path tracing.
 
 As a module: `scene_dict(path, overrides) -> (dict, info)`, with mitsuba's variant already set.
 
-Mapping (vkray README, "Scene files" and "What is computed"):
+Mapping (vkray's docs/scene-format.md and docs/rendering.md):
   camera      look_at transform with the same up (Mitsuba's camera +X is left, image x grows to the
               right = normalize(f x up), as in vkray); fov_axis 'y', vertical_fov = 2 atan(0.5/f);
               aperture_radius > 0 -> 'thinlens'. Box pixel filter, hdrfilm rgb float32.
