@@ -120,7 +120,9 @@ def scratch_tree(pristine: Path, build_dir: Path, where: Path) -> Path:
 
 def block_environment(bin_dir: Path, build_dir: Path) -> dict:
     bin_dir.mkdir()
-    (bin_dir / "python3").symlink_to(sys.executable)
+    python = bin_dir / "python3"  # a script, not a link: a link would lose a virtualenv's packages
+    python.write_text(f'#!/bin/sh\nexec "{sys.executable}" "$@"\n')
+    python.chmod(0o755)
     (bin_dir / "vkray").symlink_to(Path(os.environ.get("VKRAY_EXECUTABLE", build_dir / "vkray")).resolve())
     env = dict(os.environ, MPLBACKEND="Agg", PATH=f"{bin_dir}{os.pathsep}{os.environ.get('PATH', '')}")
     env.setdefault("PYTHONPATH", str(build_dir / "python"))
