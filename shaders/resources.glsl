@@ -26,13 +26,9 @@ void load_frame() { frame = frame_block; }
 
 // Set per scene and render by the host (gpu::ShaderVariant), so that a pipeline has no code for
 // what the render cannot need: on llvmpipe code behind an `if` costs every lane, masked, even when
-// no lane takes it.
-layout(constant_id = VKRAY_SPEC_SPHERES) const bool SCENE_HAS_SPHERES = true;
-layout(constant_id = VKRAY_SPEC_SHADOWS) const bool SHADOW_RAYS = true;
-layout(constant_id = VKRAY_SPEC_PATH) const bool PATH_TRACING = false;
-layout(constant_id = VKRAY_SPEC_EMITTERS) const bool SCENE_HAS_EMITTERS = false;
-layout(constant_id = VKRAY_SPEC_SPECULAR) const bool SCENE_HAS_SPECULAR = false;
-layout(constant_id = VKRAY_SPEC_AOVS) const bool FIRST_HIT_PASSES = false;
-layout(constant_id = VKRAY_SPEC_TEXTURES) const bool SCENE_HAS_TEXTURES = false;
+// no lane takes it. Declared from the table in shared/types.h, which the host's pipeline reads too.
+#define VKRAY_DECLARE_SPEC_CONSTANT(id, name, member, value) layout(constant_id = id) const bool name = value;
+VKRAY_SPECIALIZATION_CONSTANTS(VKRAY_DECLARE_SPEC_CONSTANT)
+#undef VKRAY_DECLARE_SPEC_CONSTANT
 
 #endif

@@ -11,9 +11,11 @@
 
 #include <sys/stat.h>
 
+#include <glslang/SPIRV/spirv.hpp>
 #include <gtest/gtest.h>
 
 #include "base/errors.h"
+#include "gpu/pipeline.h"
 #include "gpu/shader_cache.h"
 #include "gpu/shader_compiler.h"
 #include "shared/types.h"
@@ -95,6 +97,36 @@ TEST(ShaderCompilerTest, ReflectsTheBindingsTheShaderDeclares) {
       {VKRAY_BINDING_TEXTURES, {"textures", D::eUniformTexelBuffer}},
   };
   EXPECT_EQ(found, expected);
+}
+
+TEST(ShaderCompilerTest, DeclaresTheSpecializationConstantsOfThePipelinesTable) {
+  // The shader's constant_id declarations against gpu::kSpecConstants, which sets them: the same ids,
+  // the same names, and defaults that are ShaderVariant's, read from the SPIR-V itself.
+  const std::filesystem::path dir = VKRAY_SHADER_DIR;
+  const gpu::CompiledShader shader = gpu::compile_compute_shader(dir / "trace.comp", {dir});
+  std::map<uint32_t, std::string> names;  // by result id
+  std::map<uint32_t, bool> defaults;
+  std::map<uint32_t, uint32_t> spec_ids;  // result id -> SpecId
+  const std::vector<uint32_t>& code = shader.spirv;
+  for (size_t at = 5; at < code.size();) {
+    const uint32_t words = code[at] >> spv::WordCountShift, opcode = code[at] & spv::OpCodeMask;
+    ASSERT_GT(words, 0u);
+    ASSERT_LE(at + words, code.size());
+    if (opcode == spv::OpName) names[code[at + 1]] = reinterpret_cast<const char*>(&code[at + 2]);
+    if (opcode == spv::OpDecorate && code[at + 2] == spv::DecorationSpecId) spec_ids[code[at + 1]] = code[at + 3];
+    if (opcode == spv::OpSpecConstantTrue || opcode == spv::OpSpecConstantFalse)
+      defaults[code[at + 2]] = opcode == spv::OpSpecConstantTrue;
+    at += words;
+  }
+  std::map<uint32_t, std::pair<std::string, bool>> declared, table;
+  for (const auto& [result, id] : spec_ids) {
+    ASSERT_TRUE(defaults.count(result)) << "constant_id " << id << " is not a bool";
+    EXPECT_TRUE(declared.emplace(id, std::pair(names[result], defaults[result])).second) << "constant_id " << id << " twice";
+  }
+  const gpu::ShaderVariant defaults_on_host;
+  for (const gpu::SpecConstant& row : gpu::kSpecConstants)
+    table.emplace(row.id, std::pair(std::string(row.name), defaults_on_host.*row.member));
+  EXPECT_EQ(declared, table);
 }
 
 TEST(ShaderCompilerTest, ErrorInAnIncludedFileNamesThatFileAndLine) {

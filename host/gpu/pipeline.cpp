@@ -1,5 +1,8 @@
 #include "gpu/pipeline.h"
 
+#include <array>
+#include <span>
+
 #include <glslang/SPIRV/spirv.hpp>
 
 #include "base/errors.h"
@@ -30,6 +33,15 @@ constexpr BindingSlot kTraceBindings[] = {
 };
 
 // Whether a SPIR-V module declares `capability` (its OpCapability instructions come first).
+// Two rows of one id would give the shader's constant whichever value Vulkan takes first.
+constexpr bool distinct_ids(std::span<const SpecConstant> table) {
+  for (size_t i = 0; i < table.size(); ++i)
+    for (size_t j = i + 1; j < table.size(); ++j)
+      if (table[i].id == table[j].id) return false;
+  return true;
+}
+static_assert(distinct_ids(kSpecConstants), "a specialization constant id appears twice in VKRAY_SPECIALIZATION_CONSTANTS");
+
 bool declares(const std::vector<uint32_t>& spirv, spv::Capability capability) {
   constexpr size_t kHeaderWords = 5;
   for (size_t at = kHeaderWords; at < spirv.size();) {
@@ -103,13 +115,13 @@ std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVari
     inline_module = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, shader.spirv));
   }
   const vk::ShaderModule module = variant.inline_scene.empty() ? *module_ : *inline_module;
-  const VkBool32 constants[] = {variant.spheres, variant.shadows, variant.path, variant.emitters, variant.specular, variant.aovs,
-                                variant.textures};
-  const auto entry = [](uint32_t id, uint32_t index) { return vk::SpecializationMapEntry(id, index * sizeof(VkBool32), sizeof(VkBool32)); };
-  const vk::SpecializationMapEntry entries[] = {entry(VKRAY_SPEC_SPHERES, 0), entry(VKRAY_SPEC_SHADOWS, 1), entry(VKRAY_SPEC_PATH, 2),
-                                                entry(VKRAY_SPEC_EMITTERS, 3), entry(VKRAY_SPEC_SPECULAR, 4), entry(VKRAY_SPEC_AOVS, 5),
-                                                entry(VKRAY_SPEC_TEXTURES, 6)};
-  const vk::SpecializationInfo specialization(entries, vk::ArrayProxyNoTemporaries<const VkBool32>(constants));
+  std::array<VkBool32, std::size(kSpecConstants)> values{};
+  std::array<vk::SpecializationMapEntry, std::size(kSpecConstants)> entries{};
+  for (size_t i = 0; i < std::size(kSpecConstants); ++i) {
+    values[i] = variant.*kSpecConstants[i].member;
+    entries[i] = vk::SpecializationMapEntry(kSpecConstants[i].id, uint32_t(i * sizeof(VkBool32)), sizeof(VkBool32));
+  }
+  const vk::SpecializationInfo specialization(entries, vk::ArrayProxyNoTemporaries<const VkBool32>(values));
   const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, module, "main", &specialization);
   return std::make_shared<const vk::raii::Pipeline>(
       ctx_->device(), cache_ ? vk::Optional<const vk::raii::PipelineCache>(*cache_) : nullptr,

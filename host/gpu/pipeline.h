@@ -18,23 +18,35 @@
 #include "gpu/context.h"
 #include "gpu/descriptors.h"
 #include "gpu/shader_compiler.h"
+#include "shared/types.h"
 
 namespace vkray::gpu {
 
-// What a render needs of the shader: specialization constants (shared/types.h), so that a
-// pipeline has no code for what the render cannot use (on llvmpipe code behind an `if` costs every
-// lane even when no lane takes it), and the scene's own code when it is compiled in.
+// What a render needs of the shader: specialization constants, so that a pipeline has no code for
+// what the render cannot use (on llvmpipe code behind an `if` costs every lane even when no lane
+// takes it), and the scene's own code when it is compiled in. A member per row of
+// VKRAY_SPECIALIZATION_CONSTANTS (shared/types.h), which says what each means, with its default.
 struct ShaderVariant {
-  bool spheres = true;       // VKRAY_SPEC_SPHERES
-  bool shadows = true;       // VKRAY_SPEC_SHADOWS
-  bool path = false;         // VKRAY_SPEC_PATH
-  bool emitters = false;     // VKRAY_SPEC_EMITTERS
-  bool specular = false;     // VKRAY_SPEC_SPECULAR
-  bool aovs = false;         // VKRAY_SPEC_AOVS
-  bool textures = false;     // VKRAY_SPEC_TEXTURES
+#define VKRAY_SHADER_VARIANT_MEMBER(id, name, member, value) bool member = value;
+  VKRAY_SPECIALIZATION_CONSTANTS(VKRAY_SHADER_VARIANT_MEMBER)
+#undef VKRAY_SHADER_VARIANT_MEMBER
   std::string inline_scene;  // served as shaders/inline_scene.glsl; empty: that file, and the BVH is walked
 
   auto operator<=>(const ShaderVariant&) const = default;
+};
+
+// A specialization constant as the pipeline sets it: its id, its name in the shader, and the member
+// of ShaderVariant that gives its value.
+struct SpecConstant {
+  uint32_t id;
+  const char* name;
+  bool ShaderVariant::*member;
+};
+
+inline constexpr SpecConstant kSpecConstants[] = {
+#define VKRAY_SPEC_CONSTANT_ROW(id, name, member, value) {id, #name, &ShaderVariant::member},
+    VKRAY_SPECIALIZATION_CONSTANTS(VKRAY_SPEC_CONSTANT_ROW)
+#undef VKRAY_SPEC_CONSTANT_ROW
 };
 
 class TracePipeline {

@@ -26,7 +26,11 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BINDING_TEXTURES 10   // uniform texel buffer, RGBA16F: every texture's texels
 
 // ---- Specialization constants ------------------------------------------------------------------
-// false when the scene has no spheres: the pipeline for it has no sphere test (gpu::ShaderVariant).
+// One table: X(id, GLSL name, gpu::ShaderVariant member, default). resources.glsl declares each
+// as `layout(constant_id = id) const bool NAME = default;` and the host builds the pipeline's
+// specialization from the same rows (host/gpu/pipeline.cpp), so an id, a name and a member cannot
+// be paired differently on the two sides.
+// false when the scene has no spheres: the pipeline for it has no sphere test.
 #define VKRAY_SPEC_SPHERES 0
 // false for a render without shadow rays (every light counts as visible: camera rays alone, for
 // `vkray bench`): the pipeline has no shadow-ray code, which would cost every lane, masked.
@@ -41,6 +45,14 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_AOVS 5
 // false when no material has a texture: no texture coordinates and no texture code.
 #define VKRAY_SPEC_TEXTURES 6
+#define VKRAY_SPECIALIZATION_CONSTANTS(X)                     \
+  X(VKRAY_SPEC_SPHERES, SCENE_HAS_SPHERES, spheres, true)     \
+  X(VKRAY_SPEC_SHADOWS, SHADOW_RAYS, shadows, true)           \
+  X(VKRAY_SPEC_PATH, PATH_TRACING, path, false)               \
+  X(VKRAY_SPEC_EMITTERS, SCENE_HAS_EMITTERS, emitters, false) \
+  X(VKRAY_SPEC_SPECULAR, SCENE_HAS_SPECULAR, specular, false) \
+  X(VKRAY_SPEC_AOVS, FIRST_HIT_PASSES, aovs, false)           \
+  X(VKRAY_SPEC_TEXTURES, SCENE_HAS_TEXTURES, textures, false)
 
 // ---- The first-hit passes (AOVs): sums over a pixel's samples, in the output's layout -------------
 // (albedo sum, hits as uint bits), (shading normal sum, object of sample 0 as int bits, -1: none),
