@@ -14,6 +14,7 @@
 #include "session/cpu_render.h"
 #include "support/parity_run.h"
 #include "support/temp_dir.h"
+#include "load/scene_loader.h"
 
 namespace vkray::test {
 namespace {

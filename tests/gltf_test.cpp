@@ -8,6 +8,7 @@
 
 #include "base/errors.h"
 #include "gltf/gltf.h"
+#include "load/scene_loader.h"
 #include "scene/scene.h"
 #include "support/error_of.h"
 #include "support/temp_dir.h"

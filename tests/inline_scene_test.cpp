@@ -15,6 +15,7 @@
 #include "bvh/bvh.h"
 #include "packing/inline_scene.h"
 #include "packing/scene_packing.h"
+#include "load/scene_loader.h"
 
 namespace vkray::gpu {
 namespace {

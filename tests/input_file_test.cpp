@@ -10,7 +10,8 @@
 #include "base/errors.h"
 #include "base/input_file.h"
 #include "base/interrupt.h"
-#include "mesh/load.h"
+#include "load/mesh_file.h"
+#include "load/scene_loader.h"
 #include "scene/scene.h"
 #include "support/temp_dir.h"
 

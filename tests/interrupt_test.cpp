@@ -12,8 +12,9 @@
 #include "bvh/bvh.h"
 #include "cpu/reference.h"
 #include "image/image.h"
-#include "mesh/load.h"
+#include "load/mesh_file.h"
 #include "packing/scene_packing.h"
+#include "load/scene_loader.h"
 #include "scene/scene.h"
 #include "support/temp_dir.h"
 

@@ -13,6 +13,7 @@
 
 #include "support/parity_run.h"
 #include "support/temp_dir.h"
+#include "load/scene_loader.h"
 
 namespace vkray::test {
 namespace {

@@ -9,8 +9,9 @@
 #include <gtest/gtest.h>
 
 #include "base/errors.h"
-#include "mesh/load.h"
+#include "load/mesh_file.h"
 #include "mesh/normals.h"
+#include "load/scene_loader.h"
 #include "scene/scene.h"
 #include "support/temp_dir.h"
 

@@ -10,6 +10,7 @@
 
 #include "session/check.h"
 #include "support/parity_run.h"
+#include "load/scene_loader.h"
 
 namespace vkray::test {
 namespace {

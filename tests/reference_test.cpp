@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "cpu/reference.h"
+#include "load/scene_loader.h"
 
 namespace vkray {
 namespace {

@@ -16,6 +16,7 @@
 #include "session/regions.h"
 #include "support/error_of.h"
 #include "support/temp_dir.h"
+#include "load/scene_loader.h"
 
 namespace vkray::test {
 namespace {

@@ -17,6 +17,7 @@
 #include "session/session.h"
 #include "support/gpu_fixture.h"
 #include "support/temp_dir.h"
+#include "load/scene_loader.h"
 
 namespace vkray::test {
 namespace {

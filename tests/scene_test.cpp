@@ -8,7 +8,8 @@
 #include <glm/gtc/constants.hpp>
 
 #include "base/errors.h"
-#include "scene/json_document.h"
+#include "base/json_document.h"
+#include "load/scene_loader.h"
 #include "scene/scene.h"
 
 namespace vkray {

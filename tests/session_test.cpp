@@ -16,6 +16,7 @@
 #include "support/gpu_fixture.h"
 #include "support/slow_shaders.h"
 #include "support/temp_dir.h"
+#include "load/scene_loader.h"
 
 namespace vkray::test {
 namespace {

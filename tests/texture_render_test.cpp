@@ -6,6 +6,7 @@
 #include "support/parity_run.h"
 #include "support/temp_dir.h"
 #include "support/test_assets.h"
+#include "load/scene_loader.h"
 
 namespace vkray::test {
 namespace {

@@ -7,6 +7,7 @@
 #include "image/decode.h"
 #include "image/image.h"
 #include "packing/scene_packing.h"
+#include "load/scene_loader.h"
 #include "scene/scene.h"
 #include "scene/texture.h"
 #include "support/error_of.h"

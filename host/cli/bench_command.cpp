@@ -18,6 +18,7 @@
 #include "image/image.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
+#include "load/scene_loader.h"
 #include "scene/scene.h"
 #include "session/cpu_render.h"
 #include "session/paths.h"

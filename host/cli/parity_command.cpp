@@ -18,6 +18,7 @@
 #include "session/parity.h"
 #include "session/session.h"
 #include "session/version.h"
+#include "load/scene_loader.h"
 
 namespace vkray::cli {
 namespace {

@@ -15,6 +15,7 @@
 #include "session/cpu_render.h"
 #include "session/parts.h"
 #include "session/session.h"
+#include "load/scene_loader.h"
 
 namespace vkray::cli {
 namespace {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "base/timing.h"
+#include "load/scene_loader.h"
 #include "scene/scene.h"
 
 namespace vkray::cli {

@@ -19,6 +19,7 @@
 #include "session/failure.h"
 #include "session/paths.h"
 #include "session/session.h"
+#include "load/scene_loader.h"
 
 namespace vkray::cli {
 namespace {

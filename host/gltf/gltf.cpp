@@ -12,11 +12,12 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "base/errors.h"
+#include "base/grow.h"
 #include "base/input_file.h"
 #include "base/interrupt.h"
 #include "gltf/tinygltf.h"
 #include "image/decode.h"
-#include "scene/json_document.h"
+#include "base/json_document.h"
 
 namespace vkray {
 namespace {
@@ -541,7 +542,7 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
       fail(where + ".attributes." + uv_name, "texture coordinate " + std::to_string(v) + " is not finite or past +-1e9");
     return glm::vec2(t);
   };
-  scene_.triangles.reserve(scene_.triangles.size() + triangles);
+  reserve_more(scene_.triangles, triangles);
   for (size_t t = 0; t < triangles; ++t) {
     if (t % 4096 == 0) throw_if_interrupted();
     std::array<uint32_t, 3> c;

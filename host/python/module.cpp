@@ -32,6 +32,7 @@
 #include "session/regions.h"
 #include "session/session.h"
 #include "session/version.h"
+#include "load/scene_loader.h"
 
 namespace py = pybind11;
 

@@ -144,38 +144,4 @@ struct Scene {
 // Session::upload_changes).
 bool same_geometry(const Scene& a, const Scene& b);
 
-struct Mesh;
-// Mesh files read by earlier scene loads, kept for the next ones (a face that loads edited scenes
-// in a loop): a file is read again when its size or modification time changed.
-class MeshCache {
- public:
-  MeshCache();
-  ~MeshCache();
-  MeshCache(const MeshCache&) = delete;
-  MeshCache& operator=(const MeshCache&) = delete;
-  // The mesh in `file`, read now (load_mesh) unless kept. Throws what load_mesh throws.
-  std::shared_ptr<const Mesh> get(const std::filesystem::path& file);
-  // Forgets every file but these (a scene's referenced_files), so that a long-lived cache holds
-  // only what the last scene uses.
-  void keep_only(const std::vector<std::filesystem::path>& files);
-
- private:
-  struct Entry;
-  std::map<std::filesystem::path, Entry> entries_;
-};
-
-// Reads and validates a scene file. Throws SceneError naming the file and the key (as a JSON
-// pointer, e.g. /objects/2/radius) or the line and column of a syntax error. `meshes`: a cache to
-// take mesh files from and keep them in; null reads each file once for this scene.
-Scene load_scene(const std::filesystem::path& file, MeshCache* meshes = nullptr);
-
-// A glTF file (.gltf or .glb, gltf/gltf.h) as a whole scene: its first camera, or one that frames its
-// geometry from the front; its point lights, or a point light at the camera when it brings no light;
-// a 512-pixel-high image in its camera's aspect ratio; the direct model. load_scene calls it for a
-// file with either extension.
-Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes = nullptr);
-
-// The same from text already in memory; `file` is used in messages and to resolve relative paths.
-Scene parse_scene(std::string_view json_text, const std::filesystem::path& file, MeshCache* meshes = nullptr);
-
 }  // namespace vkray

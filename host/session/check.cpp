@@ -10,6 +10,7 @@
 #include "packing/inline_scene.h"
 #include "session/cpu_render.h"
 #include "session/session.h"
+#include "load/scene_loader.h"
 
 namespace vkray {
 

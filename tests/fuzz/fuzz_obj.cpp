@@ -5,7 +5,7 @@
 #include <string_view>
 
 #include "base/errors.h"
-#include "mesh/load.h"
+#include "load/mesh_file.h"
 #include "mesh/mtl.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

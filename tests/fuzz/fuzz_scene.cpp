@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "base/errors.h"
+#include "load/scene_loader.h"
 #include "scene/scene.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,4 +1,4 @@
-#include "mesh/load.h"
+#include "load/mesh_file.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1,0 +1,126 @@
+#include "load/scene_loader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/gtc/constants.hpp>
+
+#include "base/errors.h"
+#include "base/input_file.h"
+#include "base/json_document.h"
+#include "load/scene_parser.h"
+
+namespace vkray {
+namespace scene_file {
+
+// Moves each textured triangle's texture coordinates by a whole number of periods toward [0, 2)
+// along each axis its textures repeat (an even number, so that a mirrored repeat reads the same):
+// exact in float, and the texture reads the same, but both renderers then interpolate small
+// numbers, so that a floor tiled 5000 times is not sampled half a texel apart by float and double.
+void recentre_texture_coordinates(Scene& scene) {
+  for (Triangle& t : scene.triangles) {
+    const Material& m = scene.materials[t.material];
+    if (!m.textured()) continue;
+    const auto repeats = [&](bool s) {
+      for (const TextureRef* ref : {&m.albedo_texture, &m.emission_texture})
+        if (ref->present() && (s ? ref->wrap_s : ref->wrap_t) == TextureWrap::clamp_to_edge) return false;
+      return true;
+    };
+    for (int axis = 0; axis < 2; ++axis) {
+      if (!repeats(axis == 0)) continue;
+      const float lowest = std::min({t.uv[0][axis], t.uv[1][axis], t.uv[2][axis]});
+      const float shift = 2.0f * std::floor(lowest / 2.0f);
+      for (glm::vec2& uv : t.uv) uv[axis] -= shift;
+    }
+  }
+}
+
+
+}  // namespace scene_file
+
+using scene_file::recentre_texture_coordinates;
+using scene_file::SceneParser;
+
+Scene parse_scene(std::string_view json_text, const std::filesystem::path& file, MeshCache* meshes) {
+  const nlohmann::json root = parse_json_document(json_text, file);
+  Scene scene;
+  scene.file = file;
+  scene.name = file.stem().string();
+  MeshCache this_scene;
+  SceneParser(file, scene, meshes ? *meshes : this_scene).parse(root);
+  recentre_texture_coordinates(scene);
+  return scene;
+}
+
+namespace {
+
+// The camera vkray frames a glTF scene with when the file has none: a 45-degree vertical field of
+// view from the front (glTF's +z) and a little above, so that the bounding sphere fills the height.
+Camera framing_camera(const Scene& scene) {
+  Camera camera;
+  camera.focal_length = 0.5f / std::tan(glm::radians(45.0f) / 2);
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (const Triangle& t : scene.triangles)
+    for (const glm::vec3& p : t.v) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+  if (scene.triangles.empty()) {
+    camera.position = glm::vec3(0.0f, 0.0f, 1.0f);
+    camera.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+    return camera;
+  }
+  const glm::dvec3 centre = (glm::dvec3(lo) + glm::dvec3(hi)) / 2.0;
+  const double radius = std::max(glm::length(glm::dvec3(hi) - glm::dvec3(lo)) / 2.0, 1e-6);
+  const double distance = radius / std::sin(glm::radians(45.0 / 2)) * 1.05;
+  const glm::dvec3 direction = glm::normalize(glm::dvec3(0.0, 0.3, 1.0));
+  camera.position = glm::vec3(centre + distance * direction);
+  camera.forward = glm::vec3(-direction);
+  return camera;
+}
+
+}  // namespace
+
+Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
+  Scene scene;
+  scene.file = file;
+  scene.name = file.stem().string();
+  scene.description = "The glTF file " + file.filename().string();
+  MeshCache this_scene;
+  SceneParser parser(file, scene, meshes ? *meshes : this_scene);
+  const auto [camera, aspect] = parser.add_gltf(nullptr, file, glm::mat4(1.0f));
+  scene.camera = camera ? *camera : framing_camera(scene);
+  if (!(glm::all(glm::lessThanEqual(glm::abs(scene.camera.position), glm::vec3(kMaxCoordinate)))))
+    throw LimitError(file.string() + ": the camera vkray frames the model with would stand past +-1e9 (README, \"Limits\")");
+  if (!camera) scene.warnings.push_back(file.string() + ": no perspective camera: vkray frames the scene from the front");
+  if (aspect > 0.0f)
+    scene.image.width = uint32_t(std::clamp(std::lround(double(scene.image.height) * aspect), 1l, long(kMaxImageSide)));
+  // A file that brings no light is lit from the camera, so that it is seen at all (DECISIONS.md, 19):
+  // a point light whose irradiance at the scene's centre, straight on, is 1.
+  const bool emitters = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissive(); });
+  if (scene.lights.empty() && !emitters && !scene.triangles.empty()) {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const Triangle& t : scene.triangles)
+      for (const glm::vec3& p : t.v) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+      }
+    const float distance = std::max(glm::length((lo + hi) / 2.0f - scene.camera.position), 1e-6f);
+    scene.lights.push_back(PointLight{scene.camera.position, glm::vec3(glm::pi<float>() * distance * distance)});
+    scene.warnings.push_back(file.string() + ": the file brings no light: vkray adds a point light at the camera");
+  }
+  recentre_texture_coordinates(scene);
+  return scene;
+}
+
+Scene load_scene(const std::filesystem::path& file, MeshCache* meshes) {
+  if (file.empty()) throw SceneError("the scene file name is empty");
+  if (is_gltf_path(file)) return load_gltf_scene(file, meshes);
+  const InputFile input = read_input_file(file, kMaxSceneFileBytes);
+  if (!input.error.empty()) throw SceneError(file.string() + ": " + input.error);
+  return parse_scene(input.text, file, meshes);
+}
+
+
+}  // namespace vkray

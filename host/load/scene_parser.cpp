@@ -1,0 +1,326 @@
+#include "load/scene_parser.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
+
+#include "base/interrupt.h"
+#include "scene/transform.h"
+
+namespace vkray::scene_file {
+namespace {
+
+// The longest focal length, in image heights (a field of view of 5.7e-5 degrees). The camera ray's
+// direction (F * H, x, y) is normalized: F * H (at most 1.6e10) squared stays far inside a float.
+constexpr float kMaxFocalLength = 1e6f;
+
+// The largest index of refraction: past every real material (diamond is 2.4), so that a typo shows.
+constexpr float kMaxIor = 100.0f;
+
+}  // namespace
+
+void SceneParser::parse(const json& root_json) {
+  const Value root{root_json, ""};
+  expect_object(root);
+  check_keys(root, {"description", "image", "camera", "integrator", "seed", "background", "ambient", "materials", "lights",
+                    "objects"});
+  if (root.has("description")) scene_.description = printable(string(root["description"]), 1000);
+  if (root.has("image")) parse_image(root["image"]);
+  if (root.has("seed")) scene_.image.seed = static_cast<uint32_t>(integer(root["seed"], 0, UINT32_MAX));
+  parse_camera(require(root, "camera"));
+  if (root.has("integrator")) parse_integrator(root["integrator"]);
+  if (root.has("background")) scene_.background = color(root["background"]);
+  if (root.has("ambient")) scene_.ambient = color(root["ambient"]);
+  if (root.has("materials")) parse_materials(root["materials"]);
+  if (root.has("lights")) {
+    const Value lights = root["lights"];
+    expect_array(lights);
+    for (size_t i = 0; i < lights.j.size(); ++i) parse_light(lights[i]);
+  }
+  if (root.has("objects")) {
+    const Value objects = root["objects"];
+    expect_array(objects);
+    for (size_t i = 0; i < objects.j.size(); ++i) {
+      object_ = static_cast<uint32_t>(i);
+      parse_object(objects[i]);
+    }
+  }
+  const bool path = scene_.integrator.type == Integrator::Type::path;
+  if (path && scene_.ambient != glm::vec3(0.0f))
+    warn(root["ambient"], "the path integrator carries indirect light itself: ambient is the direct model's stand-in for it, "
+                          "and is ignored");
+  const bool emitters = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const Material& m) { return m.emissive(); });
+  const bool lit = !scene_.lights.empty() || emitters || (path ? scene_.background : scene_.ambient) != glm::vec3(0.0f);
+  if (!lit && !scene_.triangles.empty())
+    warn(root, path ? "no lights, no emission and no background: every surface renders black"
+                    : "no lights, no emission and no ambient: every surface renders black");
+}
+
+void SceneParser::parse_image(const Value& v) {
+  expect_object(v);
+  check_keys(v, {"width", "height", "samples_per_pixel"});
+  if (v.has("width")) scene_.image.width = count(v["width"], kMaxImageSide);
+  if (v.has("height")) scene_.image.height = count(v["height"], kMaxImageSide);
+  if (v.has("samples_per_pixel"))
+    scene_.image.samples_per_pixel = count(v["samples_per_pixel"], kMaxSamplesPerPixel);
+}
+
+void SceneParser::parse_camera(const Value& v) {
+  expect_object(v);
+  check_keys(v, {"position", "look_at", "direction", "up", "vertical_fov", "focal_length", "aperture_radius", "focus_distance"});
+  Camera& cam = scene_.camera;
+  cam.position = vec3(require(v, "position"));
+  check_coordinates(v["position"], cam.position, "the camera");
+
+  // A direction is judged in double, where any finite float vector has a finite, non-zero length
+  // unless it is zero (in float, the square of 1e20 overflows and that of 1e-30 vanishes). Its
+  // value stays the float computation wherever that is finite, as it always was.
+  const auto unit = [](glm::vec3 d) {
+    const float length = glm::length(d);
+    return length > 0.0f && std::isfinite(length) ? d / length : glm::vec3(glm::normalize(glm::dvec3(d)));
+  };
+  const bool by_target = one_of(v, "look_at", "direction");
+  const Value aim = by_target ? v["look_at"] : v["direction"];
+  if (by_target) check_coordinates(aim, vec3(aim), "look_at");
+  const glm::vec3 forward = by_target ? vec3(aim) - cam.position : vec3(aim);
+  if (!(glm::length(glm::dvec3(forward)) > 0.0))
+    fail(aim, by_target ? "look_at equals the camera position: no view direction" : "direction has zero length");
+  cam.forward = unit(forward);
+
+  if (v.has("up")) {
+    const glm::vec3 up = vec3(v["up"]);
+    if (!(glm::length(glm::dvec3(up)) > 0.0)) fail(v["up"], "up has zero length");
+    // A float length that overflows or vanishes is normalized away; the renderers only need the
+    // direction (scene/camera.h).
+    cam.up = std::isfinite(glm::length(up)) && glm::length(up) > 0.0f ? up : unit(up);
+    // Relative test: |f x up/|up|| = sin of the angle between them.
+    if (glm::length(glm::cross(cam.forward, unit(cam.up))) < 1e-6f) fail(v["up"], "up is parallel to the view direction");
+  } else if (glm::length(glm::cross(cam.forward, cam.up)) < 1e-6f) {
+    fail(v, "the default up [0,1,0] is parallel to the view direction; give \"up\"");
+  }
+
+  if (one_of(v, "vertical_fov", "focal_length")) {
+    const float fov = number(v["vertical_fov"]);
+    if (!(fov > 0.0f && fov < 180.0f)) fail(v["vertical_fov"], "expected degrees in (0, 180), got " + brief(v["vertical_fov"].j));
+    // F = (H/2) / tan(fov/2) pixels = focal_length * H.
+    cam.focal_length = 0.5f / std::tan(glm::radians(fov) * 0.5f);
+    if (!(cam.focal_length <= kMaxFocalLength))
+      fail(v["vertical_fov"], "a field of view this narrow has a focal length past 1e6 image heights; "
+                              "the smallest vkray renders is 6e-5 degrees");
+  } else {
+    cam.focal_length = positive(v["focal_length"]);
+    if (!(cam.focal_length <= kMaxFocalLength))
+      fail(v["focal_length"], "expected at most 1e6 (image heights), got " + brief(v["focal_length"].j));
+  }
+
+  // The thin lens. The focus distance defaults to the target's, when the camera has one.
+  if (v.has("aperture_radius")) {
+    cam.aperture_radius = number(v["aperture_radius"]);
+    if (!(cam.aperture_radius >= 0.0f && cam.aperture_radius <= kMaxCoordinate))
+      fail(v["aperture_radius"], "expected a radius from 0 to 1e9, got " + brief(v["aperture_radius"].j));
+  }
+  if (v.has("focus_distance")) {
+    cam.focus_distance = positive(v["focus_distance"]);
+    if (!(cam.focus_distance <= 2.0f * kMaxCoordinate))
+      fail(v["focus_distance"], "expected a distance up to 2e9, got " + brief(v["focus_distance"].j));
+  } else if (cam.aperture_radius > 0.0f) {
+    if (!by_target) fail(v, "a camera with an aperture_radius needs a \"focus_distance\" (or a \"look_at\" to focus on)");
+    cam.focus_distance = glm::length(vec3(aim) - cam.position);
+  }
+  if (v.has("focus_distance") && cam.aperture_radius == 0.0f)
+    warn(v["focus_distance"], "a pinhole camera (aperture_radius 0) is sharp everywhere: focus_distance has no effect");
+}
+
+void SceneParser::parse_integrator(const Value& v) {
+  expect_object(v);
+  const std::string type = string(require(v, "type"));
+  Integrator& integrator = scene_.integrator;
+  if (type == "direct") {
+    check_keys(v, {"type"});
+    integrator.type = Integrator::Type::direct;
+  } else if (type == "path") {
+    check_keys(v, {"type", "max_depth", "rr_depth"});
+    integrator.type = Integrator::Type::path;
+    if (v.has("max_depth")) {
+      integrator.max_depth = static_cast<int32_t>(integer(v["max_depth"], -1, kMaxPathDepth));
+      if (integrator.max_depth == 0) fail(v["max_depth"], "max_depth 0 renders nothing: give -1 (no limit) or at least 1");
+    }
+    if (v.has("rr_depth")) integrator.rr_depth = static_cast<uint32_t>(integer(v["rr_depth"], 1, kMaxPathDepth));
+  } else {
+    fail(v["type"], "unknown integrator \"" + printable(type) + "\" (expected \"direct\" or \"path\")");
+  }
+}
+
+int64_t SceneParser::integer(const Value& v, int64_t min, int64_t max) const {
+  // JSON reads a non-negative integer as unsigned, which may pass int64_t's range.
+  const bool in_range = v.j.is_number_unsigned() ? v.j.get<uint64_t>() <= uint64_t(max) && int64_t(v.j.get<uint64_t>()) >= min
+                        : v.j.is_number_integer() ? v.j.get<int64_t>() >= min && v.j.get<int64_t>() <= max
+                                                  : false;
+  if (!in_range) fail(v, "expected an integer from " + std::to_string(min) + " to " + std::to_string(max) + ", got " + brief(v.j));
+  return v.j.is_number_unsigned() ? int64_t(v.j.get<uint64_t>()) : v.j.get<int64_t>();
+}
+
+bool SceneParser::flip_normals(const Value& v) const {
+  if (!v.has("flip_normals")) return false;
+  if (!v["flip_normals"].j.is_boolean()) fail(v["flip_normals"], std::string("expected true or false, got ") + v["flip_normals"].j.type_name());
+  return v["flip_normals"].j.get<bool>();
+}
+
+void SceneParser::parse_materials(const Value& v) {
+  expect_object(v);
+  for (const auto& [name, unused] : v.j.items()) {
+    const Value m = v[name];
+    expect_object(m);
+    Material material;
+    material.name = name;
+    const std::string type = m.has("type") ? string(m["type"]) : "diffuse";
+    // A colour in [0, 1]: more would reflect more light than arrives.
+    const auto reflectance = [&](const Value& c) {
+      const glm::vec3 rgb = color(c);
+      if (rgb.r > 1.0f || rgb.g > 1.0f || rgb.b > 1.0f) warn(c, "a value above 1 reflects more light than arrives");
+      return rgb;
+    };
+    if (type == "diffuse") {
+      check_keys(m, {"type", "albedo", "emission"});
+      material.albedo = reflectance(require(m, "albedo"));
+    } else if (type == "mirror") {
+      check_keys(m, {"type", "reflectance", "emission"});
+      material.type = MaterialType::mirror;
+      material.albedo = reflectance(require(m, "reflectance"));
+    } else if (type == "glass") {
+      check_keys(m, {"type", "ior", "emission"});
+      material.type = MaterialType::glass;
+      if (m.has("ior")) {
+        material.ior = positive(m["ior"]);
+        if (!(material.ior <= kMaxIor)) fail(m["ior"], "expected an index of refraction up to 100, got " + brief(m["ior"].j));
+      }
+    } else {
+      fail(m["type"], "unknown material type \"" + printable(type) + "\" (expected \"diffuse\", \"mirror\" or \"glass\")");
+    }
+    if (m.has("emission")) material.emission = color(m["emission"]);
+    material_index_[name] = static_cast<uint32_t>(scene_.materials.size());
+    scene_.materials.push_back(material);
+  }
+}
+
+uint32_t SceneParser::material_ref(const Value& v) const {
+  const std::string name = string(v);
+  const auto it = material_index_.find(name);
+  if (it == material_index_.end()) fail(v, "undefined material \"" + printable(name) + "\"");
+  return it->second;
+}
+
+void SceneParser::parse_light(const Value& v) {
+  expect_object(v);
+  check_keys(v, {"type", "position", "intensity", "power"});
+  const Value type = require(v, "type");
+  if (string(type) != "point") fail(type, "unknown light type " + brief(type.j) + " (expected \"point\")");
+  PointLight light;
+  light.position = vec3(require(v, "position"));
+  check_coordinates(v["position"], light.position, "the light");
+  if (one_of(v, "intensity", "power")) {
+    light.intensity = color(v["intensity"]);
+  } else {
+    light.intensity = color(v["power"]) / (4.0f * glm::pi<float>());  // isotropic: I = P / 4pi
+  }
+  scene_.lights.push_back(light);
+}
+
+glm::mat4 SceneParser::parse_transform(const Value& v) {
+  expect_object(v);
+  check_keys(v, {"translate", "rotate", "scale", "matrix"});
+  if (v.has("matrix")) {
+    if (v.has("translate") || v.has("rotate") || v.has("scale"))
+      fail(v, "give either \"matrix\" or translate/rotate/scale, not both");
+    const Value m = v["matrix"];
+    if (!m.j.is_array() || m.j.size() != 16) fail(m, "expected an array of 16 numbers (row-major 4x4)");
+    float values[16];
+    for (size_t i = 0; i < 16; ++i) values[i] = number(m[i]);
+    if (values[12] != 0.0f || values[13] != 0.0f || values[14] != 0.0f || values[15] != 1.0f)
+      fail(m, "the last row must be [0, 0, 0, 1] (an affine transform)");
+    const glm::mat4 matrix = matrix_from_row_major(values);
+    if (glm::determinant(glm::mat3(matrix)) == 0.0f) fail(m, "the matrix is singular");
+    return matrix;
+  }
+  glm::vec3 translate(0.0f), rotate(0.0f), scale(1.0f);
+  if (v.has("translate")) translate = vec3(v["translate"]);
+  if (v.has("rotate")) rotate = vec3(v["rotate"]);
+  if (v.has("scale")) {
+    const Value s = v["scale"];
+    scale = s.j.is_number() ? glm::vec3(number(s)) : vec3(s);
+    if (scale.x == 0.0f || scale.y == 0.0f || scale.z == 0.0f) fail(s, "scale must be non-zero");
+  }
+  return compose_transform(translate, rotate, scale);
+}
+
+void SceneParser::parse_object(const Value& v) {
+  throw_if_interrupted();
+  expect_object(v);
+  const Value type_value = require(v, "type");
+  const std::string type = string(type_value);
+  const glm::mat4 transform = v.has("transform") ? parse_transform(v["transform"]) : glm::mat4(1.0f);
+
+  if (type == "sphere") {
+    check_keys(v, {"type", "center", "radius", "material", "transform", "flip_normals"});
+    Sphere sphere;
+    sphere.inward = flip_normals(v);
+    sphere.center = vec3(require(v, "center"));
+    sphere.radius = positive(require(v, "radius"));
+    sphere.material = material_ref(require(v, "material"));
+    sphere.object = object_;
+    if (v.has("transform")) {
+      const auto s = uniform_scale_of(transform);
+      if (!s) fail(v["transform"], "a sphere takes only a uniform scale (with rotation and translation)");
+      sphere.center = transform_point(transform, sphere.center);
+      sphere.radius *= *s;
+    }
+    if (!(sphere.radius > 0.0f)) fail(v, "the transform scales the sphere's radius to zero");
+    check_coordinates(v, glm::abs(sphere.center) + sphere.radius, "the sphere's bounding box");
+    check_primitive_count(v, 1);
+    scene_.spheres.push_back(sphere);
+  } else if (type == "triangles") {
+    check_keys(v, {"type", "positions", "indices", "material", "transform", "flip_normals"});
+    const Value positions = require(v, "positions");
+    expect_array(positions);
+    std::vector<glm::vec3> points;
+    points.reserve(positions.j.size());
+    for (size_t i = 0; i < positions.j.size(); ++i) points.push_back(transform_point(transform, vec3(positions[i])));
+    const uint32_t material = material_ref(require(v, "material"));
+    const bool flip = flip_normals(v);
+    const Value indices = require(v, "indices");
+    expect_array(indices);
+    std::vector<Triangle> triangles;
+    triangles.reserve(indices.j.size());
+    for (size_t i = 0; i < indices.j.size(); ++i) {
+      const Value tri = indices[i];
+      if (!tri.j.is_array() || tri.j.size() != 3) fail(tri, "expected an array of 3 vertex indices, got " + brief(tri.j));
+      Triangle t;
+      t.material = material;
+      t.object = object_;
+      for (size_t k = 0; k < 3; ++k) {
+        const Value idx = tri[k];
+        if (!idx.j.is_number_integer() || idx.j.get<int64_t>() < 0 ||
+            idx.j.get<int64_t>() >= static_cast<int64_t>(points.size()))
+          fail(idx, "vertex index " + brief(idx.j) + " is out of range (the object has " +
+                        std::to_string(points.size()) + " positions)");
+        t.v[k] = points[idx.j.get<size_t>()];
+      }
+      if (flip) std::swap(t.v[1], t.v[2]);  // the other winding: the normal turned around
+      triangles.push_back(t);
+    }
+    add_triangles(indices, triangles);
+  } else if (type == "mesh") {
+    check_keys(v, {"type", "file", "material", "transform", "smooth", "flip_normals"});
+    parse_mesh(v, transform);
+  } else if (type == "gltf") {
+    check_keys(v, {"type", "file", "transform"});
+    const Value file_value = require(v, "file");
+    add_gltf(&file_value, (file_.parent_path() / string(file_value)).lexically_normal(), transform);
+  } else {
+    fail(type_value, "unknown object type \"" + printable(type) + "\" (expected \"sphere\", \"triangles\", \"mesh\" or \"gltf\")");
+  }
+}
+
+
+}  // namespace vkray::scene_file

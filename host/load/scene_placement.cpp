@@ -1,0 +1,297 @@
+#include "load/scene_parser.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "base/grow.h"
+#include "base/input_file.h"
+#include "base/interrupt.h"
+#include "mesh/normals.h"
+#include "scene/transform.h"
+
+namespace vkray::scene_file {
+
+std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where, const std::filesystem::path& file,
+                                                              const glm::mat4& transform) {
+  // A file placed several times is read once: its materials and textures are the scene's once, and
+  // its warnings said once.
+  auto loaded = gltf_files_.find(file);
+  if (loaded == gltf_files_.end()) {
+    LoadedGltf entry;
+    GltfLimits limits;
+    limits.max_texels = kMaxSceneTexels - std::min(kMaxSceneTexels, scene_texels_);
+    try {
+      entry.gltf = load_gltf(file, limits);
+    } catch (const LimitError& e) {
+      if (!where) throw;
+      throw LimitError(file_.string() + ": " + where->path + ": " + e.what());
+    } catch (const SceneError& e) {
+      if (!where) throw;
+      throw SceneError(file_.string() + ": " + where->path + ": " + e.what());
+    }
+    reference(file);
+    for (const auto& f : entry.gltf.files) reference(f);
+    for (const std::string& w : entry.gltf.warnings) {
+      if (where) warn(*where, w);
+      else scene_.warnings.push_back(w);
+    }
+    entry.material_offset = uint32_t(scene_.materials.size());
+    const auto texture_offset = int32_t(scene_.textures.size());
+    for (Material m : entry.gltf.materials) {
+      for (TextureRef* ref : {&m.albedo_texture, &m.emission_texture})
+        if (ref->present()) ref->texture += texture_offset;
+      scene_.materials.push_back(std::move(m));
+    }
+    for (const auto& t : entry.gltf.textures) add_texture(t);
+    loaded = gltf_files_.emplace(file, std::move(entry)).first;
+  }
+  const GltfScene& gltf = loaded->second.gltf;
+  const uint32_t material_offset = loaded->second.material_offset;
+  static const json kNothing;
+  const Value root{kNothing, ""};  // where messages point when the file is the scene itself
+  const Value& at = where ? *where : root;
+  // The object's transform on top of the file's own: normals by the inverse transpose, and the
+  // winding turned around where it mirrors.
+  const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(transform)));
+  const bool mirrors = glm::determinant(glm::mat3(transform)) < 0.0f;
+  const bool moved = transform != glm::mat4(1.0f);
+  std::vector<Triangle> placed = gltf.triangles;
+  for (Triangle& t : placed) {
+    t.material += material_offset;
+    t.object = object_;
+    if (!moved) continue;
+    for (size_t k = 0; k < 3; ++k) {
+      t.v[k] = transform_point(transform, t.v[k]);
+      if (t.smooth) t.normals[k] = glm::normalize(normal_matrix * t.normals[k]);
+    }
+    if (t.smooth && !std::all_of(t.normals.begin(), t.normals.end(), [](const glm::vec3& n) { return std::isfinite(n.x) && glm::length(n) > 0.5f; }))
+      t.smooth = false;
+    if (mirrors) {
+      std::swap(t.v[1], t.v[2]);
+      std::swap(t.normals[1], t.normals[2]);
+      std::swap(t.uv[1], t.uv[2]);
+    }
+  }
+  add_triangles(at, placed);
+  for (PointLight light : gltf.lights) {
+    light.position = transform_point(transform, light.position);
+    check_coordinates(at, light.position, "a light of the glTF file");
+    scene_.lights.push_back(light);
+  }
+  std::optional<Camera> camera = gltf.camera;
+  if (camera && moved) {
+    camera->position = transform_point(transform, camera->position);
+    camera->forward = glm::normalize(glm::mat3(transform) * camera->forward);
+    camera->up = glm::normalize(glm::mat3(transform) * camera->up);
+  }
+  return {camera, gltf.aspect_ratio};
+}
+
+void SceneParser::check_coordinates(const Value& where, const glm::vec3& p, const char* what) const {
+  for (int c = 0; c < 3; ++c)
+    if (!(std::abs(p[c]) <= kMaxCoordinate)) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", double(p[c]));
+      fail(where, std::string(what) + " has a coordinate of " + value +
+                      "; vkray renders world-space coordinates within +-1e9 (README, \"Limits\")");
+    }
+}
+
+void SceneParser::check_primitive_count(const Value& where, size_t adding) const {
+  const size_t count = scene_.triangles.size() + scene_.spheres.size();
+  if (adding > kMaxScenePrimitives - count)
+    throw LimitError(file_.string() + ": " + where.path + ": the scene would have " + std::to_string(count + adding) +
+                     " primitives; vkray renders at most " + std::to_string(kMaxScenePrimitives));
+}
+
+void SceneParser::add_triangles(const Value& where, std::vector<Triangle>& triangles) {
+  const auto within_limit = [](const glm::vec3& p) { return glm::all(glm::lessThanEqual(glm::abs(p), glm::vec3(kMaxCoordinate))); };
+  std::vector<bool> degenerate(triangles.size());
+  size_t left_out = 0;
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    if (i % 4096 == 0) throw_if_interrupted();  // a mesh of millions takes a while to place
+    const Triangle& t = triangles[i];
+    for (const glm::vec3& p : t.v)  // the message is made only for a triangle that fails
+      if (!within_limit(p)) check_coordinates(where, p, ("triangle " + std::to_string(i) + " (after the transform)").c_str());
+    degenerate[i] = glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f;
+    left_out += degenerate[i];
+  }
+  check_primitive_count(where, triangles.size() - left_out);
+  reserve_more(scene_.triangles, triangles.size() - left_out);
+  for (size_t i = 0; i < triangles.size(); ++i)
+    if (!degenerate[i]) scene_.triangles.push_back(triangles[i]);
+  if (left_out > 0) warn(where, std::to_string(left_out) + " degenerate (zero-area) triangles left out");
+}
+
+void SceneParser::reference(const std::filesystem::path& file) {
+  if (referenced_.insert(file).second) scene_.referenced_files.push_back(file);
+}
+
+int32_t SceneParser::texture_file(const Value& where, const std::filesystem::path& file, bool srgb) {
+  const auto key = std::make_pair(file, srgb);
+  if (const auto found = texture_files_.find(key); found != texture_files_.end()) return found->second;
+  reference(file);
+  std::shared_ptr<const Texture> texture;
+  try {
+    texture = std::make_shared<const Texture>(load_texture(file, srgb));
+  } catch (const LimitError& e) {
+    throw LimitError(file_.string() + ": " + where.path + ": " + e.what());
+  } catch (const SceneError& e) {
+    throw SceneError(file_.string() + ": " + where.path + ": " + e.what());
+  }
+  const uint64_t texels = uint64_t(texture->width) * texture->height;
+  if (texels > kMaxSceneTexels - std::min(kMaxSceneTexels, scene_texels_))
+    throw LimitError(file_.string() + ": " + where.path + ": " + file.string() + ": it brings the scene's textures past " +
+                     std::to_string(kMaxSceneTexels >> 20) + "M texels, vkray's limit (README, \"Limits\")");
+  const auto index = int32_t(scene_.textures.size());
+  add_texture(std::move(texture));
+  texture_files_[key] = index;
+  return index;
+}
+
+std::vector<uint32_t> SceneParser::mesh_materials(const Value& where, const std::filesystem::path& mesh_file, const Mesh& mesh) {
+  // Every library the file names, read now; a later definition of a name replaces an earlier one.
+  std::map<std::string, std::pair<MtlMaterial, std::filesystem::path>> defined;
+  for (const std::string& library : mesh.material_libraries) {
+    const std::filesystem::path file = (mesh_file.parent_path() / library).lexically_normal();
+    reference(file);
+    auto cached = mtl_files_.find(file);
+    if (cached == mtl_files_.end()) {  // a mesh placed many times reads its libraries once
+      const InputFile input = read_input_file(file, kMaxSceneFileBytes);
+      if (!input.error.empty())
+        throw MeshError(file_.string() + ": " + where.path + ": " + mesh_file.filename().string() + ": mtllib " + printable(library) +
+                        ": " + (input.error == "not found" ? "material library not found" : input.error));
+      MtlLibrary parsed;
+      try {
+        parsed = parse_mtl(input.text, file);
+      } catch (const MeshError& e) {
+        throw MeshError(file_.string() + ": " + where.path + ": " + e.what());
+      }
+      for (const std::string& w : parsed.warnings) warn(where, w);
+      cached = mtl_files_.emplace(file, std::move(parsed)).first;
+    }
+    for (const MtlMaterial& m : cached->second.materials) defined[m.name] = {m, file};
+  }
+  std::vector<uint32_t> index;  // mesh material -> scene material
+  for (const std::string& name : mesh.material_names) {
+    const auto found = defined.find(name);
+    if (found == defined.end())
+      throw MeshError(file_.string() + ": " + where.path + ": " + mesh_file.filename().string() + ": usemtl " + printable(name) +
+                      ": no material library it names (mtllib) defines it");
+    const MtlMaterial& mtl = found->second.first;
+    const std::filesystem::path& library = found->second.second;
+    Material material;
+    material.name = mesh_file.filename().string() + ": " + name;
+    material.albedo = mtl.diffuse;
+    material.emission = mtl.emission;
+    const auto map = [&](const MtlTexture& t) {
+      TextureRef ref;
+      ref.texture = texture_file(where, (library.parent_path() / t.file).lexically_normal(), true);
+      ref.wrap_s = ref.wrap_t = t.wrap;
+      return ref;
+    };
+    if (!mtl.diffuse_map.file.empty()) material.albedo_texture = map(mtl.diffuse_map);
+    if (!mtl.emission_map.file.empty()) material.emission_texture = map(mtl.emission_map);
+    index.push_back(uint32_t(scene_.materials.size()));
+    scene_.materials.push_back(std::move(material));
+  }
+  return index;
+}
+
+void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
+  const Value file_value = require(v, "file");
+  const std::filesystem::path file = (file_.parent_path() / string(file_value)).lexically_normal();
+  bool smooth = false;
+  if (v.has("smooth")) {
+    if (!v["smooth"].j.is_boolean()) fail(v["smooth"], std::string("expected true or false, got ") + v["smooth"].j.type_name());
+    smooth = v["smooth"].j.get<bool>();
+  }
+  std::shared_ptr<const Mesh> loaded;
+  try {
+    loaded = meshes_.get(file);
+  } catch (const MeshError& e) {
+    throw MeshError(file_.string() + ": " + file_value.path + ": " + e.what());
+  }
+  if (referenced_.insert(file).second) {
+    scene_.referenced_files.push_back(file);
+    if (loaded->polygons_split > 0)
+      warn(file_value, file.filename().string() + ": " + std::to_string(loaded->polygons_split) +
+                           " faces with more than 3 vertices split into triangles");
+  }
+  const Mesh& mesh = *loaded;
+
+  // The scene's material for every face, or the ones the file's faces name (an OBJ file's usemtl).
+  std::vector<uint32_t> file_materials;
+  uint32_t material = 0;
+  if (v.has("material")) {
+    material = material_ref(v["material"]);
+  } else if (!mesh.material_names.empty()) {
+    // The file's materials are the scene's once, however often the file is placed (as a glTF file's are).
+    auto made = mesh_file_materials_.find(file);
+    if (made == mesh_file_materials_.end()) {
+      MeshFileMaterials m;
+      m.named = mesh_materials(file_value, file, mesh);
+      const bool unnamed = std::find(mesh.triangle_materials.begin(), mesh.triangle_materials.end(), Mesh::kNoMaterial) !=
+                           mesh.triangle_materials.end();
+      if (unnamed) {  // faces before the first usemtl
+        Material grey;
+        grey.name = file.filename().string() + ": (no usemtl)";
+        grey.albedo = glm::vec3(0.8f);
+        m.unnamed = uint32_t(scene_.materials.size());
+        scene_.materials.push_back(grey);
+      }
+      made = mesh_file_materials_.emplace(file, std::move(m)).first;
+    }
+    file_materials = made->second.named;
+    material = made->second.unnamed;
+  } else {
+    fail(v, "missing required key \"material\" (" + file.filename().string() + " names no materials of its own)");
+  }
+
+  std::vector<glm::vec3> points(mesh.positions.size());
+  for (size_t i = 0; i < points.size(); ++i) points[i] = transform_point(transform, mesh.positions[i]);
+  std::vector<Triangle> triangles(mesh.triangles.size());
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    const uint32_t named = file_materials.empty() ? Mesh::kNoMaterial : mesh.triangle_materials[i];
+    triangles[i].material = named == Mesh::kNoMaterial ? material : file_materials[named];
+    triangles[i].object = object_;
+    for (int k = 0; k < 3; ++k) triangles[i].v[size_t(k)] = points[mesh.triangles[i][size_t(k)]];
+    if (!mesh.corner_uvs.empty()) triangles[i].uv = mesh.corner_uvs[i];
+  }
+  if (mesh.corner_uvs.empty() &&
+      std::any_of(triangles.begin(), triangles.end(), [&](const Triangle& t) { return scene_.materials[t.material].textured(); }))
+    warn(file_value, file.filename().string() + ": a textured material on faces without texture coordinates (vt): "
+                                                "every point takes the texture's value at (0, 0)");
+  if (smooth) {
+    if (!mesh.corner_normals.empty()) {
+      // Normals transform by the inverse transpose.
+      const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(transform)));
+      for (size_t i = 0; i < triangles.size(); ++i)
+        for (size_t k = 0; k < 3; ++k) triangles[i].normals[k] = glm::normalize(normal_matrix * mesh.corner_normals[i][k]);
+    } else {
+      std::vector<std::array<glm::vec3, 3>> corners(triangles.size());
+      for (size_t i = 0; i < triangles.size(); ++i) corners[i] = triangles[i].v;
+      const auto normals = area_weighted_normals(corners);
+      for (size_t i = 0; i < triangles.size(); ++i) triangles[i].normals = normals[i];
+    }
+    for (Triangle& t : triangles) {
+      t.smooth = true;
+      // A zero normal (a vertex only on degenerate faces, or a zero normal in the file) cannot be
+      // interpolated meaningfully: shade that triangle flat.
+      for (const glm::vec3& n : t.normals)
+        if (!std::isfinite(n.x) || glm::length(n) < 0.5f) t.smooth = false;
+    }
+  }
+  if (flip_normals(v))
+    for (Triangle& t : triangles) {  // the other winding, and the vertex normals turned with it
+      std::swap(t.v[1], t.v[2]);
+      std::swap(t.normals[1], t.normals[2]);
+      std::swap(t.uv[1], t.uv[2]);
+      for (glm::vec3& n : t.normals) n = -n;
+    }
+  add_triangles(file_value, triangles);
+}
+
+
+}  // namespace vkray::scene_file
