@@ -4,11 +4,12 @@
 #ifndef VKRAY_AOVS_GLSL
 #define VKRAY_AOVS_GLSL
 
+#include "shared/first_hit_layout.h"
 #include "primitives.glsl"
 #include "ray.glsl"
 #include "resources.glsl"
 
-layout(std430, set = 0, binding = VKRAY_BINDING_AOVS) buffer AovOutput { vec4 aov_texels[]; };
+layout(std430, set = 0, binding = VKRAY_BINDING_AOVS) buffer AovOutput { FirstHitTexels first_hit_output[]; };
 
 struct FirstHitSums {
   vec3 albedo;
@@ -26,16 +27,14 @@ bool first_sample;  // the sample under way is the pixel's sample 0 (set by trac
 void load_first_hits(uint index, bool continuing) {
   first_hits = FirstHitSums(vec3(0.0), 0u, vec3(0.0), -1, vec3(0.0), 0.0);
   if (!continuing) return;
-  int base = int(index) * VKRAY_TEXELS_PER_AOV_PIXEL;
-  vec4 a = aov_texels[base], b = aov_texels[base + 1], c = aov_texels[base + 2];
-  first_hits = FirstHitSums(a.rgb, floatBitsToUint(a.w), b.xyz, floatBitsToInt(b.w), c.xyz, c.w);
+  FirstHitTexels t = first_hit_output[index];
+  first_hits = FirstHitSums(first_hit_albedo(t), first_hit_count(t), first_hit_normal(t), first_hit_object(t),
+                            first_hit_position(t), first_hit_depth(t));
 }
 
 void store_first_hits(uint index) {
-  int base = int(index) * VKRAY_TEXELS_PER_AOV_PIXEL;
-  aov_texels[base] = vec4(first_hits.albedo, uintBitsToFloat(first_hits.hits));
-  aov_texels[base + 1] = vec4(first_hits.normal, intBitsToFloat(first_hits.object));
-  aov_texels[base + 2] = vec4(first_hits.position, first_hits.depth);
+  first_hit_output[index] = first_hit_texels(first_hits.albedo, first_hits.hits, first_hits.normal, first_hits.object,
+                                             first_hits.position, first_hits.depth);
 }
 
 // Called by the integrators where the camera ray hit surface `s` at x, t along the (unit) ray.

@@ -12,6 +12,7 @@
 #include "base/errors.h"
 #include "image/aovs.h"
 #include "session/cpu_render.h"
+#include "shared/first_hit_layout.h"
 #include "support/parity_run.h"
 #include "support/temp_dir.h"
 #include "load/scene_loader.h"
@@ -130,6 +131,21 @@ TEST(AovListTest, ParsesNamesAndRefusesUnknownOrRepeatedOnes) {
   } catch (const UsageError& e) {
     EXPECT_NE(std::string(e.what()).find("\"normals\""), std::string::npos) << e.what();
   }
+}
+
+TEST(FirstHitLayoutTest, EverySumComesBackAsItWasPacked) {
+  // The shader packs with these functions and the host unpacks with them: each sum in its own
+  // place, the count and the object as exact bits (the object may be -1, a NaN's bits as a float).
+  using namespace gpu;
+  const FirstHitTexels t = first_hit_texels(vec3(0.25f, 0.5f, 1.0f), 0xfffffffeu, vec3(-1.0f, 0.0f, 2.0f), -1,
+                                            vec3(3.0f, -4.0f, 5.0f), 6.5f);
+  EXPECT_EQ(first_hit_albedo(t), vec3(0.25f, 0.5f, 1.0f));
+  EXPECT_EQ(first_hit_count(t), 0xfffffffeu);
+  EXPECT_EQ(first_hit_normal(t), vec3(-1.0f, 0.0f, 2.0f));
+  EXPECT_EQ(first_hit_object(t), -1);
+  EXPECT_EQ(first_hit_position(t), vec3(3.0f, -4.0f, 5.0f));
+  EXPECT_EQ(first_hit_depth(t), 6.5f);
+  EXPECT_EQ(first_hit_object(first_hit_texels(vec3(0.0f), 1u, vec3(0.0f), 123456, vec3(0.0f), 0.0f)), 123456);
 }
 
 }  // namespace

@@ -65,7 +65,8 @@ TEST(ShaderCompilerTest, CompilesTheTracerAndListsEveryIncludedFile) {
                          "shared/sampling.h", "camera.glsl",     "ray.glsl",        "resources.glsl",
                          "shade.glsl",      "primitives.glsl",   "intersect.glsl",  "traversal.glsl",
                          "inline_scene.glsl", "warp.glsl",        "emitters.glsl",   "bsdf.glsl",
-                         "direct.glsl",     "path.glsl",         "aovs.glsl",       "texture.glsl"};
+                         "direct.glsl",     "path.glsl",         "aovs.glsl",       "texture.glsl",
+                         "shared/first_hit_layout.h"};
   for (const char* file : files) {
     const auto expected = (dir / file).lexically_normal();
     EXPECT_NE(std::find(shader.sources.begin(), shader.sources.end(), expected), shader.sources.end()) << file;

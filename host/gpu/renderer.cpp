@@ -13,6 +13,7 @@
 #include "gpu/buffer.h"
 #include "gpu/tiling.h"
 #include "packing/scene_packing.h"
+#include "shared/first_hit_layout.h"
 #include "shared/types.h"
 
 namespace vkray::gpu {
@@ -64,6 +65,18 @@ uint32_t samples_in_one_dispatch(const Scene& scene) {
 constexpr double kSubmissionSeconds = 0.1;
 // The most pixels a submission (an output slot) holds: 64 MiB a slot, two slots.
 constexpr uint64_t kMostSlotPixels = uint64_t(1) << 22;
+
+// A pixel's first-hit sums as the shader left them.
+FirstHitSums first_hit_sums(const FirstHitTexels& texels) {
+  FirstHitSums sums;
+  sums.albedo = first_hit_albedo(texels);
+  sums.hits = first_hit_count(texels);
+  sums.normal = first_hit_normal(texels);
+  sums.object = first_hit_object(texels);
+  sums.position = first_hit_position(texels);
+  sums.depth = first_hit_depth(texels);
+  return sums;
+}
 
 bool is_timeout(const std::exception_ptr& error) {
   try {
@@ -166,7 +179,7 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   const bool aovs = request.variant.aovs;
   if (aovs && !aovs_out) throw InternalError("a render of the first-hit passes with nowhere to put them");
   // The larger of the two outputs per pixel bounds a slot: the AOVs' when asked for.
-  const uint64_t pixel_bytes = (aovs ? VKRAY_TEXELS_PER_AOV_PIXEL : 1) * sizeof(glm::vec4);
+  const uint64_t pixel_bytes = aovs ? sizeof(FirstHitTexels) : sizeof(glm::vec4);
   const uint64_t slot_limit = ctx_->limits().maxStorageBufferRange / (kSlots * pixel_bytes);
   const uint64_t image_pixels = region.pixels();
   const bool fixed_tiles = request.tile_side > 0;
@@ -190,7 +203,7 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   frame->uniforms = upload_buffer(*ctx_, &uniforms, sizeof(uniforms), vk::BufferUsageFlagBits::eUniformBuffer);
   using M = vk::MemoryPropertyFlagBits;
   frame->output = create_buffer(*ctx_, output_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
-  const vk::DeviceSize aov_bytes = aovs ? output_bytes * VKRAY_TEXELS_PER_AOV_PIXEL : sizeof(glm::vec4) * VKRAY_TEXELS_PER_AOV_PIXEL;
+  const vk::DeviceSize aov_bytes = (aovs ? kSlots * slot_pixels : 1) * sizeof(FirstHitTexels);
   frame->aov_output = create_buffer(*ctx_, aov_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
   DescriptorWriter writer = frame->trace_pipeline->descriptors().writer();
   writer.buffer(VKRAY_BINDING_FRAME, *frame->uniforms.buffer).buffer(VKRAY_BINDING_OUTPUT, *frame->output.buffer);
@@ -308,19 +321,10 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
       }
     if (aovs) {
       frame->aov_output.invalidate(device);
-      const auto* aov_texels = static_cast<const glm::vec4*>(frame->aov_output.mapped) + size_t(tile.output_offset) * VKRAY_TEXELS_PER_AOV_PIXEL;
+      const auto* first_hits = static_cast<const FirstHitTexels*>(frame->aov_output.mapped) + tile.output_offset;
       for (uint32_t y = 0; y < tile.height; ++y)
-        for (uint32_t x = 0; x < tile.width; ++x) {
-          const glm::vec4* t = aov_texels + (size_t(y) * tile.width + x) * VKRAY_TEXELS_PER_AOV_PIXEL;
-          FirstHitSums sums;  // shaders/aovs.glsl's layout (shared/types.h)
-          sums.albedo = glm::vec3(t[0]);
-          sums.hits = std::bit_cast<uint32_t>(t[0].w);
-          sums.normal = glm::vec3(t[1]);
-          sums.object = std::bit_cast<int32_t>(t[1].w);
-          sums.position = glm::vec3(t[2]);
-          sums.depth = t[2].w;
-          aovs_out->set(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y, sums);
-        }
+        for (uint32_t x = 0; x < tile.width; ++x)
+          aovs_out->set(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y, first_hit_sums(first_hits[size_t(y) * tile.width + x]));
     }
     pixels_done += done.rect.pixels();
     readback_seconds += seconds_since(read_start);

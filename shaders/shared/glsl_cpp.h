@@ -15,7 +15,9 @@ using glm::uvec4;
 using glm::vec2;
 using glm::vec3;
 using glm::vec4;
+using glm::floatBitsToInt;
 using glm::floatBitsToUint;
+using glm::intBitsToFloat;
 using glm::uintBitsToFloat;
 using glm::min;
 }  // namespace vkray::gpu

@@ -1,8 +1,9 @@
 // The interface between the C++ host and trace.comp: binding numbers, specialization constants,
 // workgroup size, and the uniform and push-constant structs, each written once for both languages
-// (the scene buffers' texel layouts are in scene_layout.h). The C++ side static_asserts every
-// member's std140 offset right here. The binding table in host/gpu/pipeline.cpp gives each binding
-// its descriptor type, and the shader's own declarations are checked against it when it is compiled.
+// (the scene buffers' texel layouts are in scene_layout.h, the first-hit passes' in
+// first_hit_layout.h). The C++ side static_asserts every member's std140 offset right here. The
+// binding table in host/gpu/pipeline.cpp gives each binding its descriptor type, and the shader's
+// own declarations are checked against it when it is compiled.
 #ifndef VKRAY_SHARED_TYPES_H
 #define VKRAY_SHARED_TYPES_H
 
@@ -21,7 +22,7 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F: point lights
 #define VKRAY_BINDING_OUTPUT 6      // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
 #define VKRAY_BINDING_EMITTERS 7    // uniform texel buffer, RGBA32F: the area lights' alias table
-#define VKRAY_BINDING_AOVS 8        // storage buffer: VKRAY_TEXELS_PER_AOV_PIXEL vec4 per pixel (aovs.glsl)
+#define VKRAY_BINDING_AOVS 8        // storage buffer: FirstHitTexels per pixel (first_hit_layout.h)
 #define VKRAY_BINDING_TEXCOORDS 9   // uniform texel buffer, RGBA32F: texture coordinates of textured triangles
 #define VKRAY_BINDING_TEXTURES 10   // uniform texel buffer, RGBA16F: every texture's texels
 
@@ -53,11 +54,6 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_SPECULAR, SCENE_HAS_SPECULAR, specular, false) \
   X(VKRAY_SPEC_AOVS, FIRST_HIT_PASSES, aovs, false)           \
   X(VKRAY_SPEC_TEXTURES, SCENE_HAS_TEXTURES, textures, false)
-
-// ---- The first-hit passes (AOVs): sums over a pixel's samples, in the output's layout -------------
-// (albedo sum, hits as uint bits), (shading normal sum, object of sample 0 as int bits, -1: none),
-// (position sum, depth sum); the host divides by the hits (image/aovs.h).
-#define VKRAY_TEXELS_PER_AOV_PIXEL 3
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
