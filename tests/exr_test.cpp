@@ -10,6 +10,7 @@
 
 #include "base/errors.h"
 #include "image/exr.h"
+#include "image/image_file.h"
 #include "support/temp_dir.h"
 
 namespace vkray::test {

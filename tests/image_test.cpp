@@ -11,6 +11,7 @@
 
 #include "base/errors.h"
 #include "image/image.h"
+#include "image/image_file.h"
 
 namespace vkray {
 namespace {

@@ -12,6 +12,7 @@
 #include "bvh/bvh.h"
 #include "cpu/reference.h"
 #include "image/image.h"
+#include "image/image_file.h"
 #include "load/mesh_file.h"
 #include "packing/scene_packing.h"
 #include "load/scene_loader.h"

@@ -17,6 +17,7 @@
 #include "support/error_of.h"
 #include "support/temp_dir.h"
 #include "load/scene_loader.h"
+#include "image/image_file.h"
 
 namespace vkray::test {
 namespace {

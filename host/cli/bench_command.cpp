@@ -16,6 +16,7 @@
 #include "base/timing.h"
 #include "bvh/bvh.h"
 #include "image/image.h"
+#include "image/image_file.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "load/scene_loader.h"

@@ -15,6 +15,7 @@
 #include "session/parity_report.h"
 #include "cli/report.h"
 #include "image/image.h"
+#include "image/image_file.h"
 #include "session/parity.h"
 #include "session/session.h"
 #include "session/version.h"

@@ -12,6 +12,7 @@
 #include "image/aovs.h"
 #include "image/exr.h"
 #include "image/image.h"
+#include "image/image_file.h"
 #include "session/cpu_render.h"
 #include "session/parts.h"
 #include "session/session.h"

@@ -9,6 +9,7 @@
 
 #include "base/errors.h"
 #include "image/image.h"
+#include "image/image_file.h"
 #include "load/scene_loader.h"
 
 namespace vkray::cli {

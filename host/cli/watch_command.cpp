@@ -16,6 +16,7 @@
 #include "cli/flags.h"
 #include "cli/report.h"
 #include "image/image.h"
+#include "image/image_file.h"
 #include "session/failure.h"
 #include "session/paths.h"
 #include "session/session.h"

@@ -12,6 +12,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "base/errors.h"
+#include "base/extension.h"
 #include "base/grow.h"
 #include "base/input_file.h"
 #include "base/interrupt.h"
@@ -818,8 +819,7 @@ GltfScene load_gltf(const std::filesystem::path& file, const GltfLimits& limits)
 }
 
 bool is_gltf_path(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  const std::string ext = lower_extension(file);
   return ext == ".gltf" || ext == ".glb";
 }
 

@@ -164,25 +164,6 @@ void write_exr(const std::filesystem::path& file, const Image& image, const Aovs
   out.commit();
 }
 
-void write_render_image(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content) {
-  check_render_image(file, content);
-  if (is_exr(file)) return write_exr(file, image, aovs, content);
-  write_image(image, file);
-}
-
-bool is_exr(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-  return ext == ".exr";
-}
-
-void check_render_image(const std::filesystem::path& file, const ExrContent& content) {
-  if (is_exr(file)) return;
-  if (!content.passes.empty())
-    throw UsageError(file.string() + ": first-hit passes (--aov) are written to EXR files only: name the output *.exr");
-  if (content.full_float) throw UsageError(file.string() + ": --exr-float is for EXR files only: name the output *.exr");
-}
-
 ExrFile read_exr(const std::filesystem::path& file) {
   // OpenEXR allocates line buffers for the data window as it opens a file, before vkray sees the
   // header: a small file claiming a huge width must be refused by OpenEXR's own header check.

@@ -36,15 +36,6 @@ struct ExrWindow {
 void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content,
                const ExrWindow* window = nullptr);
 
-// What a face calls to write a render: write_exr for a ".exr" file, write_image otherwise. Throws
-// UsageError when passes or 32-bit floats are asked of another type, OutputError.
-void write_render_image(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content);
-
-// Whether `file` is named *.exr (in any case).
-bool is_exr(const std::filesystem::path& file);
-// Throws the UsageError write_render_image would, before any work is done.
-void check_render_image(const std::filesystem::path& file, const ExrContent& content);
-
 struct ExrFile {
   Image image;  // the data window's pixels
   Aovs aovs;  // the passes the file has; the others keep Aovs' defaults

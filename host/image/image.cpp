@@ -26,16 +26,9 @@
 #include "base/check.h"
 #include "base/errors.h"
 #include "base/interrupt.h"
-#include "image/exr.h"
 
 namespace vkray {
 namespace {
-
-std::string lower_extension(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
 
 // libpng reports errors through longjmp; this handler turns them into a message instead.
 [[noreturn]] void png_failed(png_structp png, png_const_charp message) {
@@ -156,6 +149,8 @@ bool encode_png(const Image& image, FILE* out, std::string& error) {
   return true;
 }
 
+}  // namespace
+
 void write_png(const Image& image, const std::filesystem::path& file) {
   AtomicFile out(file);
   std::string error;
@@ -175,7 +170,6 @@ void write_pfm(const Image& image, const std::filesystem::path& file) {
   out.commit();
 }
 
-}  // namespace
 
 uint8_t encode_srgb8_by_formula(float linear) {
   const float c = linear > 0.0f ? std::min(linear, 1.0f) : 0.0f;  // NaN encodes as 0
@@ -234,21 +228,6 @@ uint8_t encode_srgb8(float linear) {
 float decode_srgb8(uint8_t encoded) {
   const float c = float(encoded) / 255.0f;
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
-bool is_supported_image_path(const std::filesystem::path& file) {
-  const std::string ext = lower_extension(file);
-  return ext == ".png" || ext == ".pfm" || ext == ".exr";
-}
-
-bool is_pfm(const std::filesystem::path& file) { return lower_extension(file) == ".pfm"; }
-
-void write_image(const Image& image, const std::filesystem::path& file) {
-  const std::string ext = lower_extension(file);
-  if (ext == ".png") return write_png(image, file);
-  if (ext == ".pfm") return write_pfm(image, file);
-  if (ext == ".exr") return write_exr(file, image, nullptr, {});
-  throw OutputError(file.string() + ": unknown image type \"" + ext + "\" (expected .png, .pfm or .exr)");
 }
 
 Image read_pfm(const std::filesystem::path& file) {

@@ -31,17 +31,14 @@ uint8_t encode_srgb8(float linear);
 uint8_t encode_srgb8_by_formula(float linear);
 float decode_srgb8(uint8_t encoded);
 
-// Writes by extension: ".png" (8-bit sRGB), ".pfm" (32-bit float linear, rows bottom to top,
-// little-endian) or ".exr" (16-bit half float linear RGB; write_exr for more). The file is written under a temporary name in the same folder and renamed into
-// place, so a failure never leaves a partial image. Throws OutputError.
-void write_image(const Image& image, const std::filesystem::path& file);
+// PNG (8-bit sRGB) and PFM (32-bit float linear, rows bottom to top, little-endian) files, each
+// written under a temporary name in the same folder and renamed into place, so that a failure never
+// leaves a partial image. Throw OutputError. write_image (image_file.h) picks one by extension.
+void write_png(const Image& image, const std::filesystem::path& file);
+void write_pfm(const Image& image, const std::filesystem::path& file);
 
 // Readers, for tests and tools. read_png returns decoded (linear) values. Throw InputError.
 Image read_pfm(const std::filesystem::path& file);
 Image read_png(const std::filesystem::path& file);
-
-// Whether write_image knows the file's extension; whether it is ".pfm" (in any case).
-bool is_supported_image_path(const std::filesystem::path& file);
-bool is_pfm(const std::filesystem::path& file);
 
 }  // namespace vkray

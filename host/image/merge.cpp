@@ -5,6 +5,7 @@
 #include <string>
 
 #include "base/errors.h"
+#include "image/image_file.h"
 
 namespace vkray {
 namespace {

@@ -6,6 +6,7 @@
 #include "base/errors.h"
 #include "base/hash.h"
 #include "base/input_file.h"
+#include "image/image_file.h"
 
 namespace vkray {
 namespace {

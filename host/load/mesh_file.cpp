@@ -5,6 +5,7 @@
 #include <string>
 
 #include "base/errors.h"
+#include "base/extension.h"
 #include "base/input_file.h"
 #include "mesh/obj.h"
 #include "mesh/ply.h"
@@ -19,8 +20,7 @@ namespace {
 }  // namespace
 
 Mesh parse_mesh(std::string_view bytes, const std::filesystem::path& name) {
-  std::string ext = name.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  const std::string ext = lower_extension(name);
   Mesh mesh;
   if (ext == ".obj") {
     mesh = parse_obj(bytes, name);

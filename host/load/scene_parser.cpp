@@ -70,7 +70,7 @@ void SceneParser::parse_camera(const Value& v) {
   expect_object(v);
   check_keys(v, {"position", "look_at", "direction", "up", "vertical_fov", "focal_length", "aperture_radius", "focus_distance"});
   Camera& cam = scene_.camera;
-  cam.position = vec3(require(v, "position"));
+  cam.position = three_numbers(require(v, "position"));
   check_coordinates(v["position"], cam.position, "the camera");
 
   // A direction is judged in double, where any finite float vector has a finite, non-zero length
@@ -82,14 +82,14 @@ void SceneParser::parse_camera(const Value& v) {
   };
   const bool by_target = one_of(v, "look_at", "direction");
   const Value aim = by_target ? v["look_at"] : v["direction"];
-  if (by_target) check_coordinates(aim, vec3(aim), "look_at");
-  const glm::vec3 forward = by_target ? vec3(aim) - cam.position : vec3(aim);
+  if (by_target) check_coordinates(aim, three_numbers(aim), "look_at");
+  const glm::vec3 forward = by_target ? three_numbers(aim) - cam.position : three_numbers(aim);
   if (!(glm::length(glm::dvec3(forward)) > 0.0))
     fail(aim, by_target ? "look_at equals the camera position: no view direction" : "direction has zero length");
   cam.forward = unit(forward);
 
   if (v.has("up")) {
-    const glm::vec3 up = vec3(v["up"]);
+    const glm::vec3 up = three_numbers(v["up"]);
     if (!(glm::length(glm::dvec3(up)) > 0.0)) fail(v["up"], "up has zero length");
     // A float length that overflows or vanishes is normalized away; the renderers only need the
     // direction (scene/camera.h).
@@ -126,7 +126,7 @@ void SceneParser::parse_camera(const Value& v) {
       fail(v["focus_distance"], "expected a distance up to 2e9, got " + brief(v["focus_distance"].j));
   } else if (cam.aperture_radius > 0.0f) {
     if (!by_target) fail(v, "a camera with an aperture_radius needs a \"focus_distance\" (or a \"look_at\" to focus on)");
-    cam.focus_distance = glm::length(vec3(aim) - cam.position);
+    cam.focus_distance = glm::length(three_numbers(aim) - cam.position);
   }
   if (v.has("focus_distance") && cam.aperture_radius == 0.0f)
     warn(v["focus_distance"], "a pinhole camera (aperture_radius 0) is sharp everywhere: focus_distance has no effect");
@@ -217,7 +217,7 @@ void SceneParser::parse_light(const Value& v) {
   const Value type = require(v, "type");
   if (string(type) != "point") fail(type, "unknown light type " + brief(type.j) + " (expected \"point\")");
   PointLight light;
-  light.position = vec3(require(v, "position"));
+  light.position = three_numbers(require(v, "position"));
   check_coordinates(v["position"], light.position, "the light");
   if (one_of(v, "intensity", "power")) {
     light.intensity = color(v["intensity"]);
@@ -244,11 +244,11 @@ glm::mat4 SceneParser::parse_transform(const Value& v) {
     return matrix;
   }
   glm::vec3 translate(0.0f), rotate(0.0f), scale(1.0f);
-  if (v.has("translate")) translate = vec3(v["translate"]);
-  if (v.has("rotate")) rotate = vec3(v["rotate"]);
+  if (v.has("translate")) translate = three_numbers(v["translate"]);
+  if (v.has("rotate")) rotate = three_numbers(v["rotate"]);
   if (v.has("scale")) {
     const Value s = v["scale"];
-    scale = s.j.is_number() ? glm::vec3(number(s)) : vec3(s);
+    scale = s.j.is_number() ? glm::vec3(number(s)) : three_numbers(s);
     if (scale.x == 0.0f || scale.y == 0.0f || scale.z == 0.0f) fail(s, "scale must be non-zero");
   }
   return compose_transform(translate, rotate, scale);
@@ -265,7 +265,7 @@ void SceneParser::parse_object(const Value& v) {
     check_keys(v, {"type", "center", "radius", "material", "transform", "flip_normals"});
     Sphere sphere;
     sphere.inward = flip_normals(v);
-    sphere.center = vec3(require(v, "center"));
+    sphere.center = three_numbers(require(v, "center"));
     sphere.radius = positive(require(v, "radius"));
     sphere.material = material_ref(require(v, "material"));
     sphere.object = object_;
@@ -285,7 +285,7 @@ void SceneParser::parse_object(const Value& v) {
     expect_array(positions);
     std::vector<glm::vec3> points;
     points.reserve(positions.j.size());
-    for (size_t i = 0; i < positions.j.size(); ++i) points.push_back(transform_point(transform, vec3(positions[i])));
+    for (size_t i = 0; i < positions.j.size(); ++i) points.push_back(transform_point(transform, three_numbers(positions[i])));
     const uint32_t material = material_ref(require(v, "material"));
     const bool flip = flip_normals(v);
     const Value indices = require(v, "indices");

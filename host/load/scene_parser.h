@@ -102,12 +102,12 @@ class SceneParser {
       fail(v, "expected an integer from 1 to " + std::to_string(max) + ", got " + brief(v.j));
     return static_cast<uint32_t>(v.j.get<int64_t>());
   }
-  glm::vec3 vec3(const Value& v) const {
+  glm::vec3 three_numbers(const Value& v) const {
     if (!v.j.is_array() || v.j.size() != 3) fail(v, "expected an array of 3 numbers, got " + brief(v.j));
     return {number(v[0]), number(v[1]), number(v[2])};
   }
   glm::vec3 color(const Value& v) const {  // non-negative RGB
-    const glm::vec3 c = vec3(v);
+    const glm::vec3 c = three_numbers(v);
     if (c.r < 0.0f || c.g < 0.0f || c.b < 0.0f) fail(v, "expected non-negative values, got " + brief(v.j));
     return c;
   }

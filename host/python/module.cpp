@@ -22,6 +22,7 @@
 #include "base/timing.h"
 #include "image/aovs.h"
 #include "image/exr.h"
+#include "image/image_file.h"
 #include "image/merge.h"
 #include "session/cpu_render.h"
 #include "session/failure.h"

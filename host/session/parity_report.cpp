@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "image/image.h"
+#include "image/image_file.h"
 #include "session/version.h"
 
 namespace vkray {

@@ -3,6 +3,7 @@
 #include "base/errors.h"
 #include "scene/digest.h"
 #include "session/version.h"
+#include "image/image_file.h"
 
 namespace vkray {
 

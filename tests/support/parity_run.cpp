@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "image/image.h"
+#include "image/image_file.h"
 
 namespace vkray::test {
 

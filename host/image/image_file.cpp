@@ -1,0 +1,46 @@
+#include "image/image_file.h"
+
+#include <string>
+
+#include "base/errors.h"
+#include "base/extension.h"
+
+namespace vkray {
+
+std::optional<ImageFileType> image_file_type(const std::filesystem::path& file) {
+  const std::string ext = lower_extension(file);
+  if (ext == ".png") return ImageFileType::png;
+  if (ext == ".pfm") return ImageFileType::pfm;
+  if (ext == ".exr") return ImageFileType::exr;
+  return std::nullopt;
+}
+
+bool is_supported_image_path(const std::filesystem::path& file) { return image_file_type(file).has_value(); }
+bool is_pfm(const std::filesystem::path& file) { return image_file_type(file) == ImageFileType::pfm; }
+bool is_exr(const std::filesystem::path& file) { return image_file_type(file) == ImageFileType::exr; }
+
+void write_image(const Image& image, const std::filesystem::path& file) {
+  const auto type = image_file_type(file);
+  if (!type)
+    throw OutputError(file.string() + ": unknown image type \"" + lower_extension(file) + "\" (expected .png, .pfm or .exr)");
+  switch (*type) {
+    case ImageFileType::png: return write_png(image, file);
+    case ImageFileType::pfm: return write_pfm(image, file);
+    case ImageFileType::exr: return write_exr(file, image, nullptr, {});
+  }
+}
+
+void write_render_image(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content) {
+  check_render_image(file, content);
+  if (is_exr(file)) return write_exr(file, image, aovs, content);
+  write_image(image, file);
+}
+
+void check_render_image(const std::filesystem::path& file, const ExrContent& content) {
+  if (is_exr(file)) return;
+  if (!content.passes.empty())
+    throw UsageError(file.string() + ": first-hit passes (--aov) are written to EXR files only: name the output *.exr");
+  if (content.full_float) throw UsageError(file.string() + ": --exr-float is for EXR files only: name the output *.exr");
+}
+
+}  // namespace vkray
