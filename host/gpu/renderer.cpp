@@ -88,25 +88,226 @@ bool is_timeout(const std::exception_ptr& error) {
   }
 }
 
+
+// The output holds two submissions' pixels (slots), not the image: any image size fits the
+// device's maxStorageBufferRange (128 MiB on lavapipe). One slot is traced while the other is read
+// back.
+constexpr uint32_t kSlots = 2;
+// Tiles and bands are cut in whole workgroups.
+constexpr uint32_t kGranule = VKRAY_WORKGROUP_X;
+
+// How a render's submissions fit the output's slots.
+struct SlotPlan {
+  uint64_t slot_pixels = 0;  // the most pixels one submission holds
+  uint32_t tile_side = 0;    // square tiles of this side; 0: bands sized by SubmissionSizer
+};
+
+// Square tiles of request.tile_side when asked for (smaller where a slot cannot hold one), otherwise
+// bands. Throws DeviceError when not even the least submission fits the device.
+SlotPlan plan_slots(const Context& ctx, const TraceRequest& request, const PixelRegion& region) {
+  // The larger of the two outputs per pixel bounds a slot: the AOVs' when asked for.
+  const uint64_t pixel_bytes = request.variant.aovs ? sizeof(FirstHitTexels) : sizeof(glm::vec4);
+  const uint64_t slot_limit = ctx.limits().maxStorageBufferRange / (kSlots * pixel_bytes);
+  const uint64_t image_pixels = region.pixels();
+  const bool fixed_tiles = request.tile_side > 0;
+  uint32_t side = request.tile_side;
+  const auto square_pixels = [&] { return uint64_t(std::min(side, region.width())) * std::min(side, region.height()); };
+  while (fixed_tiles && side > kGranule && square_pixels() > slot_limit) side -= kGranule;
+  // The least a slot must hold: the square asked for, or the smallest piece a submission may be.
+  const uint64_t needed = fixed_tiles ? square_pixels() : std::min<uint64_t>(image_pixels, kGranule * kGranule);
+  if (needed > slot_limit)
+    throw DeviceError("a render tile does not fit " + ctx.device_name() + ": " + std::to_string(kSlots * needed * pixel_bytes) +
+                      " bytes of output, maxStorageBufferRange is " + std::to_string(ctx.limits().maxStorageBufferRange));
+  if (fixed_tiles) return {needed, side};
+  return {std::min({kMostSlotPixels, slot_limit, std::max<uint64_t>(image_pixels, kGranule * kGranule)}), 0};
+}
+
+// Where the next tile comes from: the region cut in squares of the plan's side, or in bands sized by
+// the time the ones before took. Tiles are in the image's coordinates, which the shader's sample
+// pattern takes.
+class TileSource {
+ public:
+  TileSource(const Scene& scene, const TraceRequest& request, const PixelRegion& region, const SlotPlan& plan)
+      : region_(region),
+        side_(plan.tile_side),
+        cursor_(region.width(), region.height(), kGranule),
+        sizer_(sizer(first_submission_pixels(scene, request.image), plan, request.tile_timeout)) {}
+
+  bool done() const { return cursor_.done(); }
+  TileRect next() {
+    TileRect rect = side_ > 0 ? cursor_.next_square(side_) : cursor_.next(sizer_.next());
+    rect.x0 += region_.x0;
+    rect.y0 += region_.y0;
+    return rect;
+  }
+  // A submission of `pixels` took `seconds` of device time.
+  void finished(uint64_t pixels, double seconds) { sizer_.finished(pixels, seconds); }
+
+ private:
+  // The first submission is the size the cost model gives; the sizer takes over from the second's
+  // time on, aiming at a tenth of --tile-timeout at most, so that growing 8x from a cheap
+  // submission stays within it.
+  static SubmissionSizer sizer(uint64_t first, const SlotPlan& plan, std::chrono::milliseconds tile_timeout) {
+    const double target_seconds = std::min(kSubmissionSeconds, 0.1 * std::chrono::duration<double>(tile_timeout).count());
+    return SubmissionSizer(first, std::max<uint64_t>(kGranule * kGranule, first / 64), plan.slot_pixels, target_seconds);
+  }
+
+  PixelRegion region_;
+  uint32_t side_;
+  TileCursor cursor_;
+  SubmissionSizer sizer_;
+};
+
+// The push constants of a tile traced in `slot`, but for its samples.
+TileConstants tile_constants(const TileRect& rect, uint32_t slot, uint64_t slot_pixels) {
+  TileConstants tile{};
+  tile.x0 = rect.x0;
+  tile.y0 = rect.y0;
+  tile.width = rect.width;
+  tile.height = rect.height;
+  tile.row_stride = row_stride((tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y);
+  tile.output_offset = uint32_t(slot * slot_pixels);
+  tile.probe_iterations = 2;
+  return tile;
+}
+
 }  // namespace
 
 // Everything one render's submissions use. Declaration order is destruction order reversed: the
 // command buffer before its pool, the descriptor set before the buffers, the pipeline and the
 // scene (and through them the device) last.
 struct Renderer::Frame {
+  // Binds a frame: the frame's uniforms, the output's slots and the descriptor set.
+  Frame(const Context& ctx, std::shared_ptr<const TracePipeline> trace_pipeline, std::shared_ptr<const GpuScene> scene,
+        const ImageSettings& image, const SlotPlan& plan, bool aovs);
+  // A command buffer and a fence for each slot.
+  void create_commands(const Context& ctx);
+  // Records and submits the next submission: `rect`'s samples, at most samples_per_dispatch of them
+  // in one dispatch.
+  void submit_tile(const Context& ctx, const TileRect& rect, uint32_t samples_per_pixel, uint32_t samples_per_dispatch);
+  // Waits for submission `index` and frees its fence; returns when it was seen finished.
+  Clock::time_point wait_for_tile(const Context& ctx, uint32_t index, std::chrono::milliseconds timeout);
+  // Copies submission `index`'s pixels into `result` (and its first-hit passes into `aovs`, when
+  // asked for), both in the region's coordinates, and adds its rays. Returns false, having copied
+  // nothing, when the driver cut its loops short.
+  bool read_tile_back(const vk::raii::Device& device, uint32_t index, const PixelRegion& region, Image& result, Aovs* aovs,
+                      uint64_t& rays) const;
+
+  struct Submitted {
+    TileRect rect;
+    Clock::time_point at;
+  };
+
   std::shared_ptr<const TracePipeline> trace_pipeline;
   std::shared_ptr<const GpuScene> scene;
   std::shared_ptr<const vk::raii::Pipeline> pipeline;
+  SlotPlan plan;
   Buffer uniforms;
-  Buffer output;  // two tiles' slots: one traced while the other is read back
+  Buffer output;  // kSlots tiles' slots: one traced while the other is read back
   Buffer aov_output;  // the same slots' first-hit passes (a placeholder when not asked for)
   std::optional<DescriptorSet> descriptors;
   vk::raii::CommandPool command_pool{nullptr};
   vk::raii::CommandBuffers command_buffers{nullptr};  // one per slot
   std::vector<vk::raii::Fence> fences;                // one per slot
+  std::array<Submitted, kSlots> slots{};              // submission i is in slots[i % kSlots] until read back
+  uint32_t submitted = 0;
   std::vector<vk::Fence> in_flight;                   // submitted and not yet waited for
   bool timed_out = false;                             // left running by a TimeoutError, not an interrupt
 };
+
+Renderer::Frame::Frame(const Context& ctx, std::shared_ptr<const TracePipeline> trace_pipeline_in,
+                       std::shared_ptr<const GpuScene> scene_in, const ImageSettings& image, const SlotPlan& plan_in, bool aovs)
+    : trace_pipeline(std::move(trace_pipeline_in)), scene(std::move(scene_in)), plan(plan_in) {
+  const FrameUniforms frame_uniforms = pack_frame(scene->scene(), scene->primitive_count(), scene->emitters(), image);
+  uniforms = upload_buffer(ctx, &frame_uniforms, sizeof(frame_uniforms), vk::BufferUsageFlagBits::eUniformBuffer);
+  using M = vk::MemoryPropertyFlagBits;
+  const vk::DeviceSize output_bytes = kSlots * plan.slot_pixels * sizeof(glm::vec4);
+  output = create_buffer(ctx, output_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
+  const vk::DeviceSize aov_bytes = (aovs ? kSlots * plan.slot_pixels : 1) * sizeof(FirstHitTexels);
+  aov_output = create_buffer(ctx, aov_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
+  DescriptorWriter writer = trace_pipeline->descriptors().writer();
+  writer.buffer(VKRAY_BINDING_FRAME, *uniforms.buffer).buffer(VKRAY_BINDING_OUTPUT, *output.buffer);
+  writer.buffer(VKRAY_BINDING_AOVS, *aov_output.buffer);
+  scene->bind(writer);
+  descriptors = writer.write();
+}
+
+void Renderer::Frame::create_commands(const Context& ctx) {
+  const vk::raii::Device& device = ctx.device();
+  command_pool = vk::raii::CommandPool(device, {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, ctx.queue_family()});
+  command_buffers = vk::raii::CommandBuffers(device, {*command_pool, vk::CommandBufferLevel::ePrimary, kSlots});
+  fences.reserve(kSlots);
+  for (uint32_t slot = 0; slot < kSlots; ++slot) fences.emplace_back(device, vk::FenceCreateInfo{});
+  in_flight.reserve(kSlots);  // so that recording a submission cannot fail after it is made
+}
+
+void Renderer::Frame::submit_tile(const Context& ctx, const TileRect& rect, uint32_t samples_per_pixel,
+                                  uint32_t samples_per_dispatch) {
+  const uint32_t slot = submitted++ % kSlots;
+  slots[slot] = {rect, Clock::now()};
+  TileConstants tile = tile_constants(rect, slot, plan.slot_pixels);
+  const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
+  const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
+  const vk::PipelineLayout layout = *trace_pipeline->layout();
+  const vk::raii::CommandBuffer& cb = command_buffers[slot];
+  // The slot's command buffer and output were last used by the submission before the last, waited
+  // for and read.
+  cb.reset();
+  cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+  cb.bindPipeline(vk::PipelineBindPoint::eCompute, **pipeline);
+  cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, layout, 0, descriptors->get(), {});
+  // The samples in dispatches of at most samples_per_dispatch, each continuing the last one's sums.
+  for (tile.sample_begin = 0; tile.sample_begin < samples_per_pixel; tile.sample_begin = tile.sample_end) {
+    tile.sample_end = std::min(samples_per_pixel, tile.sample_begin + samples_per_dispatch);
+    if (tile.sample_begin > 0) {  // the last dispatch's sums are read by this one
+      const vk::MemoryBarrier sums(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
+      cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {}, sums, {}, {});
+    }
+    cb.pushConstants<TileConstants>(layout, vk::ShaderStageFlagBits::eCompute, 0, tile);
+    cb.dispatch(groups_x, groups_y, 1);
+  }
+  // The shader's writes are read by the host after the fence.
+  const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
+  cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+  cb.end();
+  const vk::CommandBuffer raw = *cb;
+  const vk::Fence fence = *fences[slot];
+  ctx.queue().submit(vk::SubmitInfo({}, {}, raw), fence);
+  in_flight.push_back(fence);  // reserved: cannot throw
+}
+
+Clock::time_point Renderer::Frame::wait_for_tile(const Context& ctx, uint32_t index, std::chrono::milliseconds timeout) {
+  const vk::raii::Fence& fence = fences[index % kSlots];
+  ctx.wait(fence, timeout, "a render tile");
+  const auto finished = Clock::now();
+  std::erase(in_flight, *fence);
+  ctx.device().resetFences(*fence);
+  return finished;
+}
+
+bool Renderer::Frame::read_tile_back(const vk::raii::Device& device, uint32_t index, const PixelRegion& region, Image& result,
+                                     Aovs* aovs, uint64_t& rays) const {
+  const TileConstants tile = tile_constants(slots[index % kSlots].rect, index % kSlots, plan.slot_pixels);
+  output.invalidate(device);
+  const auto* texels = static_cast<const glm::vec4*>(output.mapped) + tile.output_offset;
+  for (uint32_t y = 0; y < tile.height; ++y)
+    for (uint32_t x = 0; x < tile.width; ++x)
+      if (std::bit_cast<uint32_t>(texels[size_t(y) * tile.width + x].w) & VKRAY_LOOPS_CUT_SHORT) return false;
+  for (uint32_t y = 0; y < tile.height; ++y)
+    for (uint32_t x = 0; x < tile.width; ++x) {
+      const glm::vec4& texel = texels[size_t(y) * tile.width + x];
+      result.at(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y) = glm::vec3(texel);
+      rays += std::bit_cast<uint32_t>(texel.w);
+    }
+  if (aovs) {
+    aov_output.invalidate(device);
+    const auto* first_hits = static_cast<const FirstHitTexels*>(aov_output.mapped) + tile.output_offset;
+    for (uint32_t y = 0; y < tile.height; ++y)
+      for (uint32_t x = 0; x < tile.width; ++x)
+        aovs->set(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y, first_hit_sums(first_hits[size_t(y) * tile.width + x]));
+  }
+  return true;
+}
 
 Renderer::Renderer(std::shared_ptr<const Context> ctx) : ctx_(std::move(ctx)) {}
 
@@ -162,188 +363,27 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   if (busy(request.tile_timeout))
     throw TimeoutError("the device is still running a render tile that timed out before, " +
                        std::to_string(request.tile_timeout.count()) + " ms later");
-  TraceStats stats;
-  const vk::raii::Device& device = ctx_->device();
   const ImageSettings& image = request.image;
   const PixelRegion region = request.region.empty() ? full_region(image.width, image.height) : request.region;
   if (!region.within(image.width, image.height))
     throw InternalError("a render of pixels " + to_string(region) + " outside its image");
-
-  // ---- per-frame data: uniforms, output, descriptors ----
-  auto start = Clock::now();
-  // The output holds two submissions' pixels (slots), not the image: any image size fits the
-  // device's maxStorageBufferRange (128 MiB on lavapipe). Submissions are square tiles of
-  // request.tile_side when asked for, and otherwise bands sized by SubmissionSizer.
-  constexpr uint32_t kSlots = 2;
-  constexpr uint32_t kGranule = VKRAY_WORKGROUP_X;
   const bool aovs = request.variant.aovs;
   if (aovs && !aovs_out) throw InternalError("a render of the first-hit passes with nowhere to put them");
-  // The larger of the two outputs per pixel bounds a slot: the AOVs' when asked for.
-  const uint64_t pixel_bytes = aovs ? sizeof(FirstHitTexels) : sizeof(glm::vec4);
-  const uint64_t slot_limit = ctx_->limits().maxStorageBufferRange / (kSlots * pixel_bytes);
-  const uint64_t image_pixels = region.pixels();
-  const bool fixed_tiles = request.tile_side > 0;
-  uint32_t side = request.tile_side;
-  const auto square_pixels = [&] { return uint64_t(std::min(side, region.width())) * std::min(side, region.height()); };
-  while (fixed_tiles && side > kGranule && square_pixels() > slot_limit) side -= kGranule;
-  // The least a slot must hold: the square asked for, or the smallest piece a submission may be.
-  const uint64_t needed = fixed_tiles ? square_pixels() : std::min<uint64_t>(image_pixels, kGranule * kGranule);
-  if (needed > slot_limit)
-    throw DeviceError("a render tile does not fit " + ctx_->device_name() + ": " + std::to_string(kSlots * needed * pixel_bytes) +
-                      " bytes of output, maxStorageBufferRange is " + std::to_string(ctx_->limits().maxStorageBufferRange));
-  const uint64_t slot_pixels =
-      fixed_tiles ? needed : std::min({kMostSlotPixels, slot_limit, std::max<uint64_t>(image_pixels, kGranule * kGranule)});
-  const vk::DeviceSize output_bytes = kSlots * slot_pixels * sizeof(glm::vec4);
+
+  TraceStats stats;
+  auto start = Clock::now();
+  const SlotPlan plan = plan_slots(*ctx_, request, region);
   Image result(region.width(), region.height());  // the host's copy, filled tile by tile
   if (aovs) *aovs_out = Aovs(region.width(), region.height());
-  auto frame = std::make_unique<Frame>();
-  frame->trace_pipeline = std::move(trace_pipeline);
-  frame->scene = std::move(scene);
-  const FrameUniforms uniforms = pack_frame(frame->scene->scene(), frame->scene->primitive_count(), frame->scene->emitters(), image);
-  frame->uniforms = upload_buffer(*ctx_, &uniforms, sizeof(uniforms), vk::BufferUsageFlagBits::eUniformBuffer);
-  using M = vk::MemoryPropertyFlagBits;
-  frame->output = create_buffer(*ctx_, output_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
-  const vk::DeviceSize aov_bytes = (aovs ? kSlots * slot_pixels : 1) * sizeof(FirstHitTexels);
-  frame->aov_output = create_buffer(*ctx_, aov_bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
-  DescriptorWriter writer = frame->trace_pipeline->descriptors().writer();
-  writer.buffer(VKRAY_BINDING_FRAME, *frame->uniforms.buffer).buffer(VKRAY_BINDING_OUTPUT, *frame->output.buffer);
-  writer.buffer(VKRAY_BINDING_AOVS, *frame->aov_output.buffer);
-  frame->scene->bind(writer);
-  frame->descriptors = writer.write();
+  auto frame = std::make_unique<Frame>(*ctx_, std::move(trace_pipeline), std::move(scene), image, plan, aovs);
   stats.upload_seconds = seconds_since(start);
 
-  // ---- trace, one submission per tile; each tile read back while the next one traces ----
   frame->pipeline = frame->trace_pipeline->pipeline(request.variant);  // compiled here unless asked for before
   start = Clock::now();
-  double readback_seconds = 0;
-  frame->command_pool = vk::raii::CommandPool(device, {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, ctx_->queue_family()});
-  frame->command_buffers = vk::raii::CommandBuffers(device, {*frame->command_pool, vk::CommandBufferLevel::ePrimary, kSlots});
-  frame->fences.reserve(kSlots);
-  for (uint32_t slot = 0; slot < kSlots; ++slot) frame->fences.emplace_back(device, vk::FenceCreateInfo{});
-  frame->in_flight.reserve(kSlots);  // so that recording a submission cannot fail after it is made
-  abandoned_.reserve(abandoned_.size() + 1);  // nor keeping the frame when the device still runs it
-  const vk::PipelineLayout layout = *frame->trace_pipeline->layout();
-  uint32_t samples_per_dispatch = samples_in_one_dispatch(frame->scene->scene());
-  TileCursor cursor(region.width(), region.height(), kGranule);  // in the region's coordinates
-  // The first submission is the size the cost model gives; the sizer takes over from the second's
-  // time on.
-  const uint64_t first = first_submission_pixels(frame->scene->scene(), image);
-  // A tenth of --tile-timeout at most, so that growing 8x from a cheap submission stays within it.
-  const double target_seconds = std::min(kSubmissionSeconds, 0.1 * std::chrono::duration<double>(request.tile_timeout).count());
-  SubmissionSizer sizer(first, std::max<uint64_t>(kGranule * kGranule, first / 64), slot_pixels, target_seconds);
-  struct Submitted {
-    TileRect rect;
-    Clock::time_point at;
-  };
-  std::array<Submitted, kSlots> slots;  // submission i is in slots[i % kSlots] until finished
-  uint32_t submitted = 0;
-  Clock::time_point last_finished = start;
-  uint64_t pixels_done = 0;
-  const auto tile_constants = [&](uint32_t index) {
-    const TileRect& rect = slots[index % kSlots].rect;
-    TileConstants tile{};
-    tile.x0 = rect.x0;
-    tile.y0 = rect.y0;
-    tile.width = rect.width;
-    tile.height = rect.height;
-    tile.row_stride = row_stride((tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y);
-    tile.output_offset = uint32_t((index % kSlots) * slot_pixels);
-    tile.probe_iterations = 2;
-    return tile;
-  };
-  // Submits the next tile, or `again` (one whose loops were cut short).
-  const auto submit = [&](std::optional<TileRect> again = std::nullopt) {
-    const uint32_t index = submitted++;
-    TileRect rect = again ? *again : fixed_tiles ? cursor.next_square(side) : cursor.next(sizer.next());
-    if (!again) {  // to the image's coordinates, which the shader's sample pattern takes
-      rect.x0 += region.x0;
-      rect.y0 += region.y0;
-    }
-    slots[index % kSlots] = {rect, Clock::now()};
-    TileConstants tile = tile_constants(index);
-    const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
-    const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
-    const vk::raii::CommandBuffer& cb = frame->command_buffers[index % kSlots];
-    // The slot's command buffer and output were last used by submission index - 2, waited for and read.
-    cb.reset();
-    cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
-    cb.bindPipeline(vk::PipelineBindPoint::eCompute, **frame->pipeline);
-    cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, layout, 0, frame->descriptors->get(), {});
-    // The samples in dispatches of at most samples_per_dispatch, each continuing the last one's sums.
-    for (tile.sample_begin = 0; tile.sample_begin < image.samples_per_pixel; tile.sample_begin = tile.sample_end) {
-      tile.sample_end = std::min(image.samples_per_pixel, tile.sample_begin + samples_per_dispatch);
-      if (tile.sample_begin > 0) {  // the last dispatch's sums are read by this one
-        const vk::MemoryBarrier sums(vk::AccessFlagBits::eShaderWrite,
-                                     vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
-        cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
-                           sums, {}, {});
-      }
-      cb.pushConstants<TileConstants>(layout, vk::ShaderStageFlagBits::eCompute, 0, tile);
-      cb.dispatch(groups_x, groups_y, 1);
-    }
-    // The shader's writes are read by the host after the fence.
-    const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
-    cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
-    cb.end();
-    const vk::CommandBuffer raw = *cb;
-    const vk::Fence fence = *frame->fences[index % kSlots];
-    ctx_->queue().submit(vk::SubmitInfo({}, {}, raw), fence);
-    frame->in_flight.push_back(fence);  // reserved: cannot throw
-  };
-  // Waits for a submission, gives the sizer its time, copies its pixels into the image and frees its
-  // slot. Returns false, having copied nothing, when the driver cut its loops short.
-  const auto finish = [&](uint32_t index) {
-    const vk::raii::Fence& fence = frame->fences[index % kSlots];
-    ctx_->wait(fence, request.tile_timeout, "a render tile");
-    const auto read_start = Clock::now();
-    // The device ran it from when it was submitted or, queued behind the one before, from when
-    // that one finished. The first one's time also holds the driver's compile (lavapipe compiles
-    // at the first dispatch): not a rate to go by.
-    const Submitted& done = slots[index % kSlots];
-    if (index > 0) sizer.finished(done.rect.pixels(), seconds_between(std::max(done.at, last_finished), read_start));
-    last_finished = read_start;
-    std::erase(frame->in_flight, *fence);
-    device.resetFences(*fence);
-    frame->output.invalidate(device);
-    const TileConstants tile = tile_constants(index);
-    const auto* texels = static_cast<const glm::vec4*>(frame->output.mapped) + tile.output_offset;
-    for (uint32_t y = 0; y < tile.height; ++y)
-      for (uint32_t x = 0; x < tile.width; ++x)
-        if (std::bit_cast<uint32_t>(texels[size_t(y) * tile.width + x].w) & VKRAY_LOOPS_CUT_SHORT) {
-          readback_seconds += seconds_since(read_start);
-          return false;
-        }
-    for (uint32_t y = 0; y < tile.height; ++y)
-      for (uint32_t x = 0; x < tile.width; ++x) {
-        const glm::vec4& texel = texels[size_t(y) * tile.width + x];
-        result.at(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y) = glm::vec3(texel);
-        stats.rays += std::bit_cast<uint32_t>(texel.w);
-      }
-    if (aovs) {
-      frame->aov_output.invalidate(device);
-      const auto* first_hits = static_cast<const FirstHitTexels*>(frame->aov_output.mapped) + tile.output_offset;
-      for (uint32_t y = 0; y < tile.height; ++y)
-        for (uint32_t x = 0; x < tile.width; ++x)
-          aovs_out->set(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y, first_hit_sums(first_hits[size_t(y) * tile.width + x]));
-    }
-    pixels_done += done.rect.pixels();
-    readback_seconds += seconds_since(read_start);
-    if (request.progress) request.progress(uint32_t(pixels_done), uint32_t(image_pixels));
-    return true;
-  };
+  frame->create_commands(*ctx_);
+  abandoned_.reserve(abandoned_.size() + 1);  // so that keeping the frame when the device still runs it cannot fail
   try {
-    submit();
-    for (uint32_t finished = 0; finished < submitted; ++finished) {
-      if (!cursor.done()) submit();  // queued behind the one waited for below: the device never idles
-      if (!finish(finished)) {
-        if (samples_per_dispatch == 1)
-          throw DeviceError(ctx_->device_name() + " cut the shader's loops short within one sample of a pixel (llvmpipe "
-                            "stops an invocation after 65535 loop iterations): the scene needs more than that");
-        samples_per_dispatch = std::max(1u, samples_per_dispatch / 2);  // the rest of the render too
-        submit(slots[finished % kSlots].rect);
-      }
-      if (!cursor.done() && interrupt_requested()) throw Cancelled();
-    }
+    trace_tiles(*frame, request, region, result, aovs ? aovs_out : nullptr, stats);
   } catch (...) {
     // Timed out, interrupted, or any other failure while a tile may still run: what it uses is kept
     // until the device is done with it (busy()), never destroyed under it.
@@ -356,10 +396,43 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
   // Reading back overlaps tracing: the trace is the whole span (so rays/s are not flattered), the
   // read back its own part of it.
   stats.trace_seconds = seconds_since(start);
-  stats.readback_seconds = readback_seconds;
-  stats.tiles = submitted;
+  stats.tiles = frame->submitted;
   if (stats_out) *stats_out = stats;
   return result;
+}
+
+void Renderer::trace_tiles(Frame& frame, const TraceRequest& request, const PixelRegion& region, Image& result, Aovs* aovs,
+                           TraceStats& stats) {
+  TileSource tiles(frame.scene->scene(), request, region, frame.plan);
+  uint32_t samples_per_dispatch = samples_in_one_dispatch(frame.scene->scene());
+  const uint32_t samples = request.image.samples_per_pixel;
+  Clock::time_point last_finished;
+  uint64_t pixels_done = 0;
+  frame.submit_tile(*ctx_, tiles.next(), samples, samples_per_dispatch);
+  for (uint32_t finished = 0; finished < frame.submitted; ++finished) {
+    // The next one is queued behind the one waited for below: the device never idles.
+    if (!tiles.done()) frame.submit_tile(*ctx_, tiles.next(), samples, samples_per_dispatch);
+    const Frame::Submitted done = frame.slots[finished % kSlots];
+    const Clock::time_point read_start = frame.wait_for_tile(*ctx_, finished, request.tile_timeout);
+    // The device ran it from when it was submitted or, queued behind the one before, from when
+    // that one finished. The first one's time also holds the driver's compile (lavapipe compiles
+    // at the first dispatch): not a rate to go by.
+    if (finished > 0) tiles.finished(done.rect.pixels(), seconds_between(std::max(done.at, last_finished), read_start));
+    last_finished = read_start;
+    const bool complete = frame.read_tile_back(ctx_->device(), finished, region, result, aovs, stats.rays);
+    stats.readback_seconds += seconds_since(read_start);
+    if (complete) {
+      pixels_done += done.rect.pixels();
+      if (request.progress) request.progress(uint32_t(pixels_done), uint32_t(region.pixels()));
+    } else {
+      if (samples_per_dispatch == 1)
+        throw DeviceError(ctx_->device_name() + " cut the shader's loops short within one sample of a pixel (llvmpipe "
+                          "stops an invocation after 65535 loop iterations): the scene needs more than that");
+      samples_per_dispatch = std::max(1u, samples_per_dispatch / 2);  // the rest of the render too
+      frame.submit_tile(*ctx_, done.rect, samples, samples_per_dispatch);
+    }
+    if (!tiles.done() && interrupt_requested()) throw Cancelled();
+  }
 }
 
 }  // namespace vkray::gpu

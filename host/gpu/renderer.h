@@ -70,6 +70,12 @@ class Renderer {
 
  private:
   struct Frame;
+  // Submits the region's tiles, each queued behind the one before, and reads each back into
+  // `result` (and `aovs`, when not null) while the next one traces; adds the rays and the time spent
+  // reading back to `stats`.
+  void trace_tiles(Frame& frame, const TraceRequest& request, const PixelRegion& region, Image& result, Aovs* aovs,
+                   TraceStats& stats);
+
   std::shared_ptr<const Context> ctx_;
   std::vector<std::unique_ptr<Frame>> abandoned_;  // frames whose last tile timed out
 };
