@@ -1,6 +1,7 @@
 // Every error reaches a face as one exit code and one message (base/errors.h, session/failure.h):
 // vkray's own by their kind, a dependency's classified once.
 #include <new>
+#include <string>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -31,6 +32,25 @@ TEST(FailureTest, EachKindHasItsExitCode) {
   const Failure shader = failure_of(ShaderError("a.glsl:3: error: x\nb.glsl:4: error: y"));
   EXPECT_EQ(shader.exit_code, kExitBadInput);
   EXPECT_TRUE(shader.multiline);
+}
+
+TEST(FailureTest, ALongPathLosesItsMiddleAndKeepsTheFileNameAndTheReason) {
+  std::string path = "/home/user";
+  for (int i = 0; i < 40; ++i) path += "/folder-" + std::string(60, char('a' + i % 26));
+  path += "/the-scene.json";
+  const Failure failure = failure_of(SceneError(path + ": File name too long"));
+  EXPECT_LE(failure.message.size(), 1010u);
+  EXPECT_EQ(failure.message.rfind("/home/user/folder-", 0), 0u) << failure.message;
+  EXPECT_NE(failure.message.find(" ... "), std::string::npos) << failure.message;
+  const std::string end = "/the-scene.json: File name too long";
+  ASSERT_GE(failure.message.size(), end.size());
+  EXPECT_EQ(failure.message.substr(failure.message.size() - end.size()), end) << failure.message;
+  // A message that fits is left as it is; a cut never splits a UTF-8 character.
+  EXPECT_EQ(printable_middle("short: not found", 1000), "short: not found");
+  std::string wide;
+  for (int i = 0; i < 600; ++i) wide += "\xc3\xa9";  // e acute
+  const std::string cut = printable_middle(wide, 100);
+  EXPECT_EQ(cut.find('?'), std::string::npos) << cut;
 }
 
 TEST(FailureTest, AMeshErrorIsASceneError) {

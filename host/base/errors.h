@@ -119,4 +119,19 @@ inline std::string printable(std::string_view text, size_t max_length = 60) {
   return out;
 }
 
+// printable() for a whole message of up to about max_length characters: a longer one loses its
+// middle, not its end, so that a long path keeps the file's own name and what is wrong with it
+// ("/home/a/very/lo ... /deep/scene.json: not found").
+inline std::string printable_middle(std::string_view text, size_t max_length) {
+  if (text.size() <= max_length) return printable(text, max_length);
+  // Both cuts fall between characters, not inside one (UTF-8 continuation bytes are 10xxxxxx).
+  const auto inside = [&](size_t at) { return at < text.size() && (static_cast<unsigned char>(text[at]) & 0xc0) == 0x80; };
+  size_t head = max_length / 3;
+  while (head > 0 && inside(head)) --head;
+  size_t tail_start = text.size() - (max_length - max_length / 3);
+  while (inside(tail_start)) ++tail_start;
+  std::string out = printable(text.substr(0, head), head);
+  return out + " ... " + printable(text.substr(tail_start), max_length);
+}
+
 }  // namespace vkray

@@ -47,7 +47,7 @@ std::variant<const Command*, int> parse_command_line(CommandLine& line, int argc
   } catch (const CLI::ParseError& e) {
     // CLI11's own codes for usage errors become the one documented code; its message quotes the
     // arguments, which may hold anything.
-    err << "vkray: " << printable(e.what(), 500) << "\nRun with --help for more information.\n";
+    err << "vkray: " << printable_middle(e.what(), 500) << "\nRun with --help for more information.\n";
     return int(kExitUsage);
   }
   for (const Command& command : line.commands)

@@ -17,7 +17,7 @@ constexpr size_t kMaxLines = 100;
 
 Failure fit_to_print(Failure failure) {
   if (!failure.multiline) {
-    failure.message = printable(failure.message, kMaxLineLength);
+    failure.message = printable_middle(failure.message, kMaxLineLength);
     return failure;
   }
   std::string fitted;
@@ -25,7 +25,7 @@ Failure fit_to_print(Failure failure) {
   for (; at < failure.message.size() && lines < kMaxLines; ++lines) {
     const size_t end = std::min(failure.message.find('\n', at), failure.message.size());
     if (lines > 0) fitted += '\n';
-    fitted += printable(std::string_view(failure.message).substr(at, end - at), kMaxLineLength);
+    fitted += printable_middle(std::string_view(failure.message).substr(at, end - at), kMaxLineLength);
     at = end + 1;
   }
   if (at < failure.message.size()) fitted += "\n... (more lines left out)";
