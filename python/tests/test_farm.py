@@ -246,6 +246,18 @@ def test_bad_jobs_fail_before_any_work_with_a_message(scenes, tmp_path, args, co
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_python_without_dask_is_told_what_to_install_for_it(scenes, tmp_path):
+    # As a venv, pyenv or conda interpreter without Dask runs it: `distributed` cannot be imported.
+    hide_dask = ("import runpy, sys; sys.modules['distributed'] = None; sys.argv[0] = 'vkray.farm'; "
+                 "runpy.run_module('vkray.farm', run_name='__main__', alter_sys=True)")
+    job = run(sys.executable, "-c", hide_dask, f"{scenes}/cornell.json", "-o", "x.pfm", check=False, cwd=tmp_path)
+    assert job.returncode == 1, job.stderr
+    assert "needs Dask's distributed" in job.stderr, job.stderr
+    assert f"{sys.executable} -m pip install distributed" in job.stderr, job.stderr
+    assert "Traceback" not in job.stderr, job.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_outputs_are_renamed_into_place_all_or_none(tmp_path):
     # The farm's last step: frame 0 is renamed into place, frame 1 cannot be (its folder is gone), and
     # frame 0's earlier file is back as it was.

@@ -23,11 +23,16 @@ from __future__ import annotations
 import json
 import operator
 import os
+import sys
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, Optional, Union
 
-import numpy as np
+try:
+    import numpy as np
+except ModuleNotFoundError as _missing:  # a venv, pyenv or conda Python without Debian's python3-numpy
+    raise ModuleNotFoundError(f"vkray needs numpy, which {sys.executable} cannot import: install it for this Python: "
+                              f"{sys.executable} -m pip install numpy", name="numpy") from _missing
 
 from . import _vkray
 from ._vkray import DeviceError, Error, InternalError, SceneError, UsageError, __version__

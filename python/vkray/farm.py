@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib
+import importlib.util
 import logging
 import os
 import shutil
@@ -160,6 +161,24 @@ def _log(quiet: bool, line: str) -> None:
         print(f"vkray.farm: {line}", file=sys.stderr, flush=True)
 
 
+class _MissingDask(Exception):
+    """Dask's distributed is not importable by the Python that runs the farm."""
+
+
+def _require_dask() -> None:
+    """Fails before any work when this interpreter lacks Dask's distributed, saying how to get it
+    for this interpreter: Debian's python3-distributed serves /usr/bin/python3 only, not a venv,
+    pyenv or conda interpreter."""
+    if importlib.util.find_spec("distributed") is not None:
+        return
+    advice = f"install it for this Python: {sys.executable} -m pip install distributed"
+    if sys.executable != "/usr/bin/python3" and os.path.exists("/usr/bin/python3"):
+        advice += " (or run the farm with /usr/bin/python3 after apt-get install python3-distributed)"
+    elif os.path.exists("/etc/debian_version"):
+        advice = "install it: apt-get install python3-distributed (or " + advice + ")"
+    raise _MissingDask(f"the farm needs Dask's distributed, which {sys.executable} cannot import; {advice}")
+
+
 class _CannotWrite(Exception):
     pass
 
@@ -202,6 +221,7 @@ def _connect(args: argparse.Namespace):  # -> (Client, cluster or None)
 
 def run(argv: Optional[Sequence[str]] = None) -> int:
     args = _parser().parse_args(argv)
+    _require_dask()
     output = Path(args.output)
     suffix = _PART_SUFFIX.get(output.suffix.lower())
     if suffix is None:
@@ -406,9 +426,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             if isinstance(e, kind):
                 print(f"vkray.farm: error: {e}", file=sys.stderr)
                 return code
-        if isinstance(e, (_CannotWrite, _ClusterError)):
+        if isinstance(e, (_CannotWrite, _MissingDask, _ClusterError)):
             print(f"vkray.farm: error: {e}", file=sys.stderr)
-            return 1 if isinstance(e, _CannotWrite) else 3
+            return 3 if isinstance(e, _ClusterError) else 1
         # The cluster's: a scheduler out of reach, a worker lost too often (KilledWorker).
         print(f"vkray.farm: error: {type(e).__name__}: {e}", file=sys.stderr)
         return 3
