@@ -77,12 +77,12 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
 
 }  // namespace
 
-struct GpuScene::Geometry {
+struct SceneBuffers::Geometry {
   TexelBuffer primitives, normals, nodes, texcoords, textures;
   std::vector<uint32_t> order;  // the BVH's leaf order: the lighting's area lights name slots in it
 };
 
-struct GpuScene::Lighting {
+struct SceneBuffers::Lighting {
   TexelBuffer materials, lights, emitters;
 
   Lighting(const Context& ctx, const PackedLighting& packed)
@@ -91,7 +91,7 @@ struct GpuScene::Lighting {
         emitters(make_texel_buffer(ctx, packed.emitters, "area light")) {}
 };
 
-GpuScene::GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* prebuilt)
+SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* prebuilt)
     : ctx_(std::move(ctx)), scene_(std::move(scene)) {
   const auto start = Clock::now();
   Bvh built;
@@ -114,7 +114,7 @@ GpuScene::GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Sce
   upload_seconds_ = seconds_since(start) + (prebuilt ? prebuilt->build_seconds : 0.0);
 }
 
-GpuScene::GpuScene(const GpuScene& same, std::shared_ptr<const Scene> scene)
+SceneBuffers::SceneBuffers(const SceneBuffers& same, std::shared_ptr<const Scene> scene)
     : ctx_(same.ctx_),
       scene_(std::move(scene)),
       geometry_(same.geometry_),
@@ -129,9 +129,9 @@ GpuScene::GpuScene(const GpuScene& same, std::shared_ptr<const Scene> scene)
   upload_seconds_ = seconds_since(start);
 }
 
-GpuScene::~GpuScene() = default;
+SceneBuffers::~SceneBuffers() = default;
 
-void GpuScene::bind(DescriptorWriter& writer) const {
+void SceneBuffers::bind(DescriptorWriter& writer) const {
   writer.texel_buffer(VKRAY_BINDING_PRIMITIVES, *geometry_->primitives.view)
       .texel_buffer(VKRAY_BINDING_NORMALS, *geometry_->normals.view)
       .texel_buffer(VKRAY_BINDING_NODES, *geometry_->nodes.view)

@@ -1,6 +1,7 @@
-// A scene on the device: its BVH built, packed (host/packing/) and uploaded into texel buffers,
-// ready for any number of renders. It owns what it was built from and keeps its device alive, so
-// whoever holds it need not order it against anything else.
+// A scene's buffers on the device: its BVH built, packed (host/packing/) and uploaded into texel
+// buffers, ready for any number of renders. It owns what it was built from and keeps its device
+// alive, so whoever holds it need not order it against anything else. The session hands it to the
+// faces as a DeviceScene (session/session.h).
 #pragma once
 
 #include <cstdint>
@@ -18,15 +19,15 @@ struct Bvh;
 
 namespace vkray::gpu {
 
-class GpuScene {
+class SceneBuffers {
  public:
   // `bvh`: one already built for this scene (parity traverses the same one on the CPU); null builds
   // one. Throws DeviceError naming the limit when a buffer or the whole does not fit the device.
-  GpuScene(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* bvh = nullptr);
+  SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* bvh = nullptr);
   // `scene`, whose geometry is `same`'s (same_geometry): shares `same`'s BVH and primitive buffers,
   // and uploads only its lighting (materials, lights, area lights).
-  GpuScene(const GpuScene& same, std::shared_ptr<const Scene> scene);
-  ~GpuScene();
+  SceneBuffers(const SceneBuffers& same, std::shared_ptr<const Scene> scene);
+  ~SceneBuffers();
 
   const Scene& scene() const { return *scene_; }
   const Context& context() const { return *ctx_; }

@@ -178,7 +178,7 @@ TileConstants tile_constants(const TileRect& rect, uint32_t slot, uint64_t slot_
 // scene (and through them the device) last.
 struct Renderer::Frame {
   // Binds a frame: the frame's uniforms, the output's slots and the descriptor set.
-  Frame(const Context& ctx, std::shared_ptr<const TracePipeline> trace_pipeline, std::shared_ptr<const GpuScene> scene,
+  Frame(const Context& ctx, std::shared_ptr<const TracePipeline> trace_pipeline, std::shared_ptr<const SceneBuffers> scene,
         const ImageSettings& image, const SlotPlan& plan, bool aovs);
   // A command buffer and a fence for each slot.
   void create_commands(const Context& ctx);
@@ -199,7 +199,7 @@ struct Renderer::Frame {
   };
 
   std::shared_ptr<const TracePipeline> trace_pipeline;
-  std::shared_ptr<const GpuScene> scene;
+  std::shared_ptr<const SceneBuffers> scene;
   std::shared_ptr<const vk::raii::Pipeline> pipeline;
   SlotPlan plan;
   Buffer uniforms;
@@ -216,7 +216,8 @@ struct Renderer::Frame {
 };
 
 Renderer::Frame::Frame(const Context& ctx, std::shared_ptr<const TracePipeline> trace_pipeline_in,
-                       std::shared_ptr<const GpuScene> scene_in, const ImageSettings& image, const SlotPlan& plan_in, bool aovs)
+                       std::shared_ptr<const SceneBuffers> scene_in, const ImageSettings& image, const SlotPlan& plan_in,
+                       bool aovs)
     : trace_pipeline(std::move(trace_pipeline_in)), scene(std::move(scene_in)), plan(plan_in) {
   const FrameUniforms frame_uniforms = pack_frame(scene->scene(), scene->primitive_count(), scene->emitters(), image);
   uniforms = upload_buffer(ctx, &frame_uniforms, sizeof(frame_uniforms), vk::BufferUsageFlagBits::eUniformBuffer);
@@ -260,7 +261,8 @@ void Renderer::Frame::submit_tile(const Context& ctx, const TileRect& rect, uint
   for (tile.sample_begin = 0; tile.sample_begin < samples_per_pixel; tile.sample_begin = tile.sample_end) {
     tile.sample_end = std::min(samples_per_pixel, tile.sample_begin + samples_per_dispatch);
     if (tile.sample_begin > 0) {  // the last dispatch's sums are read by this one
-      const vk::MemoryBarrier sums(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
+      const vk::MemoryBarrier sums(vk::AccessFlagBits::eShaderWrite,
+                                   vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
       cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {}, sums, {}, {});
     }
     cb.pushConstants<TileConstants>(layout, vk::ShaderStageFlagBits::eCompute, 0, tile);
@@ -358,7 +360,7 @@ bool Renderer::busy(std::chrono::milliseconds wait) {
   return false;
 }
 
-Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std::shared_ptr<const GpuScene> scene,
+Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std::shared_ptr<const SceneBuffers> scene,
                        const TraceRequest& request, TraceStats* stats_out, Aovs* aovs_out) {
   if (busy(request.tile_timeout))
     throw TimeoutError("the device is still running a render tile that timed out before, " +

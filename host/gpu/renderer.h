@@ -56,7 +56,7 @@ class Renderer {
   // the next render first waits up to its own tile timeout for it), Cancelled on an interrupt
   // request (a tile still running is kept the same way), and DeviceError or vk::SystemError for
   // failed calls.
-  Image render(std::shared_ptr<const TracePipeline> pipeline, std::shared_ptr<const GpuScene> scene,
+  Image render(std::shared_ptr<const TracePipeline> pipeline, std::shared_ptr<const SceneBuffers> scene,
                const TraceRequest& request, TraceStats* stats = nullptr, Aovs* aovs = nullptr);
 
   // Whether work of a timed-out render is still running, after waiting up to `wait` for it. What

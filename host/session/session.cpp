@@ -99,10 +99,10 @@ Session::ShaderCompile Session::compile_shaders() {
   return {seconds_since(start), changed};
 }
 
-const Scene& DeviceScene::scene() const { return scene_->scene(); }
-double DeviceScene::upload_seconds() const { return scene_->upload_seconds(); }
-double DeviceScene::bvh_seconds() const { return scene_->bvh_seconds(); }
-bool DeviceScene::shares_geometry() const { return scene_->shares_geometry(); }
+const Scene& DeviceScene::scene() const { return buffers_->scene(); }
+double DeviceScene::upload_seconds() const { return buffers_->upload_seconds(); }
+double DeviceScene::bvh_seconds() const { return buffers_->bvh_seconds(); }
+bool DeviceScene::shares_geometry() const { return buffers_->shares_geometry(); }
 
 BackgroundBvh::BackgroundBvh(std::shared_ptr<const Scene> scene) : stop_(std::make_shared<std::atomic<bool>>(false)) {
   build_ = std::async(std::launch::async,
@@ -126,17 +126,17 @@ DeviceScene Session::upload(std::shared_ptr<const Scene> scene, const Bvh* bvh) 
   // once rather than wait behind it.
   if (renderer_->busy_after_interrupts(kInterruptedTileWait))
     throw TimeoutError("the device is still running a render tile that timed out; the scene was not uploaded");
-  DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::GpuScene>(ctx_, std::move(scene), bvh); }));
+  DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::SceneBuffers>(ctx_, std::move(scene), bvh); }));
   check_validation("scene upload");
   return uploaded;
 }
 
 DeviceScene Session::upload_changes(const DeviceScene& previous, std::shared_ptr<const Scene> scene) {
-  const gpu::GpuScene& same = own(previous);
+  const gpu::SceneBuffers& same = own(previous);
   if (!same_geometry(same.scene(), *scene)) return upload(std::move(scene));
   if (renderer_->busy_after_interrupts(kInterruptedTileWait))
     throw TimeoutError("the device is still running a render tile that timed out; the scene was not uploaded");
-  DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::GpuScene>(same, std::move(scene)); }));
+  DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::SceneBuffers>(same, std::move(scene)); }));
   check_validation("scene upload");
   return uploaded;
 }
@@ -145,14 +145,14 @@ namespace {
 
 // By the whole image's camera rays, never a region's: the parts of a render must trace the same code
 // as the whole render, or they would not assemble into it bit for bit.
-bool use_inline_scene(const gpu::GpuScene& scene, const ImageSettings& image, InlineScene policy) {
+bool use_inline_scene(const gpu::SceneBuffers& scene, const ImageSettings& image, InlineScene policy) {
   if (policy == InlineScene::never || scene.inline_scene().empty()) return false;
   if (policy == InlineScene::always) return true;
   const uint64_t camera_rays = uint64_t(image.width) * image.height * image.samples_per_pixel;
   return camera_rays >= kInlineMinCameraRays;
 }
 
-gpu::ShaderVariant shader_variant(const gpu::GpuScene& scene, const RenderOptions& options) {
+gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOptions& options) {
   gpu::ShaderVariant variant;
   variant.spheres = !scene.scene().spheres.empty();
   variant.shadows = options.shadows;
@@ -169,9 +169,9 @@ gpu::ShaderVariant shader_variant(const gpu::GpuScene& scene, const RenderOption
 
 }  // namespace
 
-const gpu::GpuScene& Session::own(const DeviceScene& scene) const {
-  if (&scene.scene_->context() != &device()) throw UsageError("a scene uploaded by another session");
-  return *scene.scene_;
+const gpu::SceneBuffers& Session::own(const DeviceScene& scene) const {
+  if (&scene.buffers_->context() != &device()) throw UsageError("a scene uploaded by another session");
+  return *scene.buffers_;
 }
 
 bool Session::compiles_scene_in(const DeviceScene& scene, const RenderOptions& options) const {
@@ -179,7 +179,7 @@ bool Session::compiles_scene_in(const DeviceScene& scene, const RenderOptions& o
 }
 
 double Session::prepare(const DeviceScene& scene, const RenderOptions& options) {
-  const gpu::GpuScene& on_device_scene = own(scene);
+  const gpu::SceneBuffers& on_device_scene = own(scene);
   const auto start = Clock::now();
   if (!has_shaders()) compile_shaders();
   on_device([&] { return shaders_->pipeline->pipeline(shader_variant(on_device_scene, options)); });
@@ -202,7 +202,7 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
   RenderResult result;
   if (options.aovs) result.aovs.emplace();
   result.image = on_device([&] {
-    return renderer_->render(shaders_->pipeline, scene.scene_, request, &trace, result.aovs ? &*result.aovs : nullptr);
+    return renderer_->render(shaders_->pipeline, scene.buffers_, request, &trace, result.aovs ? &*result.aovs : nullptr);
   });
   check_validation("render");
   result.settings = request.image;

@@ -19,15 +19,16 @@
 namespace vkray {
 namespace gpu {
 class Context;
-class GpuScene;
+class SceneBuffers;
 class Renderer;
 class TracePipeline;
 class ValidationLog;
 }  // namespace gpu
 
-// A scene on the device (its BVH built, its buffers uploaded), ready for any number of renders: a
-// handle that copies cheaply, owns its Scene and keeps the device alive, so it may be held as long
-// as the caller likes (but released before Session::close()).
+// A scene on the device (its BVH built, its buffers uploaded), ready for any number of renders, as
+// the faces hold it: a handle to the session's gpu::SceneBuffers that copies cheaply, owns its Scene
+// and keeps the device alive, so it may be held as long as the caller likes (but released before
+// Session::close()).
 class DeviceScene {
  public:
   const Scene& scene() const;
@@ -39,8 +40,8 @@ class DeviceScene {
 
  private:
   friend class Session;
-  explicit DeviceScene(std::shared_ptr<const gpu::GpuScene> scene) : scene_(std::move(scene)) {}
-  std::shared_ptr<const gpu::GpuScene> scene_;
+  explicit DeviceScene(std::shared_ptr<const gpu::SceneBuffers> buffers) : buffers_(std::move(buffers)) {}
+  std::shared_ptr<const gpu::SceneBuffers> buffers_;
 };
 
 class Session {
@@ -105,7 +106,7 @@ class Session {
   // The device; UsageError once the session is closed.
   const gpu::Context& device() const;
   // `scene`'s buffers, when this session uploaded it.
-  const gpu::GpuScene& own(const DeviceScene& scene) const;
+  const gpu::SceneBuffers& own(const DeviceScene& scene) const;
   // Throws DeviceError when the validation layer has reported anything since the last check.
   void check_validation(const char* during);
 
