@@ -32,8 +32,11 @@ std::string kind_of(mode_t mode) {
   return "is not a regular file";
 }
 
+// "64 MiB" for a whole number of MiB, else the bytes: a file just past a limit of 64 MiB is not
+// "64 MiB" too.
 std::string size_text(uint64_t bytes) {
-  return bytes >= (uint64_t(1) << 20) ? std::to_string(bytes >> 20) + " MiB" : std::to_string(bytes) + " bytes";
+  constexpr uint64_t kMiB = uint64_t(1) << 20;
+  return bytes >= kMiB && bytes % kMiB == 0 ? std::to_string(bytes / kMiB) + " MiB" : std::to_string(bytes) + " bytes";
 }
 
 }  // namespace
