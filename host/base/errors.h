@@ -10,16 +10,37 @@
 
 namespace vkray {
 
-// Process exit codes; documented in `vkray --help` and the README.
+// Process exit codes, each with the line `vkray --help` shows for it (docs/commands.md lists them too):
+// X(name, code, help).
+#define VKRAY_EXIT_CODES(X)                                                                                    \
+  X(kExitOk, 0, "success")                                                                                     \
+  /* a scene, mesh, shader or output file; an input past a limit */                                          \
+  X(kExitBadInput, 1,                                                                                          \
+    "bad input: scene, mesh or shader file, an output file that cannot be written, or an input past a\n"      \
+    "     limit (primitives, sizes, host memory, inotify watches)")                                            \
+  X(kExitUsage, 2, "usage: unknown command or option, bad option value")                                      \
+  X(kExitDevice, 3, "Vulkan or device failure (no device, failed call, timeout, validation message)")        \
+  /* `vkray parity`, `vkray check`: a result, not an error */                                                 \
+  X(kExitParityFailed, 4, "parity: the GPU and CPU images differ beyond the documented tolerance")            \
+  /* an invariant that does not hold (sysexits' EX_SOFTWARE) */                                               \
+  X(kExitInternal, 70, "internal error: a bug in vkray (please report it)")                                   \
+  /* the shell's convention for Ctrl-C */                                                                     \
+  X(kExitInterrupted, 130, "interrupted by SIGINT (Ctrl-C) or SIGTERM; nothing was written")
+
 enum ExitCode : int {
-  kExitOk = 0,
-  kExitBadInput = 1,       // a scene, mesh, shader or output file; an input past a limit
-  kExitUsage = 2,          // the command line
-  kExitDevice = 3,         // Vulkan or the device
-  kExitParityFailed = 4,   // `vkray parity`: the images differ beyond the tolerance (a result, not an error)
-  kExitInternal = 70,      // a bug in vkray: an invariant that does not hold (sysexits' EX_SOFTWARE)
-  kExitInterrupted = 130,  // SIGINT or SIGTERM, the shell's convention for Ctrl-C
+#define VKRAY_EXIT_CODE_ENUM(name, code, help) name = code,
+  VKRAY_EXIT_CODES(VKRAY_EXIT_CODE_ENUM)
+#undef VKRAY_EXIT_CODE_ENUM
 };
+
+// "Exit codes:" and a line for each, as `vkray --help` ends.
+inline std::string exit_codes_help() {
+  std::string text = "Exit codes:\n";
+#define VKRAY_EXIT_CODE_HELP(name, code, help) text += "  " + std::to_string(code) + "  " + help + "\n";
+  VKRAY_EXIT_CODES(VKRAY_EXIT_CODE_HELP)
+#undef VKRAY_EXIT_CODE_HELP
+  return text;
+}
 
 // The base of every error vkray raises. The message is complete: it names the file and the key or
 // line, or the Vulkan call and its result.

@@ -9,16 +9,7 @@
 
 namespace vkray::cli {
 
-const char* const kExitCodes =
-    "Exit codes:\n"
-    "  0  success\n"
-    "  1  bad input: scene, mesh or shader file, an output file that cannot be written, or an input past a\n"
-    "     limit (primitives, sizes, host memory, inotify watches)\n"
-    "  2  usage: unknown command or option, bad option value\n"
-    "  3  Vulkan or device failure (no device, failed call, timeout, validation message)\n"
-    "  4  parity: the GPU and CPU images differ beyond the documented tolerance\n"
-    "  70  internal error: a bug in vkray (please report it)\n"
-    "  130  interrupted by SIGINT (Ctrl-C) or SIGTERM; nothing was written\n";
+const std::string kExitCodes = exit_codes_help();
 
 void add_scene_flags(CLI::App& command, SceneFlags& flags) {
   command.add_option("scene", flags.scene, "Scene file (default: the Cornell box, scenes/cornell.json)");

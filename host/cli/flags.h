@@ -56,6 +56,6 @@ SessionOptions session_options(const DeviceFlags& flags);
 RenderOptions render_options(const SceneFlags* scene, const GpuFlags* gpu, const CpuFlags* cpu);
 
 // What `vkray --help` and every command's help end with.
-extern const char* const kExitCodes;
+extern const std::string kExitCodes;
 
 }  // namespace vkray::cli

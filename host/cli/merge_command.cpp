@@ -53,7 +53,7 @@ Command add_merge_command(CLI::App& app) {
   command->add_option("parts", args->parts, "The parts: .exr files, or .pfm files with their .pfm.json records")->required();
   command->add_flag("-q,--quiet", args->quiet, "Print only warnings and errors");
   command->footer(kExitCodes);
-  return {command, [args] { return run_merge(*args); }, 130, "interrupted; nothing written"};
+  return {command, [args] { return run_merge(*args); }, kExitInterrupted, "interrupted; nothing written"};
 }
 
 }  // namespace vkray::cli

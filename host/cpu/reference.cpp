@@ -11,6 +11,7 @@
 
 #include "base/errors.h"
 #include "base/interrupt.h"
+#include "base/threads.h"
 #include "bvh/bvh.h"
 #include "cpu/integrators.h"
 #include "cpu/warp.h"
@@ -102,7 +103,7 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
     total_rays += rays;
   };
 
-  const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = thread_count(options.threads);
   std::vector<std::jthread> pool;
   for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();

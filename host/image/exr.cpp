@@ -23,6 +23,7 @@
 #include "base/atomic_file.h"
 #include "base/errors.h"
 #include "base/interrupt.h"
+#include "base/threads.h"
 
 namespace vkray {
 namespace {
@@ -140,7 +141,7 @@ void write_exr(const std::filesystem::path& file, const Image& image, const Aovs
   }
   // OpenEXR compresses blocks of lines on its own thread pool: every core, set once.
   static const bool threads_set = [] {
-    Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
+    Imf::setGlobalThreadCount(int(thread_count()));
     return true;
   }();
   static_cast<void>(threads_set);

@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <thread>
 
+#include "base/threads.h"
 #include "bvh/bvh.h"
 #include "cpu/reference.h"
 
 namespace vkray {
 
 unsigned cpu_threads(const RenderOptions& options) {
-  return options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  return thread_count(options.threads);
 }
 
 RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, const Bvh* bvh,
