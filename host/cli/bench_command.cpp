@@ -137,7 +137,8 @@ int run_bench(const BenchArgs& args) {
     r.bvh_ms = median(bvh_ms);
     r.embree_build_ms = median(embree_build_ms);
     r.bvh_sah_cost = sah_cost(bvh);
-    const auto on_device = session.upload(scene, &bvh);
+    const auto tree = std::make_shared<const Bvh>(std::move(bvh));
+    const auto on_device = session.upload(scene, tree);
     r.upload_ms = (on_device.upload_seconds() - on_device.bvh_seconds()) * 1e3;
     // The path the measured renders take, decided once, so that the warm-up renders (lavapipe
     // compiles on the first dispatch) use the same two pipelines, with and without shadow rays.
@@ -172,7 +173,7 @@ int run_bench(const BenchArgs& args) {
         }
 #endif
         if (args.cpu_reference) {
-          const RenderStats cpu = render_on_cpu(*scene, options, &bvh).stats;
+          const RenderStats cpu = render_on_cpu(*scene, options, tree.get()).stats;
           r.rates[mode].cpu.push_back(double(cpu.rays) / cpu.trace_seconds * 1e-6);
         }
       }

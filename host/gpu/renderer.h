@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "gpu/context.h"
-#include "gpu/device_scene.h"
+#include "gpu/scene_buffers.h"
 #include "gpu/pipeline.h"
 #include "image/aovs.h"
 #include "image/image.h"

@@ -52,8 +52,9 @@ void run_check(Session& session, const CheckOptions& options) {
     throw_if_interrupted();
     if (options.on_scene) options.on_scene(file);
     const auto scene = std::make_shared<const Scene>(load_scene(file));
-    const Bvh bvh = build_bvh(primitive_boxes(*scene));  // one hierarchy, traversed by both renderers
-    const DeviceScene on_device = session.upload(scene, &bvh);
+    // One hierarchy, traversed by both renderers.
+    const auto bvh = std::make_shared<const Bvh>(build_bvh(primitive_boxes(*scene)));
+    const DeviceScene on_device = session.upload(scene, bvh);
     std::vector<InlineScene> paths{InlineScene::never};
     const size_t primitives = scene->triangles.size() + scene->spheres.size();
     if (primitives > 0 && primitives <= gpu::kMaxInlinePrimitives) paths.push_back(InlineScene::always);
@@ -67,7 +68,7 @@ void run_check(Session& session, const CheckOptions& options) {
       // The reference does not depend on the GPU path: rendered once for both.
       const auto cpu_start = Clock::now();
       std::vector<uint64_t> signatures;
-      const RenderResult cpu = render_on_cpu(*scene, render, &bvh, &signatures);
+      const RenderResult cpu = render_on_cpu(*scene, render, bvh.get(), &signatures);
       double shared_seconds = since(cpu_start);
       for (const InlineScene path : paths) {
         const CheckCase c{file, path, spp};

@@ -9,16 +9,17 @@ namespace vkray {
 
 ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scene> scene, const RenderOptions& options) {
   const ImageSettings image = image_settings(*scene, options);  // a bad override fails before any work
-  const Bvh bvh = build_bvh(primitive_boxes(*scene));  // one hierarchy, traversed by both
+  // One hierarchy, traversed by both.
+  const auto bvh = std::make_shared<const Bvh>(build_bvh(primitive_boxes(*scene)));
   RenderOptions with_aovs = options;  // parity covers the first-hit passes too
   with_aovs.aovs = true;
   RenderResult gpu;
   {
-    const DeviceScene on_device = session.upload(scene, &bvh);
+    const DeviceScene on_device = session.upload(scene, bvh);
     gpu = session.render(on_device, with_aovs);
   }
   std::vector<uint64_t> signatures;
-  RenderResult cpu = render_on_cpu(*scene, with_aovs, &bvh, &signatures);
+  RenderResult cpu = render_on_cpu(*scene, with_aovs, bvh.get(), &signatures);
   return judge_parity(image, std::move(gpu), std::move(cpu), std::move(signatures), parity_tolerance(*scene), scene->extent());
 }
 

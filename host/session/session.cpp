@@ -8,7 +8,7 @@
 #include "base/timing.h"
 #include "bvh/bvh.h"
 #include "gpu/context.h"
-#include "gpu/device_scene.h"
+#include "gpu/scene_buffers.h"
 #include "gpu/pipeline.h"
 #include "gpu/renderer.h"
 #include "gpu/shader_cache.h"
@@ -116,7 +116,7 @@ BackgroundBvh::~BackgroundBvh() {
 
 Bvh BackgroundBvh::get() { return build_.get(); }
 
-DeviceScene Session::upload(std::shared_ptr<const Scene> scene, const Bvh* bvh) {
+DeviceScene Session::upload(std::shared_ptr<const Scene> scene, std::shared_ptr<const Bvh> bvh) {
   device();
   // A tree built for another scene would send the packing past the primitives' ends.
   if (bvh && bvh->order.size() != scene->triangles.size() + scene->spheres.size())
@@ -126,7 +126,9 @@ DeviceScene Session::upload(std::shared_ptr<const Scene> scene, const Bvh* bvh) 
   // once rather than wait behind it.
   if (renderer_->busy_after_interrupts(kInterruptedTileWait))
     throw TimeoutError("the device is still running a render tile that timed out; the scene was not uploaded");
-  DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::SceneBuffers>(ctx_, std::move(scene), bvh); }));
+  if (!bvh) bvh = std::make_shared<const Bvh>(build_bvh(primitive_boxes(*scene)));
+  DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::SceneBuffers>(ctx_, std::move(scene), bvh.get()); }),
+                       bvh);
   check_validation("scene upload");
   return uploaded;
 }
@@ -136,7 +138,8 @@ DeviceScene Session::upload_changes(const DeviceScene& previous, std::shared_ptr
   if (!same_geometry(same.scene(), *scene)) return upload(std::move(scene));
   if (renderer_->busy_after_interrupts(kInterruptedTileWait))
     throw TimeoutError("the device is still running a render tile that timed out; the scene was not uploaded");
-  DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::SceneBuffers>(same, std::move(scene)); }));
+  DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::SceneBuffers>(same, std::move(scene)); }),
+                       previous.bvh_);
   check_validation("scene upload");
   return uploaded;
 }
@@ -179,10 +182,10 @@ bool Session::compiles_scene_in(const DeviceScene& scene, const RenderOptions& o
 }
 
 double Session::prepare(const DeviceScene& scene, const RenderOptions& options) {
-  const gpu::SceneBuffers& on_device_scene = own(scene);
+  const gpu::SceneBuffers& buffers = own(scene);
   const auto start = Clock::now();
   if (!has_shaders()) compile_shaders();
-  on_device([&] { return shaders_->pipeline->pipeline(shader_variant(on_device_scene, options)); });
+  on_device([&] { return shaders_->pipeline->pipeline(shader_variant(buffers, options)); });
   check_validation("pipeline creation");
   return seconds_since(start);
 }
@@ -190,7 +193,7 @@ double Session::prepare(const DeviceScene& scene, const RenderOptions& options) 
 RenderResult Session::render(const DeviceScene& scene, const RenderOptions& options) {
   gpu::TraceRequest request;
   request.image = image_settings(scene.scene(), options);
-  request.region = options.region ? resolve_region(scene.scene(), request.image, *options.region)
+  request.region = options.region ? resolve_region(scene.scene(), request.image, *options.region, scene.bvh_.get())
                                   : full_region(request.image.width, request.image.height);
   request.variant = shader_variant(own(scene), options);
   request.tile_timeout = options.tile_timeout;

@@ -40,8 +40,10 @@ class DeviceScene {
 
  private:
   friend class Session;
-  explicit DeviceScene(std::shared_ptr<const gpu::SceneBuffers> buffers) : buffers_(std::move(buffers)) {}
+  DeviceScene(std::shared_ptr<const gpu::SceneBuffers> buffers, std::shared_ptr<const Bvh> bvh)
+      : buffers_(std::move(buffers)), bvh_(std::move(bvh)) {}
   std::shared_ptr<const gpu::SceneBuffers> buffers_;
+  std::shared_ptr<const Bvh> bvh_;  // the tree on the device, as built: a band of a region is estimated with it
 };
 
 class Session {
@@ -76,7 +78,7 @@ class Session {
   // ---- Scenes -----------------------------------------------------------------------------------
   // Builds the scene's BVH (or takes `bvh`, built for this scene) and uploads it. Throws
   // TimeoutError at once while a tile that timed out still runs on the device.
-  DeviceScene upload(std::shared_ptr<const Scene> scene, const Bvh* bvh = nullptr);
+  DeviceScene upload(std::shared_ptr<const Scene> scene, std::shared_ptr<const Bvh> bvh = nullptr);
   // `scene`, an edit of `previous` (uploaded by this session): when their geometry is the same
   // (same_geometry: a camera, lights, materials, the image or the integrator changed), it shares
   // `previous`'s BVH and primitive buffers and uploads only the lighting; otherwise upload(scene).

@@ -1,4 +1,4 @@
-#include "gpu/device_scene.h"
+#include "gpu/scene_buffers.h"
 
 #include <algorithm>
 #include <type_traits>
