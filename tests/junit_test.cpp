@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/junit.h"
+#include "compare/junit.h"
 
 namespace vkray::cli {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "image/parity_metrics.h"
+#include "compare/parity_metrics.h"
 
 namespace vkray {
 namespace {

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/constants.hpp>
 
-#include "session/check.h"
+#include "compare/check.h"
 #include "support/parity_run.h"
 #include "load/scene_loader.h"
 

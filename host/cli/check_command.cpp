@@ -1,4 +1,4 @@
-// `vkray check`: the parity suite (session/check.h) on the chosen device, reported for a person (one
+// `vkray check`: the parity suite (compare/check.h) on the chosen device, reported for a person (one
 // line per case, the command that reproduces each failure), for CI (JUnit XML) and for scripts (JSON).
 // What a driver developer pastes into a bug report: the header names vkray, the device and driver.
 #include <algorithm>
@@ -19,10 +19,10 @@
 #include "base/errors.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
-#include "cli/junit.h"
-#include "session/parity_report.h"
+#include "compare/junit.h"
+#include "compare/parity_report.h"
 #include "cli/report.h"
-#include "session/check.h"
+#include "compare/check.h"
 #include "session/paths.h"
 #include "session/session.h"
 #include "session/version.h"
@@ -30,7 +30,7 @@
 namespace vkray::cli {
 namespace {
 
-// The tolerance of renders that make random decisions (session/parity.h).
+// The tolerance of renders that make random decisions (compare/parity.h).
 ParityTolerance stochastic_tolerance() {
   ParityTolerance t;
   t.stochastic = true;

@@ -1,11 +1,11 @@
 // Renders a scene with the GPU path (on the fixture's device, validation on) and with the CPU
-// reference, and compares them, as `vkray parity` does (session/parity.h).
+// reference, and compares them, as `vkray parity` does (compare/parity.h).
 #pragma once
 
 #include <ostream>
 #include <string>
 
-#include "session/parity.h"
+#include "compare/parity.h"
 #include "support/gpu_fixture.h"
 #include "support/temp_dir.h"
 

@@ -1,4 +1,4 @@
-#include "session/parity.h"
+#include "compare/parity.h"
 
 #include <algorithm>
 

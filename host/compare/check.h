@@ -1,7 +1,7 @@
 // `vkray check`'s suite: whether a device and its driver render vkray's contract. Every shipped scene
 // and every adversarial case (checks/: grazing rays, shared edges, a light on a surface, scenes at
 // the coordinate limit, ...), each on the BVH and, when it is small enough, compiled into the shader,
-// at 1 and 16 samples per pixel, against the CPU reference (session/parity.h).
+// at 1 and 16 samples per pixel, against the CPU reference (compare/parity.h).
 #pragma once
 
 #include <cstdint>
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "session/options.h"
-#include "session/parity.h"
+#include "compare/parity.h"
 
 namespace vkray {
 

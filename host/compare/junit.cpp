@@ -1,8 +1,8 @@
-#include "cli/junit.h"
+#include "compare/junit.h"
 
 #include <cstdio>
 
-namespace vkray::cli {
+namespace vkray {
 namespace {
 
 // The length of the valid UTF-8 sequence at text[i] whose code point XML 1.0 allows, or 0.
@@ -99,4 +99,4 @@ std::string junit_xml(const JunitSuite& suite) {
   return xml;
 }
 
-}  // namespace vkray::cli
+}  // namespace vkray

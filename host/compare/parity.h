@@ -1,13 +1,13 @@
 // Parity: a scene rendered on the session's device and with the CPU reference, both traversing the
 // same BVH, and the two images and their first-hit passes compared against the tolerance
-// (image/parity_metrics.h).
+// (compare/parity_metrics.h).
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <vector>
 
-#include "image/parity_metrics.h"
+#include "compare/parity_metrics.h"
 #include "session/options.h"
 #include "session/session.h"
 

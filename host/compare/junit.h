@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-namespace vkray::cli {
+namespace vkray {
 
 struct JunitCase {
   std::string classname, name;
@@ -32,4 +32,4 @@ struct JunitSuite {
 // characters, invalid UTF-8) become U+FFFD, so that any message makes a well-formed file.
 std::string junit_xml(const JunitSuite& suite);
 
-}  // namespace vkray::cli
+}  // namespace vkray

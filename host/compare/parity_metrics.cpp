@@ -1,4 +1,4 @@
-#include "image/parity_metrics.h"
+#include "compare/parity_metrics.h"
 
 #include <algorithm>
 #include <cmath>

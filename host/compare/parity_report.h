@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "session/parity.h"
+#include "compare/parity.h"
 
 namespace vkray {
 

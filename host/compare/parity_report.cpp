@@ -1,4 +1,4 @@
-#include "session/parity_report.h"
+#include "compare/parity_report.h"
 
 #include <cmath>
 

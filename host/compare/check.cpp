@@ -1,4 +1,4 @@
-#include "session/check.h"
+#include "compare/check.h"
 
 #include <algorithm>
 #include <chrono>
