@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "base/errors.h"
@@ -95,9 +96,10 @@ class ObjParser {
     while (!name.empty() && space(name.back())) name.pop_back();
     name.erase(name.begin(), std::find_if_not(name.begin(), name.end(), space));
     if (name.empty()) fail("usemtl without a material name");
-    const auto found = std::find(mesh_.material_names.begin(), mesh_.material_names.end(), name);
-    material_ = uint32_t(found - mesh_.material_names.begin());
-    if (found == mesh_.material_names.end()) mesh_.material_names.push_back(std::move(name));
+    // Looked up by hash: a file naming thousands of materials costs no more per usemtl than one naming two.
+    const auto [found, added] = material_index_.try_emplace(name, uint32_t(mesh_.material_names.size()));
+    material_ = found->second;
+    if (added) mesh_.material_names.push_back(std::move(name));
   }
 
   // Spaces between tokens. Tested by hand: std::string_view::find_first_of calls memchr on the set
@@ -224,6 +226,7 @@ class ObjParser {
   bool all_texcoords_ = true;  // and a texture coordinate
   std::vector<std::array<uint32_t, 3>> corner_texcoord_indices_;
   uint32_t material_ = Mesh::kNoMaterial;  // of the faces being read (usemtl)
+  std::unordered_map<std::string, uint32_t> material_index_;  // Mesh::material_names -> its index
   // Scratch space for the line being read, kept to save allocations.
   std::vector<std::string_view> tokens_;
   std::vector<float> coordinates_;
