@@ -110,8 +110,8 @@ TEST(BvhTest, BoundsPastTheCoordinateLimitAreRefused) {
 }
 
 // The build splits large ranges across threads and bins them in parallel blocks; the tree must not
-// depend on how many threads did it (DECISIONS.md: nothing that changes pixels may depend on the
-// number of threads). 200,000 boxes go through both the parallel top and the parallel binning.
+// depend on how many threads did it, since nothing a pixel depends on may (docs/rendering.md, "What a
+// pixel depends on"). 200,000 boxes go through both the parallel top and the parallel binning.
 // FNV-1a over every node's boxes and links and the leaf order: a tree's identity, to the bit.
 uint64_t tree_hash(const Bvh& bvh) {
   uint64_t h = 1469598103934665603ull;

@@ -342,7 +342,7 @@ TEST(CliTest, AClosedStderrDoesNotStopARender) {
   expect_png_size(dir / "out.png", 64, 64);
 }
 
-// Running out of resources (DECISIONS.md, issue 14): a clear message, exit 1, and never a partial
+// Running out of resources (docs/limits.md): a clear message, exit 1, and never a partial
 // output file. `ulimit -f` makes the disk "full" partway through the PNG; `ulimit -v` makes host
 // memory run out for a large CPU render.
 TEST(CliTest, AFullDiskFailsTheWriteAndLeavesNoFile) {

@@ -223,7 +223,7 @@ TEST_F(MeshFileTest, SceneMeshObjects) {
   EXPECT_EQ(scene.referenced_files[0], (dir_ / "tri.obj").lexically_normal());
 }
 
-// Policy (README, "Limits and robustness"): a mesh path may leave the scene's folder, by ".." or as
+// Policy (docs/limits.md): a mesh path may leave the scene's folder, by ".." or as
 // an absolute path, as a shared mesh library needs; vkray only reads what it names, and only a
 // regular file of bounded size.
 TEST_F(MeshFileTest, MeshPathsMayLeaveTheSceneFolder) {

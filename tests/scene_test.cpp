@@ -366,7 +366,7 @@ TEST(SceneTest, ValuesAreQuotedBriefly) {
 }
 
 // Coordinates whose sums or products overflow a float, although each number is finite, are
-// refused at the key that makes them (README, "Limits"), before any renderer sees them.
+// refused at the key that makes them (docs/limits.md), before any renderer sees them.
 TEST(SceneTest, CoordinatesPastTheLimitAreRefused) {
   const std::string material = R"("materials": {"m": {"albedo": [1, 1, 1]}}, )";
   expect_error(with_camera(material + R"("objects": [{"type": "sphere", "center": [1e9, 0, 0], "radius": 1e3, "material": "m"}])"),

@@ -1,4 +1,4 @@
-// Ctrl-C and SIGTERM (README, "Robustness"): every command stops within a second, whatever stage the
+// Ctrl-C and SIGTERM (docs/limits.md, "Signals"): every command stops within a second, whatever stage the
 // signal finds it in (reading the scene and its meshes, compiling, building the BVH, tracing on the
 // GPU or the CPU, writing), exits 130, and leaves the output folder as it was: no new file, no
 // temporary file, an existing output untouched. `vkray watch` is the exception: Ctrl-C is how it

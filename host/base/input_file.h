@@ -9,7 +9,7 @@
 
 namespace vkray {
 
-// The largest files vkray reads; README, "Limits".
+// The largest files vkray reads; docs/limits.md.
 constexpr uint64_t kMaxSceneFileBytes = uint64_t(64) << 20;
 constexpr uint64_t kMaxMeshFileBytes = uint64_t(4) << 30;
 constexpr uint64_t kMaxShaderFileBytes = uint64_t(4) << 20;

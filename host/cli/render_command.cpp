@@ -104,7 +104,7 @@ int run_render(const RenderArgs& args) {
 
 Command add_render_command(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
-  CLI::App* command = app.add_subcommand("render", "Render a scene to a PNG or PFM image.");
+  CLI::App* command = app.add_subcommand("render", "Render a scene to a PNG, PFM or OpenEXR image.");
   add_scene_flags(*command, args->scene);
   add_region_flag(*command, args->scene);
   command->add_option("-o,--output", args->output, "Output image, .png (8-bit sRGB), .pfm (float, linear) or .exr "

@@ -12,8 +12,9 @@
 
 namespace vkray {
 
-// What may legitimately differ (README, "Parity: GPU against the CPU reference"): a pixel whose samples straddle a silhouette or
-// shadow edge can flip, since GPU and CPU decide a ray that grazes an edge with different rounding.
+// What may legitimately differ (docs/parity.md, "The tolerance"): a pixel whose samples straddle a
+// silhouette or shadow edge can flip, since GPU and CPU decide a ray that grazes an edge with
+// different rounding.
 // Everywhere else the two agree to float precision, i.e. to within one step of 8-bit sRGB. The
 // edge allowance is a share of edge pixels, not of all pixels: edges are lines, so their share of
 // an image shrinks as its resolution grows, while the share of edge pixels that flip does not.
@@ -22,7 +23,7 @@ namespace vkray {
 // same samples on both, since the two draw the same random numbers; a sample whose path the two
 // renderers' rounding sends different ways differs by a whole sample's worth of noise, wherever it
 // is. Its tolerance is a share of all pixels instead, and the mean of the image, which such
-// samples hardly move but any error in the light transport does (README, "Parity for noisy images").
+// samples hardly move but any error in the light transport does (docs/parity.md, "Parity for noisy images").
 struct ParityTolerance {
   bool stochastic = false;
   double max_edge_share_over_1 = 0.02;  // edge pixels whose 8-bit sRGB values differ by more than 1

@@ -11,8 +11,8 @@
 
 namespace vkray {
 
-// The metrics as `vkray parity --json` prints them and vkray.parity() returns them (the keys are a
-// contract: DECISIONS.md).
+// The metrics as `vkray parity --json` prints them and vkray.parity() returns them (scripts read the
+// keys: docs/parity.md).
 nlohmann::json parity_json(const ParityResult& r, const std::string& scene, const std::string& device);
 
 // Writes the difference of the GPU image from the reference to `file`: a PNG heatmap of 8-bit steps

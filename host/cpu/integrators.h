@@ -1,5 +1,5 @@
 // The CPU reference's two integrators: the radiance one camera ray brings, by the direct model or by
-// path tracing (README, "What is computed"). Each draws from the sample's stream exactly as the
+// path tracing (docs/rendering.md). Each draws from the sample's stream exactly as the
 // shader does (shaders/direct.glsl, shaders/path.glsl), so that both trace the same paths.
 #pragma once
 

@@ -684,7 +684,7 @@ int32_t GltfReader::image_texture(int image, const std::string& where) {
   if (texels > limits_.max_texels - std::min(limits_.max_texels, texels_))
     throw LimitError(name + ": a " + std::to_string(size.width) + " x " + std::to_string(size.height) +
                      " picture would bring the scene's textures past " + std::to_string(limits_.max_texels >> 20) +
-                     "M texels, vkray's limit (README, \"Limits\")");
+                     "M texels, vkray's limit (docs/limits.md)");
   texels_ += texels;
   auto texture = std::make_shared<const Texture>(make_texture(decode_picture(bytes, name), name, true));
   const auto index = int32_t(scene_.textures.size());

@@ -61,7 +61,7 @@ uint32_t samples_in_one_dispatch(const Scene& scene) {
 // Every submission after the first aims at this much device time, at the rate the ones before it
 // ran: long enough that a submission's fixed costs vanish on a fast GPU, short enough that
 // progress, Ctrl-C (which waits for the running submission) and a display watchdog are not kept
-// waiting on a slow one. Well below --tile-timeout's default of a minute (DECISIONS.md).
+// waiting on a slow one. Well below --tile-timeout's default of a minute (docs/commands.md).
 constexpr double kSubmissionSeconds = 0.1;
 // The most pixels a submission (an output slot) holds: 64 MiB a slot, two slots.
 constexpr uint64_t kMostSlotPixels = uint64_t(1) << 22;

@@ -19,7 +19,7 @@ namespace vkray::gpu {
 
 // How many files deep #include may nest below the entry file, and how much one compile may include
 // in all, counting a file each time it is included (files that include each other twice at each of
-// 32 levels would otherwise be read 2^32 times); README, "Limits".
+// 32 levels would otherwise be read 2^32 times); docs/limits.md.
 constexpr size_t kMaxIncludeDepth = 32;
 constexpr size_t kMaxIncludes = 4096;
 constexpr uint64_t kMaxIncludedBytes = uint64_t(64) << 20;

@@ -20,7 +20,7 @@ void check_size(const std::string& name, uint64_t width, uint64_t height) {
   if (width > kMaxPictureSide || height > kMaxPictureSide || width * height > kMaxPicturePixels)
     throw LimitError(name + ": a picture of " + std::to_string(width) + " x " + std::to_string(height) +
                      " pixels; vkray decodes at most " + std::to_string(kMaxPictureSide) + " on a side and " +
-                     std::to_string(kMaxPicturePixels >> 20) + "M pixels (README, \"Limits\")");
+                     std::to_string(kMaxPicturePixels >> 20) + "M pixels (docs/limits.md)");
 }
 
 // libpng's simplified API: it converts any bit depth, palette and gamma to 8-bit sRGB RGBA, and

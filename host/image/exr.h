@@ -1,5 +1,5 @@
 // OpenEXR files (through the OpenEXR library): the image as R, G, B, and the first-hit passes as
-// named layers, the channel names other tools expect (DECISIONS.md, 18): albedo.R/G/B,
+// named layers, the channel names other tools expect (docs/rendering.md): albedo.R/G/B,
 // normal.X/Y/Z, position.X/Y/Z, depth.Z, object.id.
 #pragma once
 

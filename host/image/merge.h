@@ -19,7 +19,7 @@ struct MergedImage {
   ExrContent content;        // the parts' passes and precision: an EXR output written with it
   PartRecord record;         // the first part's record, region the whole image
   // Parts were rendered on more than one device (the CPU reference counts as one): the image is within parity of a
-  // single render, not bit-identical to one (DECISIONS.md, 20).
+  // single render, not bit-identical to one (docs/distributed.md).
   bool mixed_devices = false;
 };
 

@@ -92,11 +92,11 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
   const auto [camera, aspect] = parser.add_gltf(nullptr, file, glm::mat4(1.0f));
   scene.camera = camera ? *camera : framing_camera(scene);
   if (!(glm::all(glm::lessThanEqual(glm::abs(scene.camera.position), glm::vec3(kMaxCoordinate)))))
-    throw LimitError(file.string() + ": the camera vkray frames the model with would stand past +-1e9 (README, \"Limits\")");
+    throw LimitError(file.string() + ": the camera vkray frames the model with would stand past +-1e9 (docs/limits.md)");
   if (!camera) scene.warnings.push_back(file.string() + ": no perspective camera: vkray frames the scene from the front");
   if (aspect > 0.0f)
     scene.image.width = uint32_t(std::clamp(std::lround(double(scene.image.height) * aspect), 1l, long(kMaxImageSide)));
-  // A file that brings no light is lit from the camera, so that it is seen at all (DECISIONS.md, 19):
+  // A file that brings no light is lit from the camera, so that it is seen at all (docs/scene-format.md):
   // a point light whose irradiance at the scene's centre, straight on, is 1.
   const bool emitters = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissive(); });
   if (scene.lights.empty() && !emitters && !scene.triangles.empty()) {

@@ -1,4 +1,4 @@
-// Loading a scene: a scene file (JSON, README "Scene files") or a glTF file as a whole scene, with
+// Loading a scene: a scene file (JSON, docs/scene-format.md) or a glTF file as a whole scene, with
 // the meshes, material libraries, pictures and glTF files it names, read through their readers
 // (mesh/, gltf/) and placed into one Scene (scene/scene.h).
 #pragma once

@@ -94,7 +94,7 @@ void SceneParser::check_coordinates(const Value& where, const glm::vec3& p, cons
       char value[32];
       std::snprintf(value, sizeof value, "%g", double(p[c]));
       fail(where, std::string(what) + " has a coordinate of " + value +
-                      "; vkray renders world-space coordinates within +-1e9 (README, \"Limits\")");
+                      "; vkray renders world-space coordinates within +-1e9 (docs/limits.md)");
     }
 }
 
@@ -143,7 +143,7 @@ int32_t SceneParser::texture_file(const Value& where, const std::filesystem::pat
   const uint64_t texels = uint64_t(texture->width) * texture->height;
   if (texels > kMaxSceneTexels - std::min(kMaxSceneTexels, scene_texels_))
     throw LimitError(file_.string() + ": " + where.path + ": " + file.string() + ": it brings the scene's textures past " +
-                     std::to_string(kMaxSceneTexels >> 20) + "M texels, vkray's limit (README, \"Limits\")");
+                     std::to_string(kMaxSceneTexels >> 20) + "M texels, vkray's limit (docs/limits.md)");
   const auto index = int32_t(scene_.textures.size());
   add_texture(std::move(texture));
   texture_files_[key] = index;

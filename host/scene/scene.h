@@ -1,4 +1,4 @@
-// The in-memory scene: what a scene file (README, "Scene files") describes, with every object
+// The in-memory scene: what a scene file (docs/scene-format.md) describes, with every object
 // transform already applied, so renderers only see world-space primitives.
 #pragma once
 

@@ -51,8 +51,9 @@ VKRAY_INLINE vec2 sample_offset(uint pixel_index, uint seed_key, uint k, uint sp
 // ---- The random numbers of a sample past its pixel offset --------------------------------------------
 // Every other decision a sample makes (a point on the lens, on a light, a direction, Russian
 // roulette) draws the next number of the sample's own stream: PCG32 (O'Neill 2014, the RXS-M-XS
-// output) started from the sample's hash. Both renderers draw in the same order (README, "Path
-// tracing"), so that they trace the same paths and parity can be tight.
+// output) started from the sample's hash. Both renderers draw in the same order, so that they
+// trace the same paths and parity can be tight (docs/design.md, "Path tracing: how two renderers
+// trace the same paths").
 VKRAY_INLINE uint sample_stream(uint pixel_index, uint seed_key, uint k) {
   return pcg_hash(sample_hash(pixel_index, seed_key, k) ^ 0x9e3779b9u);
 }
