@@ -175,6 +175,29 @@ TEST_F(ObjMaterialTest, MapKdTexturesTheFacesThatNameItsMaterial) {
               scene.referenced_files.end()) << f;
 }
 
+TEST_F(ObjMaterialTest, AFilePlacedTwiceBringsItsMaterialsOnce) {
+  // Faces before the first usemtl take the file's "(no usemtl)" grey; the library has a line vkray
+  // warns about. Placed twice, the file's materials, textures and warnings are the scene's once.
+  write("quad.obj", "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                    "f 1/1 2/2 4/4\nusemtl checker\nf 1/1 2/2 3/3\nusemtl plain\nf 1/1 3/3 4/4\n");
+  write("quad.mtl", "newmtl checker\nKd 1 1 1\nmap_Kd tex/four.png\nnewmtl plain\nKd 0.2 0.4 0.6\nmap_Bump bump.png\n");
+  std::filesystem::create_directories(dir_ / "tex");
+  test::write_file(dir_ / "tex/four.png", test::png_bytes(four_colours()));
+  const Scene once = load(R"({"type": "mesh", "file": "quad.obj"})");
+  const Scene twice = load(R"({"type": "mesh", "file": "quad.obj"}, {"type": "mesh", "file": "quad.obj", "transform": {"translate": [0, 0, 1]}})");
+  EXPECT_EQ(twice.materials.size(), once.materials.size());
+  EXPECT_EQ(twice.textures.size(), 1u);
+  ASSERT_EQ(once.warnings.size(), 1u);
+  EXPECT_NE(once.warnings[0].find("map_Bump: not rendered"), std::string::npos) << once.warnings[0];
+  EXPECT_EQ(twice.warnings, once.warnings);
+  EXPECT_EQ(once.materials[once.triangles[0].material].name, "quad.obj: (no usemtl)");
+  ASSERT_EQ(twice.triangles.size(), 2 * once.triangles.size());
+  for (size_t i = 0; i < once.triangles.size(); ++i) {
+    EXPECT_EQ(twice.triangles[i].material, once.triangles[i].material) << i;
+    EXPECT_EQ(twice.triangles[once.triangles.size() + i].material, once.triangles[i].material) << i;
+  }
+}
+
 TEST_F(ObjMaterialTest, ASceneMaterialOverridesTheFileAndNeedsNoLibrary) {
   write("quad.obj", kTexturedQuad);  // quad.mtl does not exist
   const Scene scene = load(R"({"type": "mesh", "file": "quad.obj", "material": "grey"})");

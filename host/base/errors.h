@@ -21,7 +21,7 @@ namespace vkray {
   X(kExitUsage, 2, "usage: unknown command or option, bad option value")                                      \
   X(kExitDevice, 3, "Vulkan or device failure (no device, failed call, timeout, validation message)")        \
   /* `vkray parity`, `vkray check`: a result, not an error */                                                 \
-  X(kExitParityFailed, 4, "parity: the GPU and CPU images differ beyond the documented tolerance")            \
+  X(kExitParityFailed, 4, "parity, check: the GPU and CPU images differ beyond the documented tolerance")            \
   /* an invariant that does not hold (sysexits' EX_SOFTWARE) */                                               \
   X(kExitInternal, 70, "internal error: a bug in vkray (please report it)")                                   \
   /* the shell's convention for Ctrl-C */                                                                     \
@@ -147,12 +147,14 @@ inline std::string printable_middle(std::string_view text, size_t max_length) {
   if (text.size() <= max_length) return printable(text, max_length);
   // Both cuts fall between characters, not inside one (UTF-8 continuation bytes are 10xxxxxx).
   const auto inside = [&](size_t at) { return at < text.size() && (static_cast<unsigned char>(text[at]) & 0xc0) == 0x80; };
-  size_t head = max_length / 3;
+  constexpr std::string_view kCut = " ... ";
+  const size_t room = max_length > 2 * kCut.size() ? max_length - kCut.size() : max_length;
+  size_t head = room / 3;
   while (head > 0 && inside(head)) --head;
-  size_t tail_start = text.size() - (max_length - max_length / 3);
+  size_t tail_start = text.size() - (room - room / 3);
   while (inside(tail_start)) ++tail_start;
   std::string out = printable(text.substr(0, head), head);
-  return out + " ... " + printable(text.substr(tail_start), max_length);
+  return out + std::string(kCut) + printable(text.substr(tail_start), max_length);
 }
 
 }  // namespace vkray

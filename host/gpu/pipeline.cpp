@@ -32,7 +32,6 @@ constexpr BindingSlot kTraceBindings[] = {
     {VKRAY_BINDING_TEXTURES, kTexel, "textures"},
 };
 
-// Whether a SPIR-V module declares `capability` (its OpCapability instructions come first).
 // Two rows of one id would give the shader's constant whichever value Vulkan takes first.
 constexpr bool distinct_ids(std::span<const SpecConstant> table) {
   for (size_t i = 0; i < table.size(); ++i)
@@ -42,6 +41,7 @@ constexpr bool distinct_ids(std::span<const SpecConstant> table) {
 }
 static_assert(distinct_ids(kSpecConstants), "a specialization constant id appears twice in VKRAY_SPECIALIZATION_CONSTANTS");
 
+// Whether a SPIR-V module declares `capability` (its OpCapability instructions come first).
 bool declares(const std::vector<uint32_t>& spirv, spv::Capability capability) {
   constexpr size_t kHeaderWords = 5;
   for (size_t at = kHeaderWords; at < spirv.size();) {

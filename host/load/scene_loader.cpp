@@ -12,7 +12,7 @@
 #include "load/scene_parser.h"
 
 namespace vkray {
-namespace scene_file {
+namespace {
 
 // Moves each textured triangle's texture coordinates by a whole number of periods toward [0, 2)
 // along each axis its textures repeat (an even number, so that a mirrored repeat reads the same):
@@ -37,9 +37,8 @@ void recentre_texture_coordinates(Scene& scene) {
 }
 
 
-}  // namespace scene_file
+}  // namespace
 
-using scene_file::recentre_texture_coordinates;
 using scene_file::SceneParser;
 
 Scene parse_scene(std::string_view json_text, const std::filesystem::path& file, MeshCache* meshes) {

@@ -1,7 +1,7 @@
 // The scene file's parser: a JSON document (base/json_document.h) to a Scene, every value checked
 // and every message naming the file and the key as a JSON pointer. scene_parser.cpp reads the
 // file's own sections; scene_placement.cpp places what the files it names bring (meshes, material
-// libraries, textures, glTF files). Used by scene_loader.cpp alone.
+// libraries, textures, glTF files). Used inside load/ alone: scene_loader.cpp is its caller.
 #pragma once
 
 #include <cfloat>
@@ -56,7 +56,7 @@ class SceneParser {
     throw SceneError(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what);
   }
   void warn(const Value& v, const std::string& what) {
-    scene_.warnings.push_back(printable(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what, 500));
+    scene_.warnings.push_back(printable_middle(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what, 500));
   }
 
   // ---- typed readers -----------------------------------------------------------------------------
@@ -160,6 +160,7 @@ class SceneParser {
   };
   std::map<std::filesystem::path, LoadedGltf> gltf_files_;
   struct MeshFileMaterials {
+    std::shared_ptr<const Mesh> mesh;  // the mesh they were made for
     std::vector<uint32_t> named;  // Mesh::material_names -> Scene::materials
     uint32_t unnamed = 0;         // the material of faces before the first usemtl
   };
@@ -168,8 +169,5 @@ class SceneParser {
   uint64_t scene_texels_ = 0;  // the texels of Scene::textures
   uint32_t object_ = 0;  // the index in "objects" of the object being parsed
 };
-
-// Moves each textured triangle's texture coordinates toward [0, 2) (scene_loader.cpp says why).
-void recentre_texture_coordinates(Scene& scene);
 
 }  // namespace vkray::scene_file

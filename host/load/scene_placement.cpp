@@ -228,9 +228,12 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
     material = material_ref(v["material"]);
   } else if (!mesh.material_names.empty()) {
     // The file's materials are the scene's once, however often the file is placed (as a glTF file's are).
+    // Keyed by the mesh read, not its path: a file saved again between two placements is read again
+    // (MeshCache) and may name other materials.
     auto made = mesh_file_materials_.find(file);
-    if (made == mesh_file_materials_.end()) {
+    if (made == mesh_file_materials_.end() || made->second.mesh != loaded) {
       MeshFileMaterials m;
+      m.mesh = loaded;
       m.named = mesh_materials(file_value, file, mesh);
       const bool unnamed = std::find(mesh.triangle_materials.begin(), mesh.triangle_materials.end(), Mesh::kNoMaterial) !=
                            mesh.triangle_materials.end();
@@ -241,7 +244,7 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
         m.unnamed = uint32_t(scene_.materials.size());
         scene_.materials.push_back(grey);
       }
-      made = mesh_file_materials_.emplace(file, std::move(m)).first;
+      made = mesh_file_materials_.insert_or_assign(file, std::move(m)).first;
     }
     file_materials = made->second.named;
     material = made->second.unnamed;

@@ -38,8 +38,7 @@ struct RenderOptions {
   // Also the first-hit passes (image/aovs.h): RenderResult::aovs.
   bool aovs = false;
   // Only these pixels (session/regions.h), each as in a render of the whole image; the result holds
-  // just them. A band is computed at the render (a caller that has the scene's BVH may resolve it
-  // first with resolve_region).
+  // just them. A band is resolved at the render, with the BVH the scene was uploaded with.
   std::optional<RegionRequest> region;
   // GPU: how a small scene is traced; the longest one submission (a tile) may run; square tiles of
   // this side in pixels (0: submissions sized by the time they take, gpu/tiling.h).
