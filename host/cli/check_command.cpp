@@ -22,6 +22,7 @@
 #include "compare/junit.h"
 #include "compare/parity_report.h"
 #include "cli/report.h"
+#include "image/image_file.h"
 #include "compare/check.h"
 #include "session/paths.h"
 #include "session/session.h"

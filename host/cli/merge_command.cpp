@@ -10,6 +10,7 @@
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "cli/report.h"
+#include "image/image_file.h"
 #include "image/merge.h"
 
 namespace vkray::cli {
@@ -23,7 +24,7 @@ struct MergeArgs {
 
 int run_merge(const MergeArgs& args) {
   const auto start = Clock::now();
-  check_output_path(args.output);
+  check_output_image(args.output);
   const MergeSummary summary = merge_part_files(args.output, args.parts);
   if (summary.passes_dropped)
     std::cerr << "vkray: warning: the parts' first-hit passes are not in " << args.output.string()

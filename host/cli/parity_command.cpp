@@ -76,7 +76,7 @@ int run_parity(const ParityArgs& args) {
     if (!args.json) std::cerr << "vkray: " << line << "\n";
   };
   const LoadedScene loaded = load_scene_file(scene_file(args.scene));
-  if (!args.diff.empty()) check_output_path(args.diff);
+  if (!args.diff.empty()) check_output_image(args.diff);
   RenderOptions options = render_options(&args.scene, &args.gpu, &args.cpu);
   log(describe(*loaded.scene, image_settings(*loaded.scene, options)));
 

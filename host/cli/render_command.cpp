@@ -41,12 +41,11 @@ int run_render(const RenderArgs& args) {
   const LoadedScene loaded = load_scene_file(scene_file(args.scene));
   const std::filesystem::path output =
       args.output.empty() ? std::filesystem::path(loaded.scene->name + ".png") : args.output;
-  check_output_path(output);
   ExrContent content;
   content.full_float = args.exr_float;
+  check_output_image(output);  // before the passes' names: one order of checks for every face
   if (!args.aovs.empty()) content.passes = parse_aov_list(args.aovs);
-  check_render_image(output, content);
-  if (args.scene.region) check_part_file(output);
+  check_render_output(output, content, args.scene.region.has_value());
   RenderOptions options = render_options(&args.scene, &args.gpu, &args.cpu);
   options.aovs = !content.passes.empty();
   const ImageSettings image = image_settings(*loaded.scene, options);

@@ -14,17 +14,6 @@
 
 namespace vkray::cli {
 
-void check_output_path(const std::filesystem::path& output) {
-  if (!is_supported_image_path(output)) throw OutputError(output.string() + ": unknown image type (expected .png, .pfm or .exr)");
-  check_output_folder(output);
-}
-
-void check_output_folder(const std::filesystem::path& output) {
-  const auto dir = output.has_parent_path() ? output.parent_path() : std::filesystem::path(".");
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) throw OutputError(output.string() + ": folder " + dir.string() + " does not exist");
-}
-
 LoadedScene load_scene_file(const std::filesystem::path& file) {
   const auto start = Clock::now();
   LoadedScene loaded;

@@ -13,12 +13,6 @@
 
 namespace vkray::cli {
 
-// Throws OutputError, before any rendering, when `output` cannot be written (unknown extension,
-// missing folder).
-void check_output_path(const std::filesystem::path& output);
-// The same for a file of any type: its folder must exist.
-void check_output_folder(const std::filesystem::path& output);
-
 struct LoadedScene {
   std::shared_ptr<const Scene> scene;
   double load_ms = 0;

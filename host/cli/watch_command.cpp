@@ -89,7 +89,7 @@ Watch::Watch(const WatchArgs& args)
       output_(args.output.empty() ? std::filesystem::path(scene_file_.stem().string() + ".png") : args.output),
       session_options_(session_options(args.device)),
       options_(render_options(&args.scene, &args.gpu, nullptr)) {
-  check_output_path(output_);  // before the device: a typo costs nothing
+  check_output_image(output_);  // before the device: a typo costs nothing
   session_options_.shader_dir = absolute_normal(session_options_.shader_dir.empty() ? default_shader_dir()
                                                                                    : session_options_.shader_dir);
   session_ = std::make_unique<Session>(session_options_);

@@ -15,6 +15,19 @@ std::optional<ImageFileType> image_file_type(const std::filesystem::path& file) 
   return std::nullopt;
 }
 
+void check_output_image(const std::filesystem::path& file) {
+  if (!is_supported_image_path(file)) throw OutputError(file.string() + ": unknown image type (expected .png, .pfm or .exr)");
+  check_output_folder(file);
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw OutputError(file.string() + ": is a folder");
+}
+
+void check_output_folder(const std::filesystem::path& file) {
+  const auto dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) throw OutputError(file.string() + ": folder " + dir.string() + " does not exist");
+}
+
 bool is_supported_image_path(const std::filesystem::path& file) { return image_file_type(file).has_value(); }
 bool is_pfm(const std::filesystem::path& file) { return image_file_type(file) == ImageFileType::pfm; }
 bool is_exr(const std::filesystem::path& file) { return image_file_type(file) == ImageFileType::exr; }

@@ -33,4 +33,11 @@ void write_render_image(const std::filesystem::path& file, const Image& image, c
 // Throws the UsageError write_render_image would, before any work is done.
 void check_render_image(const std::filesystem::path& file, const ExrContent& content);
 
+// Throws OutputError, before any work is done, when `file` cannot be an image vkray writes: an
+// unknown extension, a folder that does not exist (or is a file), or a folder in the file's place.
+// Every face checks an output here first, so that each refuses it with the same message and exit code.
+void check_output_image(const std::filesystem::path& file);
+// For a file of any type (a report, a JUnit file, a folder to make): its folder must exist.
+void check_output_folder(const std::filesystem::path& file);
+
 }  // namespace vkray

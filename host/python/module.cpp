@@ -179,10 +179,7 @@ ExrContent output_content(const Request& request, const std::vector<Aov>& passes
     if (request.exr_float) throw UsageError("exr_float is for a render to an .exr file");
     return content;
   }
-  if (!is_supported_image_path(*request.output))
-    throw OutputError(request.output->string() + ": unknown image type (expected .png, .pfm or .exr)");
-  check_render_image(*request.output, content);
-  if (request.region) check_part_file(*request.output);
+  check_render_output(*request.output, content, request.region.has_value());
   return content;
 }
 
@@ -453,6 +450,24 @@ PYBIND11_MODULE(_vkray, m) {
   m.def("merge", &vp::merge, py::arg("output"), py::arg("parts"));
   m.def("_check_passes", [](const std::vector<std::string>& names) { vp::parse_passes(names); },
         "Raises UsageError unless `names` are first-hit passes, each once.");
+  m.def("_check_output",
+        [](const std::filesystem::path& output, const std::vector<std::string>& aovs, bool exr_float, bool part) {
+          vp::Request request;
+          request.output = output;
+          request.aovs = aovs;
+          request.exr_float = exr_float;
+          if (part) request.region = "0/1";
+          try {
+            vp::output_content(request, vp::parse_passes(aovs));
+          } catch (const py::error_already_set&) {
+            throw;
+          } catch (...) {
+            vp::raise_failure(std::current_exception());
+          }
+        },
+        py::arg("output"), py::arg("aovs"), py::arg("exr_float"), py::arg("part"),
+        "Raises what a render to `output` would before any work: SceneError for a path that cannot be written "
+        "(exit 1), UsageError for what cannot be asked of its type (exit 2).");
   m.def("parity", &vp::parity, py::arg("source"), py::arg("width"), py::arg("height"), py::arg("spp"), py::arg("seed"),
         py::arg("device"), py::arg("validate"), py::arg("threads"));
   m.def("devices", &vp::devices);

@@ -27,6 +27,12 @@ void check_part_file(const std::filesystem::path& file) {
                                      "*.exr or *.pfm");
 }
 
+void check_render_output(const std::filesystem::path& file, const ExrContent& content, bool part) {
+  check_output_image(file);
+  check_render_image(file, content);
+  if (part) check_part_file(file);
+}
+
 void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const ExrContent& content,
                   const std::string& device) {
   const Aovs* aovs = result.aovs ? &*result.aovs : nullptr;

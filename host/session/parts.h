@@ -19,6 +19,11 @@ constexpr const char* kCpuReferenceDevice = "CPU reference";
 // Throws the UsageError write_render would for a part, before any work is done.
 void check_part_file(const std::filesystem::path& file);
 
+// Everything write_render would refuse of `file`, checked before any work is done, in the order
+// every face reports it: the path (OutputError, image_file.h's check_output_image), then what is
+// asked of it (UsageError: passes or 32-bit floats outside an .exr, a `part` outside .exr/.pfm).
+void check_render_output(const std::filesystem::path& file, const ExrContent& content, bool part);
+
 // What `result`, a render of `scene`, was rendered from. `device`: Session::device_description(), or
 // kCpuReferenceDevice.
 PartRecord part_record(const Scene& scene, const RenderResult& result, const std::string& device);

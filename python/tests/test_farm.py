@@ -229,8 +229,12 @@ def test_sigterm_stops_the_job_and_writes_nothing(scenes, tmp_path):
 
 @pytest.mark.parametrize("args, code, says", [
     (["missing.json", "-o", "x.pfm"], 1, "missing.json"),
-    (["{scenes}/cornell.json", "-o", "x.txt"], 2, "unknown image type"),
-    (["{scenes}/cornell.json", "-o", "x.pfm", "--aov", "depth"], 2, "for an .exr output"),
+    # Output paths as `vkray render -o` refuses them: a path that cannot be written is bad input (1),
+    # what cannot be asked of a file type is usage (2).
+    (["{scenes}/cornell.json", "-o", "x.txt"], 1, "unknown image type"),
+    (["{scenes}/cornell.json", "-o", "{scenes}/cornell.json/x.pfm"], 1, "cornell.json does not exist"),
+    (["{scenes}/cornell.json", "-o", "{scenes}"], 1, "unknown image type"),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--aov", "depth"], 2, "EXR files only"),
     (["{scenes}/cornell.json", "-o", "x.pfm", "--height", "8", "--regions", "9"], 2, "1 to 8"),
     (["{scenes}/cornell.json", "-o", "x.exr", "--aov", "depth,shadows"], 2, 'unknown pass "shadows"'),
     (["{scenes}/cornell.json", "-o", "x.pfm", "--seed", "-1"], 2, "--seed: -1 is not from 0"),

@@ -223,15 +223,11 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     args = _parser().parse_args(argv)
     _require_dask()
     output = Path(args.output)
-    suffix = _PART_SUFFIX.get(output.suffix.lower())
-    if suffix is None:
-        raise _Usage(f"{output}: unknown image type (expected .exr, .pfm or .png)")
-    if (args.aov or args.exr_float) and suffix != ".exr":
-        raise _Usage(f"{output}: first-hit passes and --exr-float are for an .exr output")
-    if args.aov:
-        vkray._vkray._check_passes(args.aov.split(","))
-    if not output.parent.is_dir():
-        raise _Usage(f"{output}: folder {output.parent} does not exist")
+    aovs = args.aov.split(",") if args.aov else []
+    # The library's own checks of an output, so that the farm refuses what `vkray render -o` refuses,
+    # with the same message and exit code.
+    vkray._vkray._check_output(output, aovs, args.exr_float, False)
+    suffix = _PART_SUFFIX[output.suffix.lower()]
     settings = {"width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed, "aovs": args.aov,
                 "exr_float": args.exr_float}
     # Every scene read here first, so that a bad one fails before any worker starts.
@@ -243,8 +239,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
 
     targets = [_frame_output(output, frame, len(scenes)) for frame in range(len(scenes))]
     for target in targets:
-        if target.is_dir():
-            raise _Usage(f"{target}: is a folder")
+        vkray._vkray._check_output(target, aovs, args.exr_float, False)
 
     client = cluster = folder = None
     try:
