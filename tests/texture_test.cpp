@@ -1,6 +1,13 @@
-// Textures: PNG and JPEG decoding with its limits, the sRGB decode, the CPU reference's filtering
-// and wrap modes, textures from an OBJ file's .mtl, and how they are packed for the shader.
+// Textures: PNG and JPEG decoding with its limits, every encoding of a sample decoding to the same
+// colour, the sRGB decode, the CPU reference's filtering and wrap modes, textures from an OBJ file's
+// .mtl, and how they are packed for the shader.
+#include <cstring>
+#include <memory>
+#include <optional>
+
 #include <gtest/gtest.h>
+#include <png.h>
+#include <turbojpeg.h>
 
 #include "base/errors.h"
 #include "cpu/texture.h"
@@ -70,6 +77,146 @@ TEST(TextureTest, DecodesSrgbToLinearHalves) {
   EXPECT_EQ(texel.a, 1.0f);
   const Texture linear = make_texture(decode_picture(test::png_bytes({1, 1, {255, 128, 0}}), "x.png"), "x.png", false);
   EXPECT_NEAR(linear.texel(0, 0).g, 128.0f / 255.0f, 1e-3);
+}
+
+// ---- Every encoding of a sample decodes to the same colour ----------------------------------------
+// A picture's samples can be stored in many ways; the same intended value must give the same texel.
+// The files are written with libpng's full API so that each test states exactly what its file holds.
+
+// One pixel's worth of samples (and the file around them), in the order the colour type stores them.
+struct PngSpec {
+  int bit_depth = 8;
+  int colour_type = PNG_COLOR_TYPE_RGB;
+  std::vector<uint16_t> samples;      // one pixel, then the picture repeats it over 2 x 2
+  std::vector<png_color> palette;     // PNG_COLOR_TYPE_PALETTE: samples are indices
+  std::vector<png_byte> palette_alpha;  // tRNS for the palette
+  std::optional<double> file_gamma;   // a gAMA chunk (1.0: "linear")
+  bool srgb_chunk = false;
+  bool iccp_chunk = false;            // a (minimal, well-formed) ICC profile of a grey or RGB display
+  bool interlaced = false;            // Adam7
+};
+
+// A 132-byte ICC header with no tags: enough for libpng to accept and store it.
+std::string minimal_icc_profile(bool grey) {
+  std::string p(132, '\0');
+  const auto be32 = [&](size_t at, uint32_t v) {
+    for (int k = 0; k < 4; ++k) p[at + size_t(k)] = char((v >> (24 - 8 * k)) & 0xff);
+  };
+  be32(0, 132);
+  be32(8, 0x02100000);  // version 2.1
+  std::memcpy(&p[12], "mntr", 4);
+  std::memcpy(&p[16], grey ? "GRAY" : "RGB ", 4);
+  std::memcpy(&p[20], "XYZ ", 4);
+  std::memcpy(&p[36], "acsp", 4);
+  be32(68, 0x0000f6d6), be32(72, 0x00010000), be32(76, 0x0000d32d);  // the D50 illuminant
+  return p;
+}
+
+std::string png_file(const PngSpec& spec) {
+  constexpr uint32_t kSide = 2;
+  std::string out;
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png_create_info_struct(png);
+  png_set_write_fn(png, &out, [](png_structp p, png_bytep data, size_t length) {
+    static_cast<std::string*>(png_get_io_ptr(p))->append(reinterpret_cast<const char*>(data), length);
+  }, nullptr);
+  png_set_IHDR(png, info, kSide, kSide, spec.bit_depth, spec.colour_type, spec.interlaced ? PNG_INTERLACE_ADAM7 : PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  if (!spec.palette.empty()) png_set_PLTE(png, info, spec.palette.data(), int(spec.palette.size()));
+  if (!spec.palette_alpha.empty()) png_set_tRNS(png, info, spec.palette_alpha.data(), int(spec.palette_alpha.size()), nullptr);
+  if (spec.file_gamma) png_set_gAMA(png, info, *spec.file_gamma);
+  if (spec.srgb_chunk) png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  const std::string icc = minimal_icc_profile(!(spec.colour_type & PNG_COLOR_MASK_COLOR));
+  if (spec.iccp_chunk) png_set_iCCP(png, info, "display", 0, reinterpret_cast<png_const_bytep>(icc.data()), png_uint_32(icc.size()));
+  png_write_info(png, info);
+  // The samples packed big-endian at the bit depth, the first sample in the highest bits.
+  std::vector<png_byte> row;
+  uint32_t bits = 0, pending = 0;
+  for (uint32_t x = 0; x < kSide; ++x)
+    for (const uint16_t s : spec.samples) {
+      pending = (pending << spec.bit_depth) | s;
+      for (bits += uint32_t(spec.bit_depth); bits >= 8; bits -= 8) row.push_back(png_byte(pending >> (bits - 8)));
+    }
+  if (bits > 0) row.push_back(png_byte(pending << (8 - bits)));
+  const int passes = png_set_interlace_handling(png);
+  for (int pass = 0; pass < passes; ++pass)
+    for (uint32_t y = 0; y < kSide; ++y) png_write_row(png, row.data());
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return out;
+}
+
+// A greyscale (one-component) JPEG of a flat grey, 8 x 8.
+std::string grey_jpeg(uint8_t grey) {
+  const std::unique_ptr<void, int (*)(tjhandle)> handle(tjInitCompress(), tjDestroy);
+  const std::vector<uint8_t> pixels(64, grey);
+  unsigned char* jpeg = nullptr;
+  unsigned long size = 0;
+  EXPECT_EQ(tjCompress2(handle.get(), pixels.data(), 8, 0, 8, TJPF_GRAY, &jpeg, &size, TJSAMP_GRAY, 100, 0), 0);
+  std::string out(reinterpret_cast<const char*>(jpeg), size);
+  tjFree(jpeg);
+  return out;
+}
+
+glm::vec4 decoded(const std::string& bytes, bool srgb = true) { return make_texture(decode_picture(bytes, "t.png"), "t.png", srgb).texel(1, 1); }
+
+// The texel the 8-bit RGBA file of these samples decodes to: the reference the other encodings must meet.
+glm::vec4 reference(uint8_t r, uint8_t g, uint8_t b, uint8_t a = 255, bool srgb = true) {
+  return decoded(png_file({8, PNG_COLOR_TYPE_RGB_ALPHA, {r, g, b, a}}), srgb);
+}
+
+TEST(PictureEncodingTest, SixteenBitSamplesAreTheSameColourAsEightBit) {
+  // v in 8 bits is v * 257 in 16 (255 -> 65535): both name the same fraction of full scale.
+  const glm::vec4 grey = reference(128, 128, 128), colour = reference(200, 100, 50);
+  EXPECT_NEAR(grey.r, 0.2158f, 1e-3f);  // sRGB 128: a fifth of white's light, not a half
+  EXPECT_EQ(decoded(png_file({16, PNG_COLOR_TYPE_RGB, {128 * 257, 128 * 257, 128 * 257}})), grey);
+  EXPECT_EQ(decoded(png_file({16, PNG_COLOR_TYPE_RGB, {200 * 257, 100 * 257, 50 * 257}})), colour);
+  EXPECT_EQ(decoded(png_file({16, PNG_COLOR_TYPE_RGB_ALPHA, {200 * 257, 100 * 257, 50 * 257, 65535}})), colour);
+  EXPECT_EQ(decoded(png_file({16, PNG_COLOR_TYPE_GRAY, {128 * 257}})), grey);
+  EXPECT_EQ(decoded(png_file({16, PNG_COLOR_TYPE_GRAY_ALPHA, {128 * 257, 65535}})), grey);
+  EXPECT_EQ(decoded(png_file({.bit_depth = 16, .colour_type = PNG_COLOR_TYPE_GRAY, .samples = {128 * 257}, .interlaced = true})), grey);
+  // Linear data (not sRGB) is the same in either depth, too.
+  EXPECT_EQ(decoded(png_file({16, PNG_COLOR_TYPE_RGB, {200 * 257, 100 * 257, 50 * 257}}), false), reference(200, 100, 50, 255, false));
+  // A 16-bit file keeps its precision: half-way between 8-bit 128 and 129 decodes between them.
+  const float between = decoded(png_file({16, PNG_COLOR_TYPE_GRAY, {128 * 257 + 128}})).r;
+  EXPECT_GT(between, grey.r);
+  EXPECT_LT(between, reference(129, 129, 129).r);
+}
+
+TEST(PictureEncodingTest, GreyPaletteAndAlphaAreTheSameColourAsRgb) {
+  const glm::vec4 grey = reference(128, 128, 128), colour = reference(200, 100, 50);
+  EXPECT_EQ(decoded(png_file({8, PNG_COLOR_TYPE_GRAY, {128}})), grey);
+  EXPECT_EQ(decoded(png_file({8, PNG_COLOR_TYPE_RGB, {128, 128, 128}})), grey);
+  EXPECT_EQ(decoded(png_file({8, PNG_COLOR_TYPE_GRAY_ALPHA, {128, 64}})), reference(128, 128, 128, 64));
+  EXPECT_EQ(decoded(png_file({16, PNG_COLOR_TYPE_GRAY_ALPHA, {128 * 257, 64 * 257}})), reference(128, 128, 128, 64));
+  EXPECT_EQ(decoded(png_file({16, PNG_COLOR_TYPE_RGB_ALPHA, {200 * 257, 100 * 257, 50 * 257, 64 * 257}})), reference(200, 100, 50, 64));
+  // Fewer than 8 bits scale to full range: 4-bit 8 is 8 * 17 = 136, 1-bit 1 is 255.
+  EXPECT_EQ(decoded(png_file({4, PNG_COLOR_TYPE_GRAY, {8}})), reference(136, 136, 136));
+  EXPECT_EQ(decoded(png_file({1, PNG_COLOR_TYPE_GRAY, {1}})), reference(255, 255, 255));
+  // A palette, 8-bit and 2-bit indices, with and without alpha (tRNS).
+  const std::vector<png_color> palette = {{0, 0, 0}, {200, 100, 50}, {128, 128, 128}};
+  EXPECT_EQ(decoded(png_file({8, PNG_COLOR_TYPE_PALETTE, {1}, palette})), colour);
+  EXPECT_EQ(decoded(png_file({2, PNG_COLOR_TYPE_PALETTE, {2}, palette})), grey);
+  EXPECT_EQ(decoded(png_file({8, PNG_COLOR_TYPE_PALETTE, {1}, palette, {255, 64}})), reference(200, 100, 50, 64));
+  // JPEG: lossy, so within a step or two of 8 bits; greyscale (one component) and YCbCr alike.
+  const float step = reference(129, 129, 129).r - grey.r;
+  const glm::vec4 grey_jpeg_texel = decoded(grey_jpeg(128));
+  EXPECT_NEAR(grey_jpeg_texel.r, grey.r, 2 * step);
+  EXPECT_EQ(grey_jpeg_texel.r, grey_jpeg_texel.b);
+  EXPECT_NEAR(decoded(test::jpeg_bytes({8, 8, std::vector<uint8_t>(8 * 8 * 3, 128)})).g, grey.r, 2 * step);
+}
+
+TEST(PictureEncodingTest, ColourSpaceChunksAreIgnored) {
+  // glTF requires a picture's colour-space metadata to be ignored; vkray does so for every texture:
+  // the samples are sRGB for colour (base colour, emission) and linear for data, whatever the file says.
+  const glm::vec4 grey = reference(128, 128, 128), colour = reference(200, 100, 50);
+  EXPECT_EQ(decoded(png_file({.samples = {200, 100, 50}, .file_gamma = 1.0})), colour);
+  EXPECT_EQ(decoded(png_file({.samples = {200, 100, 50}, .file_gamma = 1 / 1.8})), colour);
+  EXPECT_EQ(decoded(png_file({.bit_depth = 16, .samples = {200 * 257, 100 * 257, 50 * 257}, .file_gamma = 1.0})), colour);
+  EXPECT_EQ(decoded(png_file({.bit_depth = 16, .samples = {200 * 257, 100 * 257, 50 * 257}, .srgb_chunk = true})), colour);
+  EXPECT_EQ(decoded(png_file({.samples = {200, 100, 50}, .iccp_chunk = true})), colour);
+  EXPECT_EQ(decoded(png_file({.bit_depth = 16, .colour_type = PNG_COLOR_TYPE_GRAY, .samples = {128 * 257}, .iccp_chunk = true})), grey);
+  EXPECT_EQ(decoded(png_file({.samples = {200, 100, 50}, .file_gamma = 1.0}), false), reference(200, 100, 50, 255, false));
 }
 
 // A scene with one 2 x 2 texture of four colours, for the lookups below.

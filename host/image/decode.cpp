@@ -1,8 +1,12 @@
 #include "image/decode.h"
 
 #include <algorithm>
+#include <bit>
+#include <csetjmp>
+#include <cstdio>
 #include <cstring>
 #include <memory>
+#include <vector>
 
 #include <png.h>
 #include <turbojpeg.h>
@@ -23,30 +27,93 @@ void check_size(const std::string& name, uint64_t width, uint64_t height) {
                      std::to_string(kMaxPicturePixels >> 20) + "M pixels (docs/limits.md)");
 }
 
-// libpng's simplified API: it converts any bit depth, palette and gamma to 8-bit sRGB RGBA, and
-// reports errors in the struct instead of by longjmp.
+// libpng's full API. Its simplified API (png_image) would do colour management vkray must not:
+// it takes a 16-bit file's samples as linear light unless told otherwise and re-encodes them as sRGB
+// (a mid grey rendered more than twice as bright as in 8 bits), and it applies a gAMA chunk to 8-bit
+// samples too. Here no gamma transform is asked for, and the colour-space chunks are not even read.
+//
+// libpng reports errors by longjmp: the structs are freed by a member's destructor (which runs when
+// the constructor throws, too), and the functions that call setjmp create no C++ object that a
+// longjmp would skip.
 class PngReader {
  public:
-  PngReader(std::string_view bytes, const std::string& name) {
-    std::memset(&image, 0, sizeof image);
-    image.version = PNG_IMAGE_VERSION;
-    // A constructor that throws runs no destructor: the struct is freed here on every failure.
-    if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size())) {
-      const std::string message = image.message;
-      png_image_free(&image);
-      fail(name, "not a readable PNG file: " + message);
-    }
-    try {
-      check_size(name, image.width, image.height);
-    } catch (...) {
-      png_image_free(&image);
-      throw;
-    }
+  PngReader(std::string_view bytes, const std::string& name) : bytes_(bytes) {
+    png_.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, this, on_error, on_warning);
+    if (png_.png) png_.info = png_create_info_struct(png_.png);
+    if (!png_.png || !png_.info) throw LimitError(name + ": libpng could not start (out of memory)");
+    if (!read_header()) fail(name, std::string("not a readable PNG file: ") + message_);
+    width = png_get_image_width(png_.png, png_.info);
+    height = png_get_image_height(png_.png, png_.info);
+    bit_depth = png_get_bit_depth(png_.png, png_.info);
+    check_size(name, width, height);
   }
-  ~PngReader() { png_image_free(&image); }
   PngReader(const PngReader&) = delete;
   PngReader& operator=(const PngReader&) = delete;
-  png_image image;
+
+  // The pixels as RGBA at the file's depth (8 bits, or 16 in the host's byte order) into `out`,
+  // which holds height rows of width * 4 samples.
+  void read(void* out, const std::string& name) {
+    const size_t row_bytes = size_t(width) * 4 * (bit_depth == 16 ? 2 : 1);
+    std::vector<png_bytep> rows(height);
+    for (size_t y = 0; y < height; ++y) rows[y] = static_cast<png_bytep>(out) + y * row_bytes;
+    if (!read_pixels(rows.data(), row_bytes)) fail(name, std::string("a damaged PNG file: ") + message_);
+  }
+
+  uint32_t width = 0, height = 0;
+  int bit_depth = 0;
+
+ private:
+  static void on_error(png_structp png, png_const_charp text) {
+    auto* self = static_cast<PngReader*>(png_get_error_ptr(png));
+    std::snprintf(self->message_, sizeof self->message_, "%s", text);
+    png_longjmp(png, 1);
+  }
+  // A damaged ancillary chunk (text, time) is dropped with a warning; vkray reads none of them.
+  static void on_warning(png_structp, png_const_charp) {}
+  static void on_read(png_structp png, png_bytep out, size_t length) {
+    auto* self = static_cast<PngReader*>(png_get_io_ptr(png));
+    if (length > self->bytes_.size() - self->at_) png_error(png, "the file ends early");
+    std::memcpy(out, self->bytes_.data() + self->at_, length);
+    self->at_ += length;
+  }
+
+  // The signature and the chunks before the pixels.
+  bool read_header() {
+    if (setjmp(png_jmpbuf(png_.png))) return false;
+    png_set_read_fn(png_.png, this, on_read);
+    static constexpr png_byte kColourSpaceChunks[] = "gAMA\0cHRM\0iCCP\0sRGB";
+    png_set_keep_unknown_chunks(png_.png, PNG_HANDLE_CHUNK_NEVER, kColourSpaceChunks, 4);
+    png_read_info(png_.png, png_.info);
+    return true;
+  }
+
+  // Every colour type to RGBA at its own depth, then the rows (all passes of an interlaced file).
+  bool read_pixels(png_bytep* rows, size_t row_bytes) {
+    if (setjmp(png_jmpbuf(png_.png))) return false;
+    const png_byte colour_type = png_get_color_type(png_.png, png_.info);
+    png_set_expand(png_.png);  // a palette to RGB, 1 to 4 bits to 8, tRNS to alpha
+    if (!(colour_type & PNG_COLOR_MASK_COLOR)) png_set_gray_to_rgb(png_.png);
+    if (!(colour_type & PNG_COLOR_MASK_ALPHA) && !png_get_valid(png_.png, png_.info, PNG_INFO_tRNS))
+      png_set_add_alpha(png_.png, bit_depth == 16 ? 0xffff : 0xff, PNG_FILLER_AFTER);
+    if (bit_depth == 16 && std::endian::native == std::endian::little) png_set_swap(png_.png);
+    png_set_interlace_handling(png_.png);
+    png_read_update_info(png_.png, png_.info);
+    if (png_get_rowbytes(png_.png, png_.info) != row_bytes) png_error(png_.png, "unexpected row size after expansion");
+    png_read_image(png_.png, rows);
+    png_read_end(png_.png, nullptr);
+    return true;
+  }
+
+  struct Structs {
+    png_structp png = nullptr;
+    png_infop info = nullptr;
+    ~Structs() { png_destroy_read_struct(&png, info ? &info : nullptr, nullptr); }
+  };
+
+  Structs png_;  // freed also when the constructor throws
+  std::string_view bytes_;
+  size_t at_ = 0;
+  char message_[200] = "";
 };
 
 // TurboJPEG's decompressor, with the header read and checked.
@@ -70,18 +137,22 @@ class JpegReader {
 
 Picture decode_png(std::string_view bytes, const std::string& name) {
   PngReader reader(bytes, name);
-  png_image& image = reader.image;
-  image.format = PNG_FORMAT_RGBA;
-  Picture picture{image.width, image.height, std::vector<uint8_t>(PNG_IMAGE_SIZE(image))};
-  if (!png_image_finish_read(&image, nullptr, picture.rgba.data(), 0, nullptr))
-    fail(name, std::string("a damaged PNG file: ") + image.message);
+  Picture picture{reader.width, reader.height, {}, {}};
+  const size_t samples = size_t(reader.width) * reader.height * 4;
+  if (reader.bit_depth == 16) {
+    picture.rgba16.resize(samples);
+    reader.read(picture.rgba16.data(), name);
+  } else {
+    picture.rgba.resize(samples);
+    reader.read(picture.rgba.data(), name);
+  }
   return picture;
 }
 
 Picture decode_jpeg(std::string_view bytes, const std::string& name) {
   JpegReader reader(bytes, name);
   const int width = reader.width, height = reader.height;
-  Picture picture{uint32_t(width), uint32_t(height), std::vector<uint8_t>(size_t(width) * size_t(height) * 4)};
+  Picture picture{uint32_t(width), uint32_t(height), std::vector<uint8_t>(size_t(width) * size_t(height) * 4), {}};
   // TJFLAG_LIMITSCANS: a progressive file of thousands of tiny scans is refused, not decoded for minutes.
   if (tjDecompress2(reader.handle.get(), reader.data, reader.size, picture.rgba.data(), width, 0, height, TJPF_RGBA,
                     TJFLAG_ACCURATEDCT | TJFLAG_LIMITSCANS) != 0)
@@ -97,7 +168,7 @@ bool is_jpeg(std::string_view bytes) { return bytes.size() >= 3 && bytes.substr(
 PictureSize picture_size(std::string_view bytes, const std::string& name) {
   if (is_png(bytes)) {
     const PngReader reader(bytes, name);
-    return {reader.image.width, reader.image.height};
+    return {reader.width, reader.height};
   }
   if (is_jpeg(bytes)) {
     const JpegReader reader(bytes, name);

@@ -1,4 +1,4 @@
-// PNG and JPEG files decoded to 8-bit RGBA: the pictures textures are made of. libpng and
+// PNG and JPEG files decoded to RGBA samples: the pictures textures are made of. libpng and
 // libjpeg-turbo (TurboJPEG) do the decoding; a picture's size is read from its header and checked
 // against vkray's limits before any pixel memory is allocated.
 #pragma once
@@ -15,10 +15,16 @@ namespace vkray {
 constexpr uint32_t kMaxPictureSide = 16384;
 constexpr uint64_t kMaxPicturePixels = uint64_t(1) << 26;
 
+// A picture's samples as its file stores them, 4 a pixel (RGBA), row-major, top row first: colour as
+// encoded (sRGB for colour data), alpha linear. No colour-space metadata of the file (PNG gAMA, cHRM,
+// iCCP, sRGB; JPEG ICC profiles) is applied: glTF requires them ignored, and so does every texture.
 struct Picture {
   uint32_t width = 0;
   uint32_t height = 0;
-  std::vector<uint8_t> rgba;  // 4 bytes a pixel, row-major, top row first, as stored (sRGB for colour)
+  std::vector<uint8_t> rgba;     // 8-bit samples (JPEG, and PNG of 1 to 8 bits scaled to 8), or
+  std::vector<uint16_t> rgba16;  // 16-bit samples (a 16-bit PNG, kept at full precision)
+
+  bool sixteen_bit() const { return !rgba16.empty(); }
 };
 
 // Whether the bytes start like a PNG or a JPEG file (by their signature, not a name's extension).
@@ -33,8 +39,9 @@ struct PictureSize {
 };
 PictureSize picture_size(std::string_view bytes, const std::string& name);
 
-// Decodes a PNG (any bit depth and colour type; 16-bit samples are rounded to 8) or a JPEG (greyscale,
-// YCbCr or RGB; CMYK is refused). Greyscale becomes grey RGB; a missing alpha is 255. Throws SceneError
+// Decodes a PNG (any bit depth and colour type: a palette, greyscale and fewer than 8 bits are
+// expanded, tRNS becomes alpha, 16 bits stay 16) or a JPEG (greyscale, YCbCr or RGB; CMYK is
+// refused). Greyscale becomes grey RGB; a missing alpha is full scale. Throws SceneError
 // "<name>: <why>": an unknown format, a damaged file, a size past the limits above.
 Picture decode_picture(std::string_view bytes, const std::string& name);
 

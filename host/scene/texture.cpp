@@ -1,18 +1,47 @@
 #include "scene/texture.h"
 
-#include <array>
+#include <cmath>
+#include <vector>
 
 #include <Imath/half.h>
 
 #include "base/errors.h"
 #include "base/input_file.h"
 #include "image/decode.h"
-#include "image/image.h"
 
 namespace vkray {
 namespace {
 
 uint16_t half_bits(float value) { return Imath::half(value).bits(); }
+
+// The sRGB transfer function, from an encoded fraction of full scale to linear light: the formula
+// of decode_srgb8, which an 8-bit sample v and a 16-bit one v * 257 meet with the same float
+// (v / 255 and 257 v / 65535 are one quotient, rounded once), so both depths decode alike.
+float srgb_to_linear(float encoded) {
+  return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
+}
+
+// Each sample value of a depth once, decoded from sRGB (colour) or taken as linear (data and alpha),
+// rounded to a half float.
+std::vector<uint16_t> sample_halves(uint32_t max_value, bool srgb) {
+  std::vector<uint16_t> halves(size_t(max_value) + 1);
+  for (uint32_t v = 0; v <= max_value; ++v) {
+    const float fraction = float(v) / float(max_value);
+    halves[v] = half_bits(srgb ? srgb_to_linear(fraction) : fraction);
+  }
+  return halves;
+}
+
+template <typename Sample>
+void fill_texels(const std::vector<Sample>& samples, uint32_t max_value, bool srgb, std::vector<uint16_t>& texels) {
+  const std::vector<uint16_t> colour = sample_halves(max_value, srgb);
+  const std::vector<uint16_t> linear = srgb ? sample_halves(max_value, false) : colour;
+  texels.resize(samples.size());
+  for (size_t i = 0; i < samples.size(); i += 4) {
+    for (size_t c = 0; c < 3; ++c) texels[i + c] = colour[samples[i + c]];
+    texels[i + 3] = linear[samples[i + 3]];
+  }
+}
 
 }  // namespace
 
@@ -24,21 +53,14 @@ glm::vec4 Texture::texel(uint32_t x, uint32_t y) const {
 }
 
 Texture make_texture(const Picture& picture, std::string name, bool srgb) {
-  // Each of the 256 byte values once: decoded (or not) and rounded to a half float.
-  std::array<uint16_t, 256> colour, linear;
-  for (int v = 0; v < 256; ++v) {
-    linear[size_t(v)] = half_bits(float(v) / 255.0f);
-    colour[size_t(v)] = srgb ? half_bits(decode_srgb8(uint8_t(v))) : linear[size_t(v)];
-  }
   Texture t;
   t.name = std::move(name);
   t.width = picture.width;
   t.height = picture.height;
-  t.texels.resize(picture.rgba.size());
-  for (size_t i = 0; i < picture.rgba.size(); i += 4) {
-    for (size_t c = 0; c < 3; ++c) t.texels[i + c] = colour[picture.rgba[i + c]];
-    t.texels[i + 3] = linear[picture.rgba[i + 3]];
-  }
+  if (picture.sixteen_bit())
+    fill_texels(picture.rgba16, 65535, srgb, t.texels);
+  else
+    fill_texels(picture.rgba, 255, srgb, t.texels);
   return t;
 }
 
