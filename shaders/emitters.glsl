@@ -1,7 +1,8 @@
 // The area lights: one picked from the alias table (shared/scene_layout.h) by its power, and a
 // point on it picked uniformly by area. Its density per unit area is then the same for every
-// light, emission_luminance(emission) * frame.inv_emitter_weight, which is what lets a hit on an
-// emitter know how likely light sampling was to find it (multiple importance sampling).
+// light of a material, emission luminance over the table's total power, computed on the host in
+// double (VKRAY_MATERIAL_LIGHT), which is what lets a hit on an emitter know how likely light
+// sampling was to find it (multiple importance sampling).
 #ifndef VKRAY_EMITTERS_GLSL
 #define VKRAY_EMITTERS_GLSL
 
@@ -40,10 +41,11 @@ LightPoint sample_area_light(inout uint stream) {
     light.position = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
     light.normal = normalize(cross(b.xyz - a.xyz, c.xyz - a.xyz));
   }
-  vec3 emission = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION).rgb;
+  vec4 emission = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION);
+  vec4 density = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_LIGHT);
   // The light is picked by its material's emission; a texture only scales what the point sends.
-  light.pdf_area = emission_luminance(emission) * frame.inv_emitter_weight;
-  light.radiance = emission;
+  light.pdf_area = density.x;
+  light.radiance = emission.rgb;
   if (SCENE_HAS_TEXTURES) {
     vec4 emission_texture = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION_TEXTURE);
     bool sphere = SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u;  // spheres have no texture coordinates
@@ -51,8 +53,5 @@ LightPoint sample_area_light(inout uint stream) {
   }
   return light;
 }
-
-// The density, per unit area, with which sample_area_light picks a point on a surface emitting `emission`.
-float area_light_pdf(vec3 emission) { return emission_luminance(emission) * frame.inv_emitter_weight; }
 
 #endif

@@ -17,9 +17,15 @@
 const float BACKGROUND_PDF = 1.0 / (4.0 * PI);
 
 // The power heuristic (Veach 1997, beta = 2): the weight of a sample drawn with density `a` when
-// density `b` could have drawn it too.
+// density `b` could have drawn it too, a^2 / (a^2 + b^2). Written with the ratio of the smaller
+// density to the larger, so that no square overflows: a small light seen at a grazing angle has a
+// density past 1.8e19, whose square is infinite, and inf / inf would be NaN. An infinite density
+// takes the whole weight; two zero densities (a sample neither strategy could draw) weigh 1.
 float power_heuristic(float a, float b) {
-  return (a * a) / (a * a + b * b);
+  float larger = max(a, b);
+  float r = min(a, b) / larger;
+  float w_larger = 1.0 / (1.0 + r * r);
+  return larger > 0.0 ? (a >= b ? w_larger : 1.0 - w_larger) : 1.0;
 }
 
 // A path under way: where it goes next and what it carries.
@@ -53,7 +59,7 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   bool front = cos_hit > 0.0;
   if (SCENE_HAS_EMITTERS && front && s.emission != vec3(0.0)) {  // (0 * a grazing hit's infinite density is NaN)
     // Light sampling finds this point with density pdf_area t^2 / cos per unit solid angle.
-    float light_pdf = area_light_pdf(s.emission_factor) * hit.t * hit.t / cos_hit;
+    float light_pdf = s.light_pdf_area * hit.t * hit.t / cos_hit;
     float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, light_pdf);
     p.radiance += p.throughput * s.emission * weight;
   }

@@ -22,7 +22,7 @@ struct Surface {
   uint material_type;     // VKRAY_MATERIAL_*
   vec3 emission;          // its texture applied
   float ior;
-  vec3 emission_factor;   // the material's emission, which weighs area lights (emitters.glsl)
+  float light_pdf_area;   // the density per unit area with which light sampling picks this point (emitters.glsl)
 };
 
 Surface hit_surface(Hit hit, vec3 position) {
@@ -35,12 +35,14 @@ Surface hit_surface(Hit hit, vec3 position) {
   s.material_type = floatBitsToUint(color.w);
   s.emission = vec3(0.0);
   s.ior = 1.0;
+  s.light_pdf_area = 0.0;
   if (SCENE_HAS_EMITTERS || SCENE_HAS_SPECULAR) {
     vec4 emission = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION);
+    vec4 density = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_LIGHT);
     s.emission = emission.rgb;
     s.ior = emission.w;
+    s.light_pdf_area = density.x;
   }
-  s.emission_factor = s.emission;
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     s.geometric_normal = (position - a.xyz) / sphere_radius(texelFetch(primitives, base + 1));
     if ((flags & VKRAY_PRIM_INWARD) != 0u) s.geometric_normal = -s.geometric_normal;

@@ -241,5 +241,17 @@ class WrongFresnel : public BrokenShaderParityTest {
 };
 TEST_F(WrongFresnel, IsCaught) { expect_caught(shipped("cornell-glass.json"), {64, 64, 16}); }
 
+class SquaredDensities : public BrokenShaderParityTest {
+ protected:
+  // The power heuristic as a^2 / (a^2 + b^2): a tiny light seen at a grazing angle has a density
+  // whose square overflows, and the weight is inf / inf.
+  SquaredDensities()
+      : BrokenShaderParityTest("path.glsl", "return larger > 0.0 ? (a >= b ? w_larger : 1.0 - w_larger) : 1.0;",
+                               "return (a * a) / (a * a + b * b);") {}
+};
+TEST_F(SquaredDensities, IsCaught) {
+  expect_caught(load_scene(std::filesystem::path(VKRAY_CHECK_DIR) / "lights-at-float-limits.json"), {96, 96, 16});
+}
+
 }  // namespace
 }  // namespace vkray::test

@@ -1,6 +1,7 @@
 // GPU vs CPU reference parity: what the check cases must show beyond the tolerance, and proof that
 // the comparison catches a wrong image.
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -82,6 +83,30 @@ TEST_P(CheckCaseTest, ThousandsOfSamplesPerPixelMatchTheReference) {
 INSTANTIATE_TEST_SUITE_P(Paths, CheckCaseTest, ::testing::Values(InlineScene::never, InlineScene::always),
                          [](const ::testing::TestParamInfo<InlineScene>& param) {
                            return param.param == InlineScene::always ? "inline" : "bvh";
+                         });
+
+// ---- The ends of the float range ----------------------------------------------------------------------
+// Radiance near the largest and below the smallest normal 32-bit float, an area light whose power
+// is below what a float holds, a lens as wide as a scene allows: the GPU's image is finite and agrees
+// with the double-precision reference, whose image is finite too.
+class FloatRangeTest : public ParityTest, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(FloatRangeTest, TheGpuStaysFiniteAndAgreesWithTheReference) {
+  const ParityResult r = run(check_case(GetParam()), {96, 96, 16});
+  for (const RenderResult* result : {&r.gpu, &r.cpu})
+    for (const glm::vec3& p : result->image.pixels)
+      ASSERT_TRUE(std::isfinite(p.r) && std::isfinite(p.g) && std::isfinite(p.b))
+          << (result == &r.gpu ? "GPU" : "CPU") << " pixel (" << p.r << ", " << p.g << ", " << p.b << ")";
+  expect_parity(r, GetParam());
+}
+
+INSTANTIATE_TEST_SUITE_P(Checks, FloatRangeTest,
+                         ::testing::Values("sky-at-float-max", "lights-at-float-limits", "dim-small-light", "aperture-at-limit"),
+                         [](const ::testing::TestParamInfo<const char*>& param) {
+                           std::string name = param.param;
+                           for (char& ch : name)
+                             if (ch == '-') ch = '_';
+                           return name;
                          });
 
 // The suite finds its cases: every shipped scene and every file in checks/, in a fixed order.

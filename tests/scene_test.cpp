@@ -196,6 +196,41 @@ TEST(SceneTest, IntegratorMaterialAndLensErrors) {
                "/camera/focus_distance", "> 0");
 }
 
+// Values a 32-bit float holds but the GPU's float math could not carry: refused by the loader, so
+// that both renderers refuse them alike.
+TEST(SceneTest, ValuesPastWhatTheGpuCarriesAreRefused) {
+  // A lens wider than f/0.5: its radius past the distance it focuses at.
+  expect_error(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "focal_length": 1, "aperture_radius": 2.5,
+                   "focus_distance": 2}})", "/camera/aperture_radius", "past the focus distance");
+  expect_error(R"({"camera": {"position": [0, 0, 0], "look_at": [0, 0, 3], "focal_length": 1, "aperture_radius": 1e9}})",
+               "/camera/aperture_radius", "at most the distance it focuses at");
+  EXPECT_NO_THROW(parse_scene(R"({"camera": {"position": [0, 0, 0], "look_at": [0, 0, 3], "focal_length": 1,
+                                  "aperture_radius": 3}})", "test.json"));
+  // Paths carry a reflectance above 1 without end; the direct model takes it with a warning.
+  expect_error(with_camera(R"("integrator": {"type": "path"}, "materials": {"w": {"albedo": [0.5, 1.5, 0.5]}})"),
+               "/materials/w/albedo", "at most 1");
+  expect_error(with_camera(R"("integrator": {"type": "path"}, "materials": {"m": {"type": "mirror", "reflectance": [2, 2, 2]}})"),
+               "/materials/m/reflectance", "at most 1");
+  const Scene direct = parse_scene(with_camera(R"("materials": {"w": {"albedo": [0.5, 1.5, 0.5]}})"), "test.json");
+  ASSERT_FALSE(direct.warnings.empty());
+  EXPECT_NE(direct.warnings.front().find("reflects more light than arrives"), std::string::npos);
+  // An area light whose sampling density (its share of the lights' power over its area) passes the
+  // largest float: a tiny light that is the only one. Beside a light of ordinary size it is picked
+  // rarely and its density is small.
+  expect_error(with_camera(R"("materials": {"d": {"albedo": [1, 1, 1]}, "e": {"albedo": [1, 1, 1], "emission": [1, 1, 1]}},
+                              "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1, "material": "d"},
+                                          {"type": "sphere", "center": [0, 0, 5], "radius": 1e-21, "material": "e"}])"),
+               "/objects/1", "past the largest 32-bit float");
+  EXPECT_NO_THROW(parse_scene(with_camera(R"("materials": {"e": {"albedo": [1, 1, 1], "emission": [1, 1, 1]},
+                                                           "f": {"albedo": [1, 1, 1], "emission": [1, 1, 1]}},
+                                             "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1, "material": "e"},
+                                                         {"type": "sphere", "center": [0, 0, 5], "radius": 1e-21, "material": "f"}])"),
+                              "test.json"));
+  EXPECT_NO_THROW(parse_scene(with_camera(R"("materials": {"e": {"albedo": [1, 1, 1], "emission": [1e-25, 1e-25, 1e-25]}},
+                                             "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1e-8, "material": "e"}])"),
+                              "test.json"));
+}
+
 TEST(SceneTest, CommentsAreAllowed) {
   EXPECT_NO_THROW(parse_scene("{ // a comment\n" + std::string(kCamera) + " /* another */ }", "t.json"));
 }

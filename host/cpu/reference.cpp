@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cfloat>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -89,7 +90,8 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
           row_rays += 1 + state.rays;
         }
         const size_t out = size_t(row) * region.width() + (i - region.x0);
-        result.image.pixels[out] = glm::vec3(sum / double(settings.samples_per_pixel));
+        // Radiance past the largest float is held at it, as the GPU's is (packing/scene_packing.h).
+        result.image.pixels[out] = glm::vec3(glm::min(sum / double(settings.samples_per_pixel), dvec3(FLT_MAX)));
         result.signatures[out] = signature;
         if (options.aovs) result.aovs->set(i - region.x0, row, first_hits);
       }

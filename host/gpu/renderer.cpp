@@ -219,7 +219,7 @@ Renderer::Frame::Frame(const Context& ctx, std::shared_ptr<const TracePipeline> 
                        std::shared_ptr<const SceneBuffers> scene_in, const ImageSettings& image, const SlotPlan& plan_in,
                        bool aovs)
     : trace_pipeline(std::move(trace_pipeline_in)), scene(std::move(scene_in)), plan(plan_in) {
-  const FrameUniforms frame_uniforms = pack_frame(scene->scene(), scene->primitive_count(), scene->emitters(), image);
+  const FrameUniforms frame_uniforms = pack_frame(scene->scene(), scene->primitive_count(), scene->lighting(), image);
   uniforms = upload_buffer(ctx, &frame_uniforms, sizeof(frame_uniforms), vk::BufferUsageFlagBits::eUniformBuffer);
   using M = vk::MemoryPropertyFlagBits;
   const vk::DeviceSize output_bytes = kSlots * plan.slot_pixels * sizeof(glm::vec4);
@@ -295,10 +295,11 @@ bool Renderer::Frame::read_tile_back(const vk::raii::Device& device, uint32_t in
   for (uint32_t y = 0; y < tile.height; ++y)
     for (uint32_t x = 0; x < tile.width; ++x)
       if (std::bit_cast<uint32_t>(texels[size_t(y) * tile.width + x].w) & VKRAY_LOOPS_CUT_SHORT) return false;
+  const int radiance_exponent = scene->lighting().radiance_exponent;  // the shader's radiance is scaled
   for (uint32_t y = 0; y < tile.height; ++y)
     for (uint32_t x = 0; x < tile.width; ++x) {
       const glm::vec4& texel = texels[size_t(y) * tile.width + x];
-      result.at(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y) = glm::vec3(texel);
+      result.at(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y) = unscale_radiance(glm::vec3(texel), radiance_exponent);
       rays += std::bit_cast<uint32_t>(texel.w);
     }
   if (aovs) {

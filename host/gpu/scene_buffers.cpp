@@ -108,7 +108,7 @@ SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<c
                                                         make_texel_buffer(*ctx_, packed.texcoords, "texture coordinate"),
                                                         make_texture_buffer(*ctx_, packed.textures), bvh.order});
   lighting_ = std::make_unique<Lighting>(*ctx_, packed);
-  emitters_ = packed.emitter_frame;
+  lighting_frame_ = packed.frame;
   // A BVH built beforehand (perhaps while the shaders compiled) still counts: the upload stage
   // reports the build's own time.
   upload_seconds_ = seconds_since(start) + (prebuilt ? prebuilt->build_seconds : 0.0);
@@ -125,7 +125,7 @@ SceneBuffers::SceneBuffers(const SceneBuffers& same, std::shared_ptr<const Scene
   const auto start = Clock::now();
   const PackedLighting packed = pack_lighting(*scene_, geometry_->order);
   lighting_ = std::make_unique<Lighting>(*ctx_, packed);
-  emitters_ = packed.emitter_frame;
+  lighting_frame_ = packed.frame;
   upload_seconds_ = seconds_since(start);
 }
 

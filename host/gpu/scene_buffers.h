@@ -38,7 +38,7 @@ class SceneBuffers {
   double bvh_seconds() const { return bvh_seconds_; }
   double upload_seconds() const { return upload_seconds_; }  // BVH build included, prebuilt or not
   bool shares_geometry() const { return shares_geometry_; }  // made by the second constructor
-  const EmitterFrame& emitters() const { return emitters_; }
+  const LightingFrame& lighting() const { return lighting_frame_; }
 
   // Adds the scene's buffers at their bindings (shared/types.h).
   void bind(DescriptorWriter& writer) const;
@@ -52,7 +52,7 @@ class SceneBuffers {
   std::unique_ptr<Lighting> lighting_;
   uint32_t primitive_count_ = 0;
   std::string inline_scene_;
-  EmitterFrame emitters_;
+  LightingFrame lighting_frame_;
   double bvh_seconds_ = 0, upload_seconds_ = 0;
   bool shares_geometry_ = false;
 };

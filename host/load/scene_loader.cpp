@@ -10,6 +10,7 @@
 #include "base/input_file.h"
 #include "base/json_document.h"
 #include "load/scene_parser.h"
+#include "scene/emitters.h"
 
 namespace vkray {
 namespace {
@@ -36,6 +37,13 @@ void recentre_texture_coordinates(Scene& scene) {
   }
 }
 
+// What every scene goes through last, whatever its file type: its texture coordinates recentred,
+// and the checks that need the whole scene.
+void finish_scene(Scene& scene) {
+  recentre_texture_coordinates(scene);
+  check_area_lights(scene);
+}
+
 
 }  // namespace
 
@@ -48,7 +56,7 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& file,
   scene.name = file.stem().string();
   MeshCache this_scene;
   SceneParser(file, scene, meshes ? *meshes : this_scene).parse(root);
-  recentre_texture_coordinates(scene);
+  finish_scene(scene);
   return scene;
 }
 
@@ -109,7 +117,7 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
     scene.lights.push_back(PointLight{scene.camera.position, glm::vec3(glm::pi<float>() * distance * distance)});
     scene.warnings.push_back(file.string() + ": the file brings no light: vkray adds a point light at the camera");
   }
-  recentre_texture_coordinates(scene);
+  finish_scene(scene);
   return scene;
 }
 

@@ -128,6 +128,14 @@ void SceneParser::parse_camera(const Value& v) {
     if (!by_target) fail(v, "a camera with an aperture_radius needs a \"focus_distance\" (or a \"look_at\" to focus on)");
     cam.focus_distance = glm::length(three_numbers(aim) - cam.position);
   }
+  // A lens in air is at most f/0.5 (a numerical aperture of 1), so its radius is at most its focal
+  // length, which is at most the distance it focuses at. Past that, rays leave the lens far from the
+  // scene they light, where 32-bit floats place them too coarsely for the scene's epsilon.
+  if (cam.aperture_radius > cam.focus_distance)
+    fail(v["aperture_radius"], "an aperture radius of " + brief(v["aperture_radius"].j) + " is past the focus distance (" +
+                                   std::to_string(cam.focus_distance) +
+                                   "): a thin lens's aperture radius is at most the distance it focuses at (f/0.5, the "
+                                   "widest a lens in air can be)");
   if (v.has("focus_distance") && cam.aperture_radius == 0.0f)
     warn(v["focus_distance"], "a pinhole camera (aperture_radius 0) is sharp everywhere: focus_distance has no effect");
 }
@@ -175,10 +183,17 @@ void SceneParser::parse_materials(const Value& v) {
     Material material;
     material.name = name;
     const std::string type = m.has("type") ? string(m["type"]) : "diffuse";
-    // A colour in [0, 1]: more would reflect more light than arrives.
+    // A colour in [0, 1]: more would reflect more light than arrives. The direct model takes it with
+    // a warning (a light bounces at most a few times); paths would carry it without end, so that a
+    // closed room of such a surface has no finite radiance.
     const auto reflectance = [&](const Value& c) {
       const glm::vec3 rgb = color(c);
-      if (rgb.r > 1.0f || rgb.g > 1.0f || rgb.b > 1.0f) warn(c, "a value above 1 reflects more light than arrives");
+      if (rgb.r > 1.0f || rgb.g > 1.0f || rgb.b > 1.0f) {
+        if (scene_.integrator.type == Integrator::Type::path)
+          fail(c, "a value above 1 reflects more light than arrives, which the path integrator would carry without end "
+                  "(radiance past any bound): at most 1");
+        warn(c, "a value above 1 reflects more light than arrives");
+      }
       return rgb;
     };
     if (type == "diffuse") {

@@ -181,6 +181,10 @@ std::vector<uint32_t> SceneParser::mesh_materials(const Value& where, const std:
                       ": no material library it names (mtllib) defines it");
     const MtlMaterial& mtl = found->second.first;
     const std::filesystem::path& library = found->second.second;
+    if (scene_.integrator.type == Integrator::Type::path && glm::any(glm::greaterThan(mtl.diffuse, glm::vec3(1.0f))))
+      throw MeshError(file_.string() + ": " + where.path + ": " + library.filename().string() + ": material " + printable(name) +
+                      ": Kd above 1 reflects more light than arrives, which the path integrator would carry without end "
+                      "(radiance past any bound): at most 1");
     Material material;
     material.name = mesh_file.filename().string() + ": " + name;
     material.albedo = mtl.diffuse;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cfloat>
 #include <cmath>
 #include <numeric>
 
@@ -157,6 +158,15 @@ Aabb unpack_child_box(const glm::uvec4* node, int c) {
   return box;
 }
 
+namespace {
+
+// `radiance` times 2^exponent: exact for every normal float result.
+glm::vec3 scale_radiance(glm::vec3 radiance, int exponent) {
+  return {std::ldexp(radiance.r, exponent), std::ldexp(radiance.g, exponent), std::ldexp(radiance.b, exponent)};
+}
+
+}  // namespace
+
 uint32_t row_stride(uint32_t rows) {
   if (rows <= 2) return 1;
   uint32_t stride = static_cast<uint32_t>(std::lround(double(rows) * 0.6180339887498949));
@@ -164,15 +174,15 @@ uint32_t row_stride(uint32_t rows) {
   return stride;
 }
 
-FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const EmitterFrame& emitters, const ImageSettings& image) {
+FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const LightingFrame& lighting, const ImageSettings& image) {
   FrameUniforms f{};
   const CameraBasis cam = camera_basis(scene.camera, image.height);
   f.origin = glm::vec4(cam.origin, 0.0f);
   f.right = glm::vec4(cam.right, 0.0f);
   f.up = glm::vec4(cam.up, 0.0f);
   f.forward = glm::vec4(cam.forward, cam.focal_px);
-  f.background = glm::vec4(scene.background, 0.0f);
-  f.ambient = glm::vec4(scene.ambient, 0.0f);
+  f.background = glm::vec4(scale_radiance(scene.background, lighting.radiance_exponent), 0.0f);
+  f.ambient = glm::vec4(scale_radiance(scene.ambient, lighting.radiance_exponent), 0.0f);
   f.width = image.width;
   f.height = image.height;
   f.samples_per_pixel = image.samples_per_pixel;
@@ -190,8 +200,7 @@ FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const Emi
   f.focus_distance = scene.camera.focus_distance;
   f.max_depth = scene.integrator.max_depth;
   f.rr_depth = scene.integrator.rr_depth;
-  f.emitter_count = emitters.count;
-  f.inv_emitter_weight = emitters.inv_weight;
+  f.emitter_count = lighting.emitter_count;
   return f;
 }
 
@@ -256,8 +265,27 @@ std::vector<uint32_t> texture_offsets(const Scene& scene) {
   return offsets;
 }
 
+int radiance_exponent(const Scene& scene) {
+  float brightest = std::max({scene.background.r, scene.background.g, scene.background.b, scene.ambient.r, scene.ambient.g,
+                              scene.ambient.b});
+  for (const Material& m : scene.materials) brightest = std::max({brightest, m.emission.r, m.emission.g, m.emission.b});
+  for (const PointLight& l : scene.lights) brightest = std::max({brightest, l.intensity.r, l.intensity.g, l.intensity.b});
+  if (!(brightest > 0.0f)) return 0;
+  int exponent = 0;
+  std::frexp(brightest, &exponent);  // brightest = m 2^exponent, m in [0.5, 1)
+  return -40 - exponent;
+}
+
+glm::vec3 unscale_radiance(glm::vec3 scaled, int radiance_exponent) {
+  glm::vec3 out;
+  for (int c = 0; c < 3; ++c) out[c] = std::min(std::ldexp(scaled[c], -radiance_exponent), FLT_MAX);
+  return out;
+}
+
 PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& order) {
   PackedLighting packed;
+  const int exponent = radiance_exponent(scene);
+  const EmitterTable table = build_emitter_table(scene);
   packed.materials.resize(scene.materials.size() * VKRAY_TEXELS_PER_MATERIAL);
   const std::vector<uint32_t> offsets = texture_offsets(scene);
   const auto header = [&](const TextureRef& ref) {
@@ -270,23 +298,24 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     const Material& m = scene.materials[i];
     glm::vec4* texels = &packed.materials[i * VKRAY_TEXELS_PER_MATERIAL];
     texels[VKRAY_MATERIAL_COLOR] = glm::vec4(m.albedo, uintBitsToFloat(uint32_t(m.type)));
-    texels[VKRAY_MATERIAL_EMISSION] = glm::vec4(m.emission, m.ior);
+    texels[VKRAY_MATERIAL_EMISSION] = glm::vec4(scale_radiance(m.emission, exponent), m.ior);
     texels[VKRAY_MATERIAL_ALBEDO_TEXTURE] = header(m.albedo_texture);
     texels[VKRAY_MATERIAL_EMISSION_TEXTURE] = header(m.emission_texture);
+    // In double on the host, then one rounding: no 1 / total power in float that could overflow.
+    texels[VKRAY_MATERIAL_LIGHT] = glm::vec4(float(table.density[i]), 0.0f, 0.0f, 0.0f);
   }
   // The area lights, their primitives as slots in the primitive buffer.
-  const EmitterTable table = build_emitter_table(scene);
   if (!table.entries.empty()) {
     std::vector<uint32_t> slot_of(order.size());
     for (size_t slot = 0; slot < order.size(); ++slot) slot_of[order[slot]] = uint32_t(slot);
     for (const EmitterTable::Entry& e : table.entries)
       packed.emitters.push_back(glm::vec4(e.probability, uintBitsToFloat(e.alias), uintBitsToFloat(slot_of[e.primitive]), 0.0f));
-    packed.emitter_frame = {uint32_t(table.entries.size()), float(1.0 / table.total_weight)};
   }
+  packed.frame = {uint32_t(table.entries.size()), exponent};
   packed.lights.resize(scene.lights.size() * VKRAY_TEXELS_PER_LIGHT);
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     packed.lights[i * VKRAY_TEXELS_PER_LIGHT + VKRAY_LIGHT_POSITION] = glm::vec4(scene.lights[i].position, 0.0f);
-    packed.lights[i * VKRAY_TEXELS_PER_LIGHT + VKRAY_LIGHT_INTENSITY] = glm::vec4(scene.lights[i].intensity, 0.0f);
+    packed.lights[i * VKRAY_TEXELS_PER_LIGHT + VKRAY_LIGHT_INTENSITY] = glm::vec4(scale_radiance(scene.lights[i].intensity, exponent), 0.0f);
   }
   return packed;
 }

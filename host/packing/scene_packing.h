@@ -14,11 +14,25 @@
 
 namespace vkray::gpu {
 
-// What the frame uniforms say of the area lights (FrameUniforms::emitter_count, inv_emitter_weight).
-struct EmitterFrame {
-  uint32_t count = 0;
-  float inv_weight = 0.0f;
+// What the frame goes by that depends on the lighting: the area lights' table's entries
+// (FrameUniforms::emitter_count), and the power of two by which every radiance the shader reads is
+// scaled (shared/types.h): 2^radiance_exponent.
+struct LightingFrame {
+  uint32_t emitter_count = 0;
+  int radiance_exponent = 0;
 };
+
+// The exponent k that brings the scene's brightest radiance (an emission, the background, the
+// ambient term, a light's intensity) to [2^-41, 2^-40) when multiplied by 2^k; 0 when all are 0.
+// Far below 1, so that the products a path makes (a point light's 1 / r^2 near a surface, a
+// sample's weight, thousands of samples summed) stay below FLT_MAX even where the brightest light is
+// near it; far above FLT_MIN, so that lights 10^25 times dimmer than the brightest are still normal
+// floats, not flushed to zero. Powers of two scale floats exactly.
+int radiance_exponent(const Scene& scene);
+
+// The shader's radiance back in the scene's units: `scaled` times 2^-radiance_exponent, exactly,
+// with values past the largest float held at it.
+glm::vec3 unscale_radiance(glm::vec3 scaled, int radiance_exponent);
 
 // The buffers that depend on the primitives alone (same_geometry), which a scene whose camera,
 // lights or materials change keeps on the device.
@@ -36,7 +50,7 @@ struct PackedLighting {
   std::vector<glm::vec4> materials;   // VKRAY_TEXELS_PER_MATERIAL texels each
   std::vector<glm::vec4> lights;      // VKRAY_TEXELS_PER_LIGHT texels each
   std::vector<glm::vec4> emitters;    // VKRAY_TEXELS_PER_EMITTER texels each (scene/emitters.h)
-  EmitterFrame emitter_frame;
+  LightingFrame frame;
 };
 
 // The scene's buffers; the per-frame uniforms come from pack_frame().
@@ -60,7 +74,7 @@ Aabb unpack_child_box(const glm::uvec4* node, int c);
 
 // The per-frame uniforms (camera, image, counts). `image` is the resolution actually rendered (the
 // scene's, or the command line's).
-FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const EmitterFrame& emitters, const ImageSettings& image);
+FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const LightingFrame& lighting, const ImageSettings& image);
 
 // TileConstants::row_stride for a dispatch of `rows` workgroup rows: the integer nearest
 // rows / golden ratio that is coprime with rows (so r -> r * stride mod rows is a permutation, and

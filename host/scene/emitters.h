@@ -19,12 +19,20 @@ struct EmitterTable {
   };
   std::vector<Entry> entries;  // empty when nothing emits
   double total_weight = 0;     // the sum of area * luminance(emission) over the entries
+  // For each of the scene's materials, the density per unit area with which light sampling picks a
+  // point of one of its emitters: luminance(emission) / total_weight (0 for a material with none).
+  std::vector<double> density;
 };
 
 // The alias table over the emissive primitives, each weighted by its power. Primitives whose
 // weight is 0 (an emission of zero luminance, an area that underflows) are left out: they would
 // never be picked.
 EmitterTable build_emitter_table(const Scene& scene);
+
+// Throws SceneError, naming the object, for an area light the GPU cannot sample: one whose density
+// (at least 1 / its area) passes the largest 32-bit float. The loader checks every scene here, so
+// that both renderers refuse it before any work.
+void check_area_lights(const Scene& scene);
 
 // The area of primitive p (scene numbering), in double.
 double primitive_area(const Scene& scene, uint32_t p);

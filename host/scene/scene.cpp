@@ -9,7 +9,8 @@ namespace vkray {
 float Scene::extent() const {
   float e = 0.0f;
   auto grow = [&e](glm::vec3 p) { e = std::max({e, std::abs(p.x), std::abs(p.y), std::abs(p.z)}); };
-  grow(camera.position);
+  // Rays leave anywhere on the lens: its rounding is what epsilon must stand above.
+  grow(glm::abs(camera.position) + camera.aperture_radius);
   for (const auto& l : lights) grow(l.position);
   for (const auto& s : spheres) grow(glm::abs(s.center) + s.radius);
   for (const auto& t : triangles)

@@ -161,7 +161,7 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   variant.shadows = options.shadows;
   const Scene& s = scene.scene();
   variant.path = s.integrator.type == Integrator::Type::path;
-  variant.emitters = scene.emitters().count > 0;
+  variant.emitters = scene.lighting().emitter_count > 0;
   variant.specular = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.specular(); });
   variant.aovs = options.aovs;
   variant.textures = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.textured(); });

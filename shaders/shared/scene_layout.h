@@ -59,11 +59,14 @@ VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 //   VKRAY_MATERIAL_EMISSION:          (emitted radiance, index of refraction)
 //   VKRAY_MATERIAL_ALBEDO_TEXTURE:    the texture that multiplies the colour (texture_texel)
 //   VKRAY_MATERIAL_EMISSION_TEXTURE:  the texture that multiplies the emission
-#define VKRAY_TEXELS_PER_MATERIAL 4
+//   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
+//                                     an emitter of this material, 0, 0, 0): scene/emitters.h
+#define VKRAY_TEXELS_PER_MATERIAL 5
 #define VKRAY_MATERIAL_COLOR 0
 #define VKRAY_MATERIAL_EMISSION 1
 #define VKRAY_MATERIAL_ALBEDO_TEXTURE 2
 #define VKRAY_MATERIAL_EMISSION_TEXTURE 3
+#define VKRAY_MATERIAL_LIGHT 4
 // The types, as vkray::MaterialType numbers them.
 #define VKRAY_MATERIAL_DIFFUSE 0u
 #define VKRAY_MATERIAL_MIRROR 1u

@@ -78,6 +78,11 @@ VKRAY_SHARED_BEGIN
 
 // ---- Per-frame constants (std140 uniform block) ----------------------------------------------
 // The camera follows the scene contract: d = normalize(x*right + y*up + focal_px*forward).
+// Radiance here (background, ambient), in the materials' emission and in the lights' intensity is
+// the scene's times a power of two that brings the brightest of them near 2^-40 (gpu::LightingFrame):
+// light transport is linear in them, so the shader's image is the scene's times that power exactly,
+// which the host divides out, and no float the shader computes overflows or flushes to zero where
+// the double-precision CPU reference's does not (docs/limits.md, "Floats on the GPU").
 struct FrameUniforms {
   vec4 origin;      // xyz: camera position; w: unused
   vec4 right;       // xyz: unit right vector r
@@ -102,9 +107,7 @@ struct FrameUniforms {
   int max_depth;          // the path integrator's; -1: no limit
   uint rr_depth;
   uint emitter_count;     // entries of the area lights' alias table
-  // 1 / the table's total weight (the sum of area times luminance): an area light's point is
-  // picked with density emission_luminance(emission) * inv_emitter_weight per unit area.
-  float inv_emitter_weight;
+  uint unused2;
   uint unused0;     // std140 rounds the struct up to a multiple of 16 bytes; the buffer holds all of it
   uint unused1;
 };
@@ -132,7 +135,7 @@ static_assert(offsetof(FrameUniforms, focus_distance) == 148);
 static_assert(offsetof(FrameUniforms, max_depth) == 152);
 static_assert(offsetof(FrameUniforms, rr_depth) == 156);
 static_assert(offsetof(FrameUniforms, emitter_count) == 160);
-static_assert(offsetof(FrameUniforms, inv_emitter_weight) == 164);
+static_assert(offsetof(FrameUniforms, unused2) == 164);
 static_assert(offsetof(FrameUniforms, unused0) == 168);
 static_assert(offsetof(FrameUniforms, unused1) == 172);
 static_assert(sizeof(FrameUniforms) == 176);
