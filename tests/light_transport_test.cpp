@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -63,6 +64,22 @@ TEST_F(LightTransportTest, DiffusePlaneUnderTheSkyGivesAlbedoTimesTheSky) {
     "objects": [{"type": "triangles", "material": "ground", "positions": [[-50, 0, -50], [50, 0, -50], [50, 0, 50], [-50, 0, 50]],
                  "indices": [[0, 1, 2], [0, 2, 3]]}]})";
   expect_both(json, {32, 32, 16}, {0.4, 0.15, 0.4}, 0.01);
+}
+
+TEST_F(LightTransportTest, TheSkyLawHoldsAtBothEndsOfTheFloatRange) {
+  // The same plane under a sky near the largest float and under one below the smallest normal
+  // float: the image is still a B, which a GPU computing the sky's light unscaled overflows or
+  // flushes to zero.
+  for (const auto& [b, sky] : {std::pair<std::string, double>{"3e38", 3e38}, {"1e-39", 1e-39}}) {
+    const std::string json = R"({
+      "camera": {"position": [0, 1, 0], "direction": [0, -1, 0], "up": [0, 0, 1], "vertical_fov": 30},
+      "integrator": {"type": "path"},
+      "background": [)" + b + ", " + b + ", " + b + R"(],
+      "materials": {"ground": {"albedo": [0.5, 0.25, 1.0]}},
+      "objects": [{"type": "triangles", "material": "ground", "positions": [[-50, 0, -50], [50, 0, -50], [50, 0, 50], [-50, 0, 50]],
+                   "indices": [[0, 1, 2], [0, 2, 3]]}]})";
+    expect_both(json, {32, 32, 16}, {0.5 * sky, 0.25 * sky, sky}, 0.01);
+  }
 }
 
 // A closed slab of glass, 2.4 x 2.4 x 0.5, its faces wound so that every normal points out: corner i
