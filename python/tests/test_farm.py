@@ -18,6 +18,7 @@ import OpenImageIO as oiio
 import pytest
 
 import vkray
+import vkray.farm as farm_module
 from conftest import run
 
 # Every test renders the Cornell box with paths: cheap, and noisy, so that any wrong sample shows.
@@ -241,6 +242,8 @@ def test_sigterm_stops_the_job_and_writes_nothing(scenes, tmp_path):
     (["{scenes}/cornell.json", "-o", "x.pfm", "--spp", "many"], 2, "--spp: 'many' is not a whole number"),
     (["{scenes}/cornell.json", "-o", "x.pfm", "--scheduler", "tcp://127.0.0.1:1", "--worker-timeout", "2"], 3,
      "cannot reach the scheduler at tcp://127.0.0.1:1"),
+    # Not an address at all: a bad option value, as `vkray render --width x` is.
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--scheduler", "no-port"], 2, "--scheduler no-port: missing port number"),
 ])
 def test_bad_jobs_fail_before_any_work_with_a_message(scenes, tmp_path, args, code, says):
     job = farm(*[a.format(scenes=scenes) for a in args], cwd=tmp_path)
@@ -248,6 +251,21 @@ def test_bad_jobs_fail_before_any_work_with_a_message(scenes, tmp_path, args, co
     assert job.returncode == code, err
     assert says in err, err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("error, code", [
+    (vkray.SceneError("scene.json: key"), 1), (farm_module._CannotWrite("out: disk full"), 1), (MemoryError(), 1),
+    (farm_module._Usage("--regions"), 2), (vkray.UsageError("width"), 2), (vkray.DeviceError("lost"), 3),
+    (farm_module._ClusterError("no worker"), 3), (distributed.comm.CommClosedError("lost"), 3),
+    (vkray.InternalError("bug"), 70), (KeyboardInterrupt(), 130),
+])
+def test_each_kind_of_error_exits_with_the_command_lines_code(monkeypatch, capsys, error, code):
+    def fail(argv):
+        raise error
+    monkeypatch.setattr(farm_module, "run", fail)
+    monkeypatch.setattr(signal, "signal", lambda *args: None)  # pytest's own handlers stay
+    assert farm_module.main([]) == code
+    assert capsys.readouterr().err.startswith("vkray.farm: ")
 
 
 def test_a_python_without_dask_is_told_what_to_install_for_it(scenes, tmp_path):

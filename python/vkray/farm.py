@@ -16,8 +16,9 @@ A worker that is lost mid-task has its task run again elsewhere (Dask's schedule
 ``distributed.scheduler.allowed-failures`` times); when no worker with a GPU is left for
 ``--worker-timeout`` seconds, the job fails. A part that fails (a bad scene, a device error) fails
 the whole job with vkray's message, and then no output is written: the outputs of all frames are
-written only when every part of every frame is in. Exit codes are vkray's: 0 done, 1 bad input,
-2 usage, 3 device or cluster failure, 130 interrupted (Ctrl-C or SIGTERM).
+written only when every part of every frame is in. Exit codes are vkray's: 0 done, 1 bad input
+(an output that cannot be written included), 2 usage, 3 device or cluster failure, 130 interrupted
+(Ctrl-C or SIGTERM).
 """
 
 from __future__ import annotations
@@ -203,6 +204,9 @@ def _connect(args: argparse.Namespace):  # -> (Client, cluster or None)
                 client = distributed.Client(args.scheduler, timeout=f"{args.worker_timeout}s")
         except OSError as e:
             raise _ClusterError(f"cannot reach the scheduler at {args.scheduler}: {e}") from None
+        except ValueError as e:
+            # Not an address at all: a bad option value, which is usage (2) on every face.
+            raise _Usage(f"--scheduler {args.scheduler}: {e}") from None
         try:
             client.wait_for_workers(1, timeout=args.worker_timeout)
         except Exception:
@@ -273,7 +277,10 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
                 print("vkray.farm: warning: the parts were rendered on more than one device: the image agrees with a "
                       "single render within parity, not bit for bit", file=sys.stderr)
         with _no_interrupts():
-            _commit(merged, targets, folder)
+            try:
+                _commit(merged, targets, folder)
+            except OSError as e:
+                raise _CannotWrite(f"cannot put the output in place: {e}") from None
         for target in targets:
             _log(args.quiet, f"wrote {target}")
     finally:
@@ -369,9 +376,12 @@ def _render_parts(client: Any, args: argparse.Namespace, jobs: list, settings: d
             part = future.result()
             future.release()
             file = folder / f"frame{frame:05d}-part{index:05d}{suffix}"
-            file.write_bytes(part["data"])
-            if part["record"] is not None:
-                file.with_name(file.name + ".json").write_bytes(part["record"])
+            try:
+                file.write_bytes(part["data"])
+                if part["record"] is not None:
+                    file.with_name(file.name + ".json").write_bytes(part["record"])
+            except OSError as e:
+                raise _CannotWrite(f"{file}: cannot write a part there ({e.strerror})") from None
             done += 1
             part_seconds += part["seconds"]
             trace_seconds += part["stats"].get("trace_seconds", 0)
@@ -381,8 +391,12 @@ def _render_parts(client: Any, args: argparse.Namespace, jobs: list, settings: d
     _log(args.quiet, f"the parts took {part_seconds:.2f} s on the workers, {trace_seconds:.2f} s of it tracing")
 
 
-# vkray's exit code for each kind of error, as the command line has them.
-_EXIT_CODES = ((_Usage, 2), (vkray.SceneError, 1), (vkray.UsageError, 2), (vkray.DeviceError, 3), (vkray.InternalError, 70))
+# The exit code of each kind of error, in the command line's classes: 1 bad input (an output that
+# cannot be written, a machine without Dask or without the host memory for the job), 2 usage, 3
+# device or cluster, 70 a bug of vkray's. Anything else is the cluster's (a worker lost too often,
+# KilledWorker): 3.
+_EXIT_CODES = ((_Usage, 2), (_CannotWrite, 1), (_MissingDask, 1), (MemoryError, 1), (_ClusterError, 3),
+               (vkray.SceneError, 1), (vkray.UsageError, 2), (vkray.DeviceError, 3), (vkray.InternalError, 70))
 
 
 # While set, Ctrl-C and SIGTERM are ignored: the outputs are being renamed into place (milliseconds),
@@ -417,16 +431,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print("vkray.farm: interrupted; nothing written", file=sys.stderr)
         return 130
     except Exception as e:
-        for kind, code in _EXIT_CODES:
-            if isinstance(e, kind):
-                print(f"vkray.farm: error: {e}", file=sys.stderr)
-                return code
-        if isinstance(e, (_CannotWrite, _MissingDask, _ClusterError)):
-            print(f"vkray.farm: error: {e}", file=sys.stderr)
-            return 3 if isinstance(e, _ClusterError) else 1
-        # The cluster's: a scheduler out of reach, a worker lost too often (KilledWorker).
-        print(f"vkray.farm: error: {type(e).__name__}: {e}", file=sys.stderr)
-        return 3
+        code = next((code for kind, code in _EXIT_CODES if isinstance(e, kind)), None)
+        own = code is not None and not isinstance(e, MemoryError)
+        print(f"vkray.farm: error: {e if own else f'{type(e).__name__}: {e}'}", file=sys.stderr)
+        return 3 if code is None else code
 
 
 if __name__ == "__main__":
