@@ -4,22 +4,28 @@ resource, as workers on GPU machines would. The farm's output is compared byte f
 `vkray render`; a worker is killed in the middle of a job (and then the only one), and a worker whose
 device fails fails the job cleanly."""
 
+import contextlib
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
+import threading
 import time
+import types
 from pathlib import Path
+from typing import Optional
 
 import distributed
 import numpy as np
 import OpenImageIO as oiio
+import psutil
 import pytest
 
 import vkray
 import vkray.farm as farm_module
-from conftest import run
+from conftest import SCENES, run
 
 # Every test renders the Cornell box with paths: cheap, and noisy, so that any wrong sample shows.
 RENDER = ["--width", "64", "--height", "48", "--spp", "8"]
@@ -199,6 +205,134 @@ def test_a_part_that_fails_fails_the_job_with_vkrays_message_and_writes_nothing(
     assert list(tmp_path.glob("farm*")) == [] and list(tmp_path.glob(".farm*")) == []
 
 
+class Stderr:
+    """A running farm's stderr, line by line as it comes (read by a thread of its own)."""
+
+    def __init__(self, job: subprocess.Popen):
+        self.job, self.lines, self.changed = job, [], threading.Condition()
+        self.reader = threading.Thread(target=self._read, daemon=True)
+        self.reader.start()
+
+    def _read(self) -> None:
+        for line in self.job.stderr:
+            with self.changed:
+                self.lines.append(line)
+                self.changed.notify_all()
+
+    def wait_for(self, pattern: str, timeout: float) -> re.Match:
+        with self.changed:
+            assert self.changed.wait_for(lambda: self._match(pattern) or self.job.poll() is not None, timeout), \
+                f"no line matched {pattern!r} within {timeout} s:\n{self.text()}"
+            match = self._match(pattern)
+            assert match, f"the farm ended (exit {self.job.returncode}) before a line matched {pattern!r}:\n{self.text()}"
+            return match
+
+    def _match(self, pattern: str) -> Optional[re.Match]:
+        return next((m for m in map(re.compile(pattern).search, self.lines) if m), None)
+
+    def text(self) -> str:
+        return "".join(self.lines)
+
+
+def processes_in_session(sid: int) -> list[psutil.Process]:
+    """The processes still running (zombies aside) in the session of the farm's process `sid`."""
+    left = []
+    for process in psutil.process_iter():
+        with contextlib.suppress(psutil.Error, OSError):
+            if os.getsid(process.pid) == sid and process.status() != psutil.STATUS_ZOMBIE:
+                left.append(process)
+    return left
+
+
+# A render whose parts take a second or so each on lavapipe, so that a worker is stopped while it
+# holds parts, long before the others are done.
+SLOW = ["--width", "128", "--height", "96", "--spp", "1024"]
+
+
+@pytest.fixture(scope="module")
+def slow_single_render(tmp_path_factory) -> bytes:
+    """`vkray render` of SLOW, once for the tests that compare with it."""
+    out = tmp_path_factory.mktemp("single") / "single.pfm"
+    run(os.environ["VKRAY_EXECUTABLE"], "render", str(SCENES / "cornell-path.json"), *SLOW, "-o", str(out), "-q")
+    return out.read_bytes()
+
+
+@pytest.mark.parametrize("resumed", [False, True], ids=["stays-stopped", "resumed-later"])
+def test_a_stopped_worker_has_its_parts_rendered_elsewhere_and_is_ended(scenes, tmp_path, slow_single_render, resumed):
+    # A worker process of the farm's LocalCluster is stopped (SIGSTOP) while it holds parts: Dask
+    # would keep them for its worker-ttl of five minutes. The farm says which parts wait on that
+    # worker and renders them on the other one; a worker that continues later (SIGCONT) must not
+    # break the job either.
+    out = tmp_path / "farm.pfm"
+    job = farm(str(scenes / "cornell-path.json"), *SLOW, "-o", str(out), "--workers", "2", "--regions", "8")
+    err = Stderr(job)
+    victim = None
+    try:
+        address = err.wait_for(r"scheduler (tcp://\S+)", 120)[1]
+        with distributed.Client(address, timeout="30s") as client:
+            pids = client.run(os.getpid)
+            deadline = time.monotonic() + 60
+            while not any(client.processing().values()):
+                assert time.monotonic() < deadline and job.poll() is None, err.text()
+                time.sleep(0.05)
+            holder = max(client.processing().items(), key=lambda item: len(item[1]))[0]
+            victim = pids[holder]
+            os.kill(victim, signal.SIGSTOP)
+            assert client.processing()[holder], "the stopped worker held no part"
+            name = f"worker {client.scheduler_info()['workers'][holder]['name']}"
+        # Which parts wait on which worker, and where they go.
+        slow = err.wait_for(rf"slow: part \d+ of frame 0 \(rows \d+-\d+\), (running|waiting) on {name}( for [\d.]+ s)?: "
+                            rf"rendering it again on (worker \d)$", 240)
+        if resumed:
+            os.kill(victim, signal.SIGCONT)
+        # Well within Dask's five minutes, whatever the load on this machine.
+        job.wait(timeout=240)
+        err.reader.join(timeout=30)
+        assert job.returncode == 0, err.text()
+        assert f"slow: {name} has started or finished no part for" in err.text(), err.text()
+        assert slow[3] != name, err.text()
+        # Each part was written once, and the merged image is a single render's.
+        assert len(re.findall(r"^vkray\.farm: \d+/8 parts:", err.text(), re.MULTILINE)) == 8, err.text()
+        assert "8/8 parts" in err.text() and f"wrote {out}" in err.text(), err.text()
+        if not resumed:
+            assert re.search(rf"by {slow[3]} on .*\(the first of 2 attempts; the others are cancelled\)", err.text()), \
+                err.text()
+        assert out.read_bytes() == slow_single_render
+        assert list(tmp_path.glob(".farm*")) == []
+        # Nothing the job started is left, the stopped worker included.
+        deadline = time.monotonic() + 30
+        while processes_in_session(job.pid) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert processes_in_session(job.pid) == [], [p.cmdline() for p in processes_in_session(job.pid)]
+    finally:
+        if victim is not None:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(victim, signal.SIGCONT)
+                os.kill(victim, signal.SIGKILL)
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(job.pid, signal.SIGKILL)
+        job.wait()
+
+
+def test_closing_a_cluster_that_does_not_answer_ends_its_worker_processes():
+    # As a LocalCluster whose close times out on a stopped worker process: the farm ends the process.
+    class Unanswering:
+        def __init__(self, pid: int):
+            self.workers = {0: types.SimpleNamespace(pid=pid)}
+
+        def close(self, timeout: Optional[float] = None) -> None:
+            raise TimeoutError(f"the cluster did not close within {timeout} s")
+
+    worker = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"])
+    try:
+        worker.send_signal(signal.SIGSTOP)
+        farm_module._close(None, Unanswering(worker.pid))
+        assert worker.wait(timeout=30) == -signal.SIGKILL
+    finally:
+        worker.kill()
+        worker.wait()
+
+
 def test_frames_on_a_local_cluster(scenes, vkray_command, tmp_path):
     out = tmp_path / "frame.pfm"
     job = farm(str(scenes / "cornell.json"), "--frames", str(scenes / "cornell-spheres.json"), *RENDER, "-o", str(out),
@@ -244,6 +378,8 @@ def test_sigterm_stops_the_job_and_writes_nothing(scenes, tmp_path):
      "cannot reach the scheduler at tcp://127.0.0.1:1"),
     # Not an address at all: a bad option value, as `vkray render --width x` is.
     (["{scenes}/cornell.json", "-o", "x.pfm", "--scheduler", "no-port"], 2, "--scheduler no-port: missing port number"),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--slow-factor", "1"], 2, "--slow-factor: 1 is not more than 1"),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--slow-floor", "0"], 2, "--slow-floor: 0 is not more than 0"),
 ])
 def test_bad_jobs_fail_before_any_work_with_a_message(scenes, tmp_path, args, code, says):
     job = farm(*[a.format(scenes=scenes) for a in args], cwd=tmp_path)

@@ -14,23 +14,31 @@ it must be on a file system they share (as on a Slurm cluster), and import this 
 
 A worker that is lost mid-task has its task run again elsewhere (Dask's scheduler does that, up to
 ``distributed.scheduler.allowed-failures`` times); when no worker with a GPU is left for
-``--worker-timeout`` seconds, the job fails. A part that fails (a bad scene, a device error) fails
+``--worker-timeout`` seconds, the job fails. A worker that is still there but makes no progress
+(stopped, stuck in a driver, or a much slower GPU) is slow once it has held parts without starting
+or finishing one for ``--slow-factor`` times the median time of the finished parts (at least
+``--slow-floor`` seconds): the job says so and renders its parts again on the other workers, uses
+each part's first result and cancels the rest. A part that fails (a bad scene, a device error) fails
 the whole job with vkray's message, and then no output is written: the outputs of all frames are
-written only when every part of every frame is in. Exit codes are vkray's: 0 done, 1 bad input
-(an output that cannot be written included), 2 usage, 3 device or cluster failure, 130 interrupted
-(Ctrl-C or SIGTERM).
+written only when every part of every frame is in. At the end the job closes its LocalCluster in
+bounded time and ends any worker process that does not answer. Exit codes are vkray's: 0 done,
+1 bad input (an output that cannot be written included), 2 usage, 3 device or cluster failure,
+130 interrupted (Ctrl-C or SIGTERM).
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import importlib
 import importlib.util
 import logging
+import math
 import os
 import shutil
 import signal
+import statistics
 import sys
 import tempfile
 import threading
@@ -60,14 +68,17 @@ def _worker_name(name: Any) -> str:
 
 
 def _render_part(scene: str, region: tuple[int, int, int, int], settings: dict[str, Any],
-                 suffix: str) -> dict[str, Any]:
+                 suffix: str, topic: str) -> dict[str, Any]:
     """A Dask task: renders `region` of `scene` and returns the part file's bytes (and a PFM part's
-    record) with what it cost."""
+    record) with what it cost. It tells the job on `topic` when it starts rendering, so that the job
+    sees a worker that stops making progress."""
     global _renderer
     import distributed
 
-    start = time.perf_counter()
+    worker = distributed.get_worker()
     with _renderer_lock, tempfile.TemporaryDirectory(prefix="vkray-part-") as folder:
+        start = time.perf_counter()
+        worker.log_event(topic, {"key": worker.get_current_task(), "address": worker.address})
         try:
             if _renderer is None:
                 _renderer = vkray.Renderer(os.environ.get("VKRAY_DEVICE") or None)
@@ -88,7 +99,8 @@ def _render_part(scene: str, region: tuple[int, int, int, int], settings: dict[s
             "record": record.read_bytes() if record.exists() else None,
             "stats": dict(_renderer.last_stats or {}),
             "device": _renderer.device,
-            "worker": _worker_name(distributed.get_worker().name),
+            "worker": _worker_name(worker.name),
+            "address": worker.address,
         }
     result["seconds"] = time.perf_counter() - start
     return result
@@ -114,14 +126,20 @@ def _whole(low: int, high: int = 2**32 - 1):
     return parse
 
 
-def _seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
-    if not 0 < value < 1e6:
-        raise argparse.ArgumentTypeError(f"{value} seconds: more than 0, less than 1e6")
-    return value
+def _number(what: str, low: float, high: float):
+    """An argparse type: a number more than `low` and less than `high`."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a {what}") from None
+        if not low < value < high:
+            raise argparse.ArgumentTypeError(f"{value:g} is not more than {low:g} and less than {high:.0f}")
+        return value
+    return parse
+
+
+_seconds = _number("number of seconds", 0, 1e6)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -143,6 +161,12 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--worker-timeout", type=_seconds, default=60.0, metavar="SECONDS",
                    help="how long to wait for the scheduler, and for a worker with a GPU when the cluster has none "
                         "(default 60)")
+    p.add_argument("--slow-factor", type=_number("number", 1, 1e6), default=4.0, metavar="F",
+                   help="a worker that holds parts but has started or finished none for F times the median time of "
+                        "the finished parts (and --slow-floor seconds) is slow: its parts are rendered again on other "
+                        "workers, and the first result of each is used (default 4)")
+    p.add_argument("--slow-floor", type=_seconds, default=10.0, metavar="SECONDS",
+                   help="the least time that makes a worker slow, whatever the median (default 10)")
     p.add_argument("--width", type=_whole(1), metavar="W", help="image width in pixels (default: the scene's)")
     p.add_argument("--height", type=_whole(1), metavar="H", help="image height in pixels (default: the scene's)")
     p.add_argument("--spp", type=_whole(1), metavar="N", help="samples per pixel (default: the scene's)")
@@ -188,11 +212,18 @@ class _ClusterError(Exception):
     """The cluster cannot do the job: no workers, none with a GPU, all of them lost."""
 
 
+def _gpu_addresses(workers: dict[str, Any]) -> list[str]:
+    """The workers (scheduler_info()["workers"]) that declare a GPU."""
+    return [address for address, w in workers.items() if w.get("resources", {}).get("GPU", 0) >= 1]
+
+
 def _gpu_workers(client: Any) -> int:
-    return sum(1 for w in client.scheduler_info()["workers"].values() if w.get("resources", {}).get("GPU", 0) >= 1)
+    return len(_gpu_addresses(client.scheduler_info()["workers"]))
 
 
-def _connect(args: argparse.Namespace):  # -> (Client, cluster or None)
+def _connect(args: argparse.Namespace, workspace: Optional[Path]):  # -> (Client, cluster or None)
+    """A client of the scheduler at --scheduler, or of a LocalCluster started here whose workers keep
+    their files in `workspace`."""
     import distributed
 
     if args.scheduler:
@@ -219,8 +250,12 @@ def _connect(args: argparse.Namespace):  # -> (Client, cluster or None)
         return client, None
     cluster = distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
                                        resources={"GPU": 1}, dashboard_address=None,
-                                       silence_logs=logging.ERROR)
-    return distributed.Client(cluster), cluster
+                                       silence_logs=logging.ERROR, local_directory=str(workspace))
+    try:
+        return distributed.Client(cluster), cluster
+    except BaseException:
+        _close(None, cluster)
+        raise
 
 
 def run(argv: Optional[Sequence[str]] = None) -> int:
@@ -245,7 +280,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     for target in targets:
         vkray._vkray._check_output(target, aovs, args.exr_float, False)
 
-    client = cluster = folder = None
+    client = cluster = folder = workspace = None
     try:
         # The parts go to disk as they arrive (the client holds none for long, however many frames),
         # in a folder beside the output, removed at the end whatever happens.
@@ -253,7 +288,15 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
             folder = Path(tempfile.mkdtemp(prefix=f".{output.name}.parts-", dir=output.parent))
         except OSError as e:
             raise _CannotWrite(f"{output.parent}: cannot write there ({e.strerror})") from None
-        client, cluster = _connect(args)
+        if not args.scheduler:
+            # A LocalCluster's workers keep their files in a folder of the job's, removed at the end: a
+            # worker that had to be ended leaves nothing behind in Dask's shared dask-worker-space.
+            try:
+                workspace = Path(tempfile.mkdtemp(prefix="vkray-farm-"))
+            except OSError as e:
+                raise _ClusterError(f"cannot start the workers: no folder for them in {tempfile.gettempdir()} "
+                                    f"({e.strerror})") from None
+        client, cluster = _connect(args, workspace)
         started = time.perf_counter()
         gpus = _gpu_workers(client)
         regions = args.regions if args.regions is not None else min(rows, max(2, 2 * gpus))
@@ -263,8 +306,12 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
             for index, region in enumerate(vkray.bands(scene, regions, width=args.width, height=args.height)):
                 jobs.append((frame, index, scene, region))
         _log(args.quiet, f"{len(jobs)} parts ({len(scenes)} frame{'s' if len(scenes) > 1 else ''} x {regions} bands) on "
-                         f"{len(client.scheduler_info()['workers'])} workers with {gpus} GPU{'s' if gpus != 1 else ''}")
-        _render_parts(client, args, jobs, settings, suffix, folder)
+                         f"{len(client.scheduler_info()['workers'])} workers with {gpus} GPU{'s' if gpus != 1 else ''},"
+                         f" scheduler {client.scheduler.address}")
+        job = _Job(client, args, settings, suffix, folder)
+        for frame, index, scene, region in jobs:
+            job.submit(_Part(frame, index, scene, region))
+        job.wait()
         rendered = time.perf_counter() - started
         # Every part is here: now, and only now, the outputs are written, each merged under a name
         # of its own in the parts' folder and then all renamed into place (one file system).
@@ -283,18 +330,38 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
                 raise _CannotWrite(f"cannot put the output in place: {e}") from None
         for target in targets:
             _log(args.quiet, f"wrote {target}")
+        merged_in = time.perf_counter() - started - rendered
     finally:
         # A second Ctrl-C or a SIGTERM from a batch system must not leave the parts or the cluster.
         with _no_interrupts():
-            if folder is not None:
-                shutil.rmtree(folder, ignore_errors=True)
-            if client is not None:
-                client.close()
-            if cluster is not None:
-                cluster.close()
-    _log(args.quiet, f"{len(jobs)} parts rendered in {rendered:.2f} s, merged in "
-                     f"{time.perf_counter() - started - rendered:.2f} s")
+            _close(client, cluster)
+            for remove in (folder, workspace):
+                if remove is not None:
+                    shutil.rmtree(remove, ignore_errors=True)
+    _log(args.quiet, f"{len(jobs)} parts rendered in {rendered:.2f} s, merged in {merged_in:.2f} s")
     return 0
+
+
+# How long closing the client, and then the LocalCluster, may take.
+_CLOSE_SECONDS = 20
+
+
+def _close(client: Any, cluster: Any) -> None:
+    """Closes the client and a LocalCluster in bounded time, and then ends any of the cluster's worker
+    processes still there (one stopped, or stuck in a driver, does not answer): nothing the job
+    started is left running."""
+    pids = [nanny.pid for nanny in cluster.workers.values() if getattr(nanny, "pid", None)] if cluster else []
+    for closing in (client, cluster):
+        if closing is not None:
+            with contextlib.suppress(Exception):
+                closing.close(timeout=_CLOSE_SECONDS)
+    import psutil  # a dependency of Dask's distributed
+
+    for pid in pids:
+        with contextlib.suppress(psutil.Error):
+            process = psutil.Process(pid)
+            if process.ppid() == os.getpid():
+                process.kill()
 
 
 def _commit(merged: list[Path], targets: list[Path], folder: Path) -> None:
@@ -321,74 +388,281 @@ def _commit(merged: list[Path], targets: list[Path], folder: Path) -> None:
         raise
 
 
-def _render_parts(client: Any, args: argparse.Namespace, jobs: list, settings: dict[str, Any], suffix: str,
-                  folder: Path) -> None:
-    """Runs every job as a Dask task and writes each part to `folder` as it arrives; raises the first
-    failure (vkray's exception, or the cluster's) after cancelling the rest."""
-    import distributed
+# ---- the job: each part's attempts, and the watch for slow workers --------------------------------
 
-    run_id = uuid.uuid4().hex[:8]
-    # The task by its module's name, so that Dask sends a reference the workers import, not this
-    # module's code (when it runs as __main__, `python3 -m vkray.farm`).
-    task = importlib.import_module("vkray.farm")._render_part
-    futures = {}
-    for frame, index, scene, region in jobs:
-        future = client.submit(task, scene, region, settings, suffix, key=f"vkray-{run_id}-{frame}-{index}",
-                               resources={"GPU": 1}, pure=False)
-        futures[future] = (frame, index, region)
-    done = 0
-    part_seconds = trace_seconds = 0.0
-    arrivals = distributed.as_completed(list(futures))
-    # A task that needs a GPU waits for one however long it takes, so a job whose GPU workers are
-    # all gone would wait for ever: between arrivals the loop looks every 2 s for GPUs left.
-    without_gpus_since = None
-    looked = time.monotonic()
-    while futures:
-        batch = arrivals.next_batch(block=False)
-        if not batch:
+# How often the job looks at the cluster: the workers with a GPU, what each holds, what each started.
+_LOOK_SECONDS = 1.0
+
+
+@dataclasses.dataclass(eq=False)
+class _Part:
+    """A band of a frame and the Dask tasks that render it: the first, and one more each time the
+    workers that held the earlier ones were slow."""
+    frame: int
+    index: int
+    scene: str
+    region: tuple[int, int, int, int]
+    attempts: list = dataclasses.field(default_factory=list)  # futures, in the order submitted
+    done: bool = False  # its part file is written; a later result of it is not used
+
+    def __str__(self) -> str:
+        return f"part {self.index} of frame {self.frame} (rows {self.region[1]}-{self.region[3] - 1})"
+
+
+class _Progress:
+    """What the workers were seen doing: when each last started or finished a part, when each attempt
+    started and where, and how long the finished parts took. From that, how long a worker may go
+    without starting or finishing a part before it counts as slow."""
+
+    def __init__(self, factor: float, floor: float):
+        self.factor, self.floor = factor, floor
+        # (when it came, the event) for each start event, appended by the client's thread as it comes.
+        self.events: list[tuple[float, dict[str, str]]] = []
+        self.events_read = 0
+        self.since: dict[str, float] = {}  # worker address -> when it last started or finished a part, or got one
+        self.started: dict[str, tuple[str, float]] = {}  # attempt key -> (worker address, when it started)
+        self.seconds: dict[int, list[float]] = {}  # frame -> how long each of its finished parts took
+        self.busy: set[str] = set()  # the workers that held parts at the last look
+
+    def heard(self, event: tuple[float, dict[str, str]]) -> None:
+        """The handler of the job's topic: a worker started an attempt (Dask's event, (time, message))."""
+        self.events.append((time.monotonic(), event[1]))
+
+    def read(self) -> list[str]:
+        """Takes the start events not read yet; returns the workers they came from."""
+        new = self.events[self.events_read:]
+        self.events_read += len(new)
+        for when, event in new:
+            self.started[event["key"]] = (event["address"], when)
+            self.since[event["address"]] = max(self.since.get(event["address"], when), when)
+        return [event["address"] for _, event in new]
+
+    def finished(self, address: str, frame: int, seconds: float, now: float) -> None:
+        self.since[address] = now
+        self.seconds.setdefault(frame, []).append(seconds)
+
+    def hold(self, held: dict[str, list[str]], now: float) -> None:
+        """Notes which workers hold parts now: one that held none at the last look starts its clock."""
+        busy = {address for address, keys in held.items() if keys}
+        for address in busy - self.busy:
+            self.since[address] = now
+        self.busy = busy
+
+    def expected(self, frame: int) -> Optional[float]:
+        """A part's expected seconds: the median of its frame's finished parts (the bands of a frame are
+        of about equal work), else of all finished parts; None before any part is in."""
+        seconds = self.seconds.get(frame) or [s for each in self.seconds.values() for s in each]
+        return statistics.median(seconds) if seconds else None
+
+    def limit(self, frames: set[int]) -> Optional[tuple[float, float]]:
+        """(how long, the expected part's seconds): a worker holding parts of `frames` is slow once it has
+        started or finished none for --slow-factor times the longest of their expected times, and at
+        least --slow-floor seconds."""
+        expected = [e for e in map(self.expected, frames) if e is not None]
+        return (max(self.floor, self.factor * max(expected)), max(expected)) if expected else None
+
+
+class _Job:
+    """Every part of every frame as Dask tasks; each part is written to `folder` when its first result
+    arrives. A worker that holds parts but has started or finished none for far longer than a part
+    takes (`_Progress.limit`) is slow: each part it holds is submitted again to the other workers with
+    a GPU, the first result of a part is used and its other attempts are cancelled (speculative
+    execution, as MapReduce's backup tasks and Spark's speculation), so that a stopped or stuck worker
+    costs the job that limit, not Dask's worker-ttl (5 minutes)."""
+
+    def __init__(self, client: Any, args: argparse.Namespace, settings: dict[str, Any], suffix: str, folder: Path):
+        import distributed
+
+        self.client, self.args, self.settings, self.suffix, self.folder = client, args, settings, suffix, folder
+        run_id = uuid.uuid4().hex[:8]
+        self.prefix, self.topic = f"vkray-{run_id}", f"vkray-farm-{run_id}"
+        # The task by its module's name, so that Dask sends a reference the workers import, not this
+        # module's code (when it runs as __main__, `python3 -m vkray.farm`).
+        self.task = importlib.import_module("vkray.farm")._render_part
+        self.parts: list[_Part] = []
+        self.part_of: dict[str, _Part] = {}  # attempt key -> its part
+        self.only_on: dict[str, list[str]] = {}  # a later attempt's key -> the workers it may run on
+        self.arrivals = distributed.as_completed()
+        self.progress = _Progress(args.slow_factor, args.slow_floor)
+        # Each start event comes to this client once, as it happens (before any task is submitted).
+        client.subscribe_topic(self.topic, self.progress.heard)
+        self.slow: dict[str, str] = {}  # a slow worker's address -> its name
+        self.stuck: set[_Part] = set()  # parts said to have no other worker to go to
+        self.without_gpus_since: Optional[float] = None
+        self.done = 0  # parts written
+        self.part_seconds = self.trace_seconds = 0.0
+
+    def submit(self, part: _Part, workers: Optional[list[str]] = None) -> None:
+        if not part.attempts:
+            self.parts.append(part)
+        key = f"{self.prefix}-{part.frame}-{part.index}-{len(part.attempts)}"
+        # A later attempt goes to `workers` only, ahead of the parts not started yet: the job waits for it.
+        future = self.client.submit(self.task, part.scene, part.region, self.settings, self.suffix, self.topic,
+                                    key=key, resources={"GPU": 1}, pure=False, workers=workers,
+                                    priority=1 if workers else 0)
+        part.attempts.append(future)
+        self.part_of[key] = part
+        if workers:
+            self.only_on[key] = workers
+        self.arrivals.add(future)
+
+    def wait(self) -> None:
+        """Writes each part as it arrives, until all are in; raises the first failure (vkray's, or the
+        cluster's) after cancelling the rest."""
+        looked = time.monotonic()
+        while self.done < len(self.parts):
+            batch = self.arrivals.next_batch(block=False)
+            for future in sorted(batch, key=lambda f: (self.part_of[f.key].frame, self.part_of[f.key].index)):
+                self._arrive(future)
+            if batch:
+                continue
             time.sleep(0.05)
-            if time.monotonic() - looked < 2:
-                continue
-            looked = time.monotonic()
-            if _gpu_workers(client):
-                without_gpus_since = None
-            elif without_gpus_since is None:
-                without_gpus_since = looked
-                _log(args.quiet, f"no worker with a GPU is left; waiting up to {args.worker_timeout:g} s for one")
-            elif looked - without_gpus_since > args.worker_timeout:
-                raise _ClusterError(f"no worker with a GPU has been in the cluster for {args.worker_timeout:g} s; "
-                                    f"{len(futures)} of {len(jobs)} parts were not rendered")
-            continue
-        for future in sorted(batch, key=lambda f: futures[f][:2]):
-            if future.status == "error":
-                error = future.exception()
-                client.cancel([other for other in futures if other is not future])
-                raise error
-            if future.status == "cancelled":
-                raise _ClusterError(f"the cluster cancelled part {futures[future][1]} of frame {futures[future][0]} "
-                                    f"(was the scheduler restarted?); {len(futures)} of {len(jobs)} parts were not "
-                                    f"rendered")
-            if future.status != "finished":
-                # Its result was lost with its worker before it came here: Dask renders it again.
-                arrivals.add(future)
-                continue
-            frame, index, region = futures.pop(future)
-            part = future.result()
+            if time.monotonic() - looked >= _LOOK_SECONDS:
+                looked = time.monotonic()
+                self._look(looked)
+        _log(self.args.quiet, f"the parts took {self.part_seconds:.2f} s on the workers, {self.trace_seconds:.2f} s of "
+                              f"it tracing")
+
+    # ---- a result, or a failure, arrives
+
+    def _arrive(self, future: Any) -> None:
+        part = self.part_of[future.key]
+        if part.done:
+            # Another attempt of this part came first: this one's result is not used.
             future.release()
-            file = folder / f"frame{frame:05d}-part{index:05d}{suffix}"
-            try:
-                file.write_bytes(part["data"])
-                if part["record"] is not None:
-                    file.with_name(file.name + ".json").write_bytes(part["record"])
-            except OSError as e:
-                raise _CannotWrite(f"{file}: cannot write a part there ({e.strerror})") from None
-            done += 1
-            part_seconds += part["seconds"]
-            trace_seconds += part["stats"].get("trace_seconds", 0)
-            _log(args.quiet, f"{done}/{len(jobs)} parts: frame {frame} rows {region[1]}-{region[3] - 1} in "
-                             f"{part['seconds']:.2f} s ({part['stats'].get('trace_seconds', 0):.2f} s tracing) by "
-                             f"{part['worker']} on {part['device']}")
-    _log(args.quiet, f"the parts took {part_seconds:.2f} s on the workers, {trace_seconds:.2f} s of it tracing")
+            return
+        if future.status in ("error", "cancelled"):
+            self._failed(part, future)
+            return
+        if future.status != "finished":
+            # Its result was lost with its worker before it came here: Dask renders it again.
+            self.arrivals.add(future)
+            return
+        result = future.result()
+        part.done = True
+        self.done += 1
+        others = [f for f in part.attempts if f is not future]
+        if others:
+            self.client.cancel(others)
+        future.release()
+        self._write(part, result)
+        self.progress.finished(result["address"], part.frame, result["seconds"], time.monotonic())
+        self._heard_from(result["address"])
+        self.part_seconds += result["seconds"]
+        tracing = result["stats"].get("trace_seconds", 0)
+        self.trace_seconds += tracing
+        first = f" (the first of {len(part.attempts)} attempts; the others are cancelled)" if others else ""
+        _log(self.args.quiet, f"{self.done}/{len(self.parts)} parts: frame {part.frame} rows {part.region[1]}-"
+                              f"{part.region[3] - 1} in {result['seconds']:.2f} s ({tracing:.2f} s tracing) by "
+                              f"{result['worker']} on {result['device']}{first}")
+
+    def _write(self, part: _Part, result: dict[str, Any]) -> None:
+        file = self.folder / f"frame{part.frame:05d}-part{part.index:05d}{self.suffix}"
+        try:
+            file.write_bytes(result["data"])
+            if result["record"] is not None:
+                file.with_name(file.name + ".json").write_bytes(result["record"])
+        except OSError as e:
+            raise _CannotWrite(f"{file}: cannot write a part there ({e.strerror})") from None
+
+    def _failed(self, part: _Part, future: Any) -> None:
+        """A part's failure fails the job, unless it is the cluster's (not vkray's) and another attempt
+        of the part is still under way."""
+        error = future.exception() if future.status == "error" else _ClusterError(
+            f"the cluster cancelled {part} (was the scheduler restarted?); "
+            f"{len(self.parts) - self.done} of {len(self.parts)} parts were not rendered")
+        if not isinstance(error, vkray.Error) and any(not f.done() for f in part.attempts):
+            _log(self.args.quiet, f"{part}: an attempt failed ({type(error).__name__}: {error}); another is under way")
+            return
+        self.client.cancel([f for p in self.parts for f in p.attempts if f is not future and not f.done()])
+        raise error
+
+    # ---- the periodic look at the cluster
+
+    def _look(self, now: float) -> None:
+        workers = self.client.scheduler_info()["workers"]
+        gpus = set(_gpu_addresses(workers))
+        self._check_gpus(gpus, now)
+        for address in self.progress.read():
+            self._heard_from(address)
+        held = {address: [key for key in keys if key in self.part_of and not self.part_of[key].done]
+                for address, keys in self.client.processing().items()}
+        self.progress.hold(held, now)
+        self._find_slow(held, workers, now)
+        self._speculate(held, gpus, workers, now)
+
+    def _check_gpus(self, gpus: set[str], now: float) -> None:
+        """A task that needs a GPU waits for one however long it takes, so a job whose GPU workers are
+        all gone would wait for ever: it fails after --worker-timeout seconds without any."""
+        if gpus:
+            self.without_gpus_since = None
+        elif self.without_gpus_since is None:
+            self.without_gpus_since = now
+            _log(self.args.quiet, f"no worker with a GPU is left; waiting up to {self.args.worker_timeout:g} s for one")
+        elif now - self.without_gpus_since > self.args.worker_timeout:
+            raise _ClusterError(f"no worker with a GPU has been in the cluster for {self.args.worker_timeout:g} s; "
+                                f"{len(self.parts) - self.done} of {len(self.parts)} parts were not rendered")
+
+    def _heard_from(self, address: str) -> None:
+        name = self.slow.pop(address, None)
+        if name is not None:
+            _log(self.args.quiet, f"{name} is rendering again")
+
+    def _find_slow(self, held: dict[str, list[str]], workers: dict[str, Any], now: float) -> None:
+        heartbeats = [w["last_seen"] for w in workers.values() if "last_seen" in w]
+        for address, keys in held.items():
+            if not keys or address in self.slow:
+                continue
+            limit = self.progress.limit({self.part_of[key].frame for key in keys})
+            quiet = now - self.progress.since.get(address, now)
+            if limit is None or quiet <= limit[0]:
+                continue
+            silent = max(heartbeats, default=0) - workers.get(address, {}).get("last_seen", math.inf)
+            self.slow[address] = _name(address, workers)
+            _log(self.args.quiet, f"slow: {self.slow[address]} has started or finished no part for {quiet:.1f} s, past "
+                                  f"{limit[0]:.1f} s ({self.args.slow_factor:g} x {limit[1]:.2f} s, the median time of "
+                                  f"the finished parts, and at least {self.args.slow_floor:g} s)"
+                                  + (f"; its last heartbeat was {silent:.0f} s ago" if silent >= 5 else ""))
+
+    def _alive(self, future: Any, holder: dict[str, str], gpus: set[str]) -> bool:
+        """Whether an attempt may still bring its part: finished, or held by a worker that is not
+        slow, or waiting for a worker that is still in the cluster."""
+        if future.status == "finished":
+            return True
+        if future.done():
+            return False
+        if future.key in holder:
+            return holder[future.key] not in self.slow
+        return future.key not in self.only_on or bool(gpus.intersection(self.only_on[future.key]))
+
+    def _speculate(self, held: dict[str, list[str]], gpus: set[str], workers: dict[str, Any], now: float) -> None:
+        """Submits again each part none of whose attempts may still bring it, to the GPU workers that
+        are not slow, and says why."""
+        holder = {key: address for address, keys in held.items() for key in keys}
+        others = sorted(gpus - self.slow.keys())
+        for part in self.parts:
+            if part.done or any(self._alive(f, holder, gpus) for f in part.attempts):
+                continue
+            key = next((f.key for f in reversed(part.attempts) if f.key in holder), None)
+            address = holder.get(key)
+            started = self.progress.started.get(key)
+            if address in self.slow:
+                why = (f"{part}, running on {self.slow[address]} for {now - started[1]:.1f} s"
+                       if started and started[0] == address else f"{part}, waiting on {self.slow[address]}")
+            else:
+                why = f"{part}, whose last attempt was for workers that have left"
+            if not others:
+                if part not in self.stuck:
+                    self.stuck.add(part)
+                    _log(self.args.quiet, f"slow: {why}: no other worker with a GPU can take it; waiting")
+                continue
+            _log(self.args.quiet, f"slow: {why}: rendering it again on {', '.join(_name(a, workers) for a in others)}")
+            self.stuck.discard(part)
+            self.submit(part, others)
+
+
+def _name(address: str, workers: dict[str, Any]) -> str:
+    return _worker_name(workers[address]["name"]) if address in workers else address
 
 
 # The exit code of each kind of error, in the command line's classes: 1 bad input (an output that
