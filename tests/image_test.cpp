@@ -1,14 +1,19 @@
-// Image encoding and files: the contract's sRGB rule, PFM layout, atomic writes.
+// Image encoding and files: the contract's sRGB rule, PFM layout, atomic writes (of one file, and of
+// files that change together).
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "base/atomic_file.h"
 #include "base/errors.h"
 #include "image/image.h"
 #include "image/image_file.h"
@@ -128,6 +133,38 @@ TEST_F(ImageFileTest, WriteReplacesAnExistingFile) {
   write_image(gradient(), dir_ / "r.pfm");
   EXPECT_EQ(read_pfm(dir_ / "r.pfm").width, 5u);
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_), {}), 1);
+}
+
+std::string text_of(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST_F(ImageFileTest, FilesCommittedTogetherAreAllReplacedOrNone) {
+  // An image and its record change together: when the second cannot be renamed into place (here a
+  // folder stands in its way), the first is put back as it was, or removed if it was not there.
+  std::ofstream(dir_ / "image") << "old image";
+  std::filesystem::create_directories(dir_ / "record" / "inside");
+  for (const char* first : {"image", "new-image"}) {
+    AtomicFile image(dir_ / first), record(dir_ / "record");
+    std::fputs("new image", image.get());
+    std::fputs("new record", record.get());
+    EXPECT_THROW(AtomicFile::commit_together({&image, &record}), OutputError) << first;
+  }
+  EXPECT_EQ(text_of(dir_ / "image"), "old image");
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "new-image"));
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"image", "record"}));  // no temporary file, no second name left
+  // When both can be, both are.
+  std::filesystem::remove_all(dir_ / "record");
+  AtomicFile image(dir_ / "image"), record(dir_ / "record");
+  std::fputs("new image", image.get());
+  std::fputs("new record", record.get());
+  AtomicFile::commit_together({&image, &record});
+  EXPECT_EQ(text_of(dir_ / "image"), "new image");
+  EXPECT_EQ(text_of(dir_ / "record"), "new record");
 }
 
 }  // namespace

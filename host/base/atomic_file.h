@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <initializer_list>
 #include <string_view>
 
 namespace vkray {
@@ -18,9 +19,19 @@ class AtomicFile {
   FILE* get() { return file_; }
   // Renames the file into place, unless an interrupt was requested (base/interrupt.h): then it is
   // removed. Throws OutputError when a write failed.
-  void commit();
+  void commit() { commit_together({this}); }
+
+  // Renames every file into place, or none: files that belong together (an image and its record).
+  // Every write is checked before the first rename, the renames happen under one interrupt check,
+  // and when a rename fails the files the earlier ones replaced are put back (kept meanwhile under
+  // a second name, a hard link). Throws OutputError naming the file whose write or rename failed,
+  // Cancelled.
+  static void commit_together(std::initializer_list<AtomicFile*> files);
 
  private:
+  // Closes the file and gives it its mode. Throws OutputError when a write failed.
+  void finish();
+
   std::filesystem::path target_, temp_;
   FILE* file_ = nullptr;
   bool committed_ = false;
