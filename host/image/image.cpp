@@ -13,6 +13,7 @@
 #include <iomanip>
 #include <limits>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 #include <system_error>
@@ -160,16 +161,19 @@ void write_png(const Image& image, const std::filesystem::path& file) {
 }
 
 void write_pfm(const Image& image, const std::filesystem::path& file) {
-  static_assert(std::endian::native == std::endian::little, "PFM writer assumes a little-endian host");
   AtomicFile out(file);
+  write_pfm(image, out);
+  out.commit();
+}
+
+void write_pfm(const Image& image, AtomicFile& out) {
+  static_assert(std::endian::native == std::endian::little, "PFM writer assumes a little-endian host");
   std::fprintf(out.get(), "PF\n%u %u\n-1.0\n", image.width, image.height);
   for (uint32_t row = image.height; row-- > 0;) {  // PFM stores the bottom row first
     throw_if_interrupted();
     std::fwrite(&image.at(0, row), sizeof(glm::vec3), image.width, out.get());
   }
-  out.commit();
 }
-
 
 uint8_t encode_srgb8_by_formula(float linear) {
   const float c = linear > 0.0f ? std::min(linear, 1.0f) : 0.0f;  // NaN encodes as 0
@@ -230,6 +234,23 @@ float decode_srgb8(uint8_t encoded) {
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
+LimitError out_of_host_memory(const std::filesystem::path& file, uint32_t width, uint32_t height) {
+  return LimitError(file.string() + ": out of host memory for its " + std::to_string(width) + " x " +
+                    std::to_string(height) + " pixels");
+}
+
+namespace {
+
+Image allocate_image(const std::filesystem::path& file, uint32_t width, uint32_t height) {
+  try {
+    return Image(width, height);
+  } catch (const std::bad_alloc&) {
+    throw out_of_host_memory(file, width, height);
+  }
+}
+
+}  // namespace
+
 Image read_pfm(const std::filesystem::path& file) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(file, error)) throw InputError(file.string() + ": not found, or not a regular file");
@@ -246,12 +267,18 @@ Image read_pfm(const std::filesystem::path& file) {
   // The header's size must be the file's, before anything that large is allocated.
   const uint64_t data_bytes = uint64_t(width) * height * sizeof(glm::vec3);
   const std::streamoff header_bytes = in.tellg();
-  if (width > 65536 || height > 65536 || header_bytes < 0 || file_bytes != uint64_t(header_bytes) + data_bytes)
-    throw InputError(file.string() + ": a PFM header of " + std::to_string(width) + " x " + std::to_string(height) +
-                     " pixels in a file of " + std::to_string(file_bytes) + " bytes");
-  Image image(width, height);
-  for (uint32_t row = height; row-- > 0;)
+  const std::string claim = file.string() + ": a PFM header of " + std::to_string(width) + " x " + std::to_string(height) +
+                            " pixels in a file of " + std::to_string(file_bytes) + " bytes";
+  if (width > kMaxImageSide || height > kMaxImageSide)
+    throw InputError(claim + " (vkray reads up to " + std::to_string(kMaxImageSide) + " pixels on a side)");
+  if (header_bytes < 0 || file_bytes != uint64_t(header_bytes) + data_bytes)
+    throw InputError(claim + " (" + std::to_string(uint64_t(header_bytes)) + " of header and " + std::to_string(data_bytes) +
+                     " of pixels)");
+  Image image = allocate_image(file, width, height);
+  for (uint32_t row = height; row-- > 0;) {
+    throw_if_interrupted();
     in.read(reinterpret_cast<char*>(&image.at(0, row)), std::streamsize(sizeof(glm::vec3) * width));
+  }
   if (!in) throw InputError(file.string() + ": truncated PFM data");
   return image;
 }
@@ -261,11 +288,23 @@ Image read_png(const std::filesystem::path& file) {
   png.version = PNG_IMAGE_VERSION;
   if (!png_image_begin_read_from_file(&png, file.string().c_str()))
     throw InputError(file.string() + ": " + png.message);
+  if (png.width > kMaxImageSide || png.height > kMaxImageSide) {
+    png_image_free(&png);
+    throw InputError(file.string() + ": a PNG of " + std::to_string(png.width) + " x " + std::to_string(png.height) +
+                     " pixels (vkray reads up to " + std::to_string(kMaxImageSide) + " on a side)");
+  }
   png.format = PNG_FORMAT_RGB;
-  std::vector<uint8_t> bytes(PNG_IMAGE_SIZE(png));
+  std::vector<uint8_t> bytes;
+  Image image;
+  try {
+    bytes.resize(PNG_IMAGE_SIZE(png));
+    image = Image(png.width, png.height);
+  } catch (const std::bad_alloc&) {
+    png_image_free(&png);
+    throw out_of_host_memory(file, png.width, png.height);
+  }
   if (!png_image_finish_read(&png, nullptr, bytes.data(), 0, nullptr))
     throw InputError(file.string() + ": " + png.message);
-  Image image(png.width, png.height);
   for (size_t i = 0; i < image.pixels.size(); ++i)
     image.pixels[i] = {decode_srgb8(bytes[i * 3]), decode_srgb8(bytes[i * 3 + 1]), decode_srgb8(bytes[i * 3 + 2])};
   return image;

@@ -10,6 +10,9 @@
 
 namespace vkray {
 
+class AtomicFile;
+struct LimitError;
+
 // The largest side of an image vkray renders or reads: far from overflow in any size arithmetic.
 constexpr uint32_t kMaxImageSide = 16384;
 
@@ -36,9 +39,18 @@ float decode_srgb8(uint8_t encoded);
 // leaves a partial image. Throw OutputError. write_image (image_file.h) picks one by extension.
 void write_png(const Image& image, const std::filesystem::path& file);
 void write_pfm(const Image& image, const std::filesystem::path& file);
+// The PFM's bytes into `out`, which the caller commits (with a file that must change with it).
+void write_pfm(const Image& image, AtomicFile& out);
 
-// Readers, for tests and tools. read_png returns decoded (linear) values. Throw InputError.
+// Readers of parts, tests and tools. read_png returns decoded (linear) values. A header's size is
+// checked against the file's (a PFM's exactly) and against kMaxImageSide before anything is
+// allocated for it. Throw InputError naming the file; LimitError ("out of host memory") when an
+// image the file does hold does not fit in memory.
 Image read_pfm(const std::filesystem::path& file);
 Image read_png(const std::filesystem::path& file);
+
+// What a reader throws when an allocation for pixels its file has been checked to hold fails: the
+// machine's limit ("FILE: out of host memory for its W x H pixels"), not a bug.
+LimitError out_of_host_memory(const std::filesystem::path& file, uint32_t width, uint32_t height);
 
 }  // namespace vkray
