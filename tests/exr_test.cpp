@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -131,6 +133,120 @@ TEST(ExrTest, AHeaderClaimingAHugeImageIsRefused) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("huge.exr"), std::string::npos) << e.what();
   }
+}
+
+// The bytes of a small EXR that write_exr wrote, for tests that change what its header claims.
+std::string small_exr_bytes(const TempDir& dir) {
+  const auto [image, aovs] = sample_render(8, 8);
+  write_exr(dir / "small.exr", image, nullptr, {});
+  std::ifstream in(dir / "small.exr", std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// `value` over the bytes of `bytes` at `at`.
+template <typename T>
+void put(std::string& bytes, size_t at, T value) {
+  ASSERT_LE(at + sizeof value, bytes.size());
+  std::memcpy(bytes.data() + at, &value, sizeof value);
+}
+
+// What read_exr says of `bytes`, written to `name` in `dir`: the message of the InputError it throws.
+std::string refusal(const TempDir& dir, const std::string& name, const std::string& bytes) {
+  std::ofstream(dir / name, std::ios::binary | std::ios::trunc) << bytes;
+  try {
+    read_exr(dir / name);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(ExrTest, AHeaderClaimingMorePixelsThanTheFileHoldsIsRefusedBeforeAnythingIsAllocated) {
+  // An 8 x 8 file whose data window says 16384 x 16384 (within vkray's limit on a side): its chunk
+  // offset table alone would be 8 KiB, its pixels gigabytes. Refused for what the file can hold.
+  TempDir dir;
+  std::string bytes = small_exr_bytes(dir);
+  const std::string attribute("dataWindow\0box2i\0", 17);
+  const size_t at = bytes.find(attribute) + attribute.size() + 4;
+  put(bytes, at + 8, int32_t(16383));
+  put(bytes, at + 12, int32_t(16383));
+  const std::string message = refusal(dir, "claims.exr", bytes);
+  EXPECT_NE(message.find("claims.exr: its header claims 16384 x 16384 pixels in 1024 blocks, which need at least"),
+            std::string::npos) << message;
+  EXPECT_NE(message.find("in a file of " + std::to_string(bytes.size()) + " bytes"), std::string::npos) << message;
+}
+
+TEST(ExrTest, AnAttributeOrPreviewClaimingMoreThanTheFileIsRefused) {
+  TempDir dir;
+  const std::string small = small_exr_bytes(dir);
+  // An attribute's size: the string "software" claims a gigabyte.
+  std::string bytes = small;
+  const std::string software("software\0string\0", 16);
+  const size_t at = bytes.find(software);
+  ASSERT_NE(at, std::string::npos);
+  put(bytes, at + software.size(), int32_t(1) << 30);
+  std::string message = refusal(dir, "attribute.exr", bytes);
+  EXPECT_NE(message.find("attribute.exr: its header attribute \"software\" claims 1073741824 bytes past byte"), std::string::npos)
+      << message;
+  // A preview image of 65535 x 65535 pixels in 8 bytes, in the place of "software" (as long:
+  // name, type, size, value), which OpenEXR would allocate 17 GB for before reading it.
+  bytes = small;
+  std::string preview("prev\0preview\0", 13);
+  preview.append(4 + 8, '\0');
+  put(preview, 13, int32_t(8));
+  put(preview, 17, uint32_t(65535));
+  put(preview, 21, uint32_t(65535));
+  ASSERT_EQ(preview.size(), software.size() + 4 + std::strlen("vkray"));
+  bytes.replace(at, preview.size(), preview);
+  message = refusal(dir, "preview.exr", bytes);
+  EXPECT_NE(message.find("preview.exr: its preview image claims 65535 x 65535 pixels in an attribute of 8 bytes"), std::string::npos)
+      << message;
+}
+
+TEST(ExrTest, AChunkOffsetOutsideTheFileOrASubsampledChannelIsRefused) {
+  TempDir dir;
+  const std::string small = small_exr_bytes(dir);
+  // The one chunk's offset: the first 8 bytes that hold their own position plus 8 (the table's end).
+  std::string bytes = small;
+  size_t table = 0;
+  for (size_t at = 0; at + 8 <= bytes.size() && !table; ++at) {
+    uint64_t value;
+    std::memcpy(&value, bytes.data() + at, sizeof value);
+    if (value == at + 8) table = at;
+  }
+  ASSERT_NE(table, 0u);
+  put(bytes, table, uint64_t(1) << 40);
+  std::string message = refusal(dir, "offset.exr", bytes);
+  EXPECT_NE(message.find("offset.exr: its chunk offset table points outside the file: block 0 at byte 1099511627776"),
+            std::string::npos) << message;
+  // Channel B (the channel list's first) sampled every second column.
+  bytes = small;
+  const std::string channels("channels\0chlist\0", 16);
+  const size_t list = bytes.find(channels) + channels.size() + 4;
+  ASSERT_EQ(bytes.substr(list, 2), std::string("B\0", 2));
+  put(bytes, list + 2 + 8, int32_t(2));
+  message = refusal(dir, "sampled.exr", bytes);
+  EXPECT_NE(message.find("sampled.exr: channel B is subsampled (2 x 1)"), std::string::npos) << message;
+}
+
+TEST(ExrTest, WhatIsReadIsHashedAsStored) {
+  // The hash read_exr gives is that of the values as the file holds them: the same for a file
+  // written again with the same pixels, another for one value changed by less than a half float's
+  // step in a 32-bit file.
+  TempDir dir;
+  auto [image, aovs] = sample_render(13, 7);
+  const ExrContent content{true, {Aov::depth, Aov::object}};
+  write_exr(dir / "a.exr", image, &aovs, content);
+  write_exr(dir / "b.exr", image, &aovs, content);
+  image.pixels[20].g = std::nextafter(image.pixels[20].g, 1.0f);
+  write_exr(dir / "c.exr", image, &aovs, content);
+  aovs.object[3] += 1;
+  write_exr(dir / "d.exr", image, &aovs, content);
+  const std::string a = read_exr(dir / "a.exr").pixels_hash;
+  EXPECT_EQ(a.size(), 32u);
+  EXPECT_EQ(read_exr(dir / "b.exr").pixels_hash, a);
+  EXPECT_NE(read_exr(dir / "c.exr").pixels_hash, a);
+  EXPECT_NE(read_exr(dir / "d.exr").pixels_hash, read_exr(dir / "c.exr").pixels_hash);
 }
 
 }  // namespace

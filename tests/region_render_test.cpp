@@ -177,5 +177,45 @@ TEST(RegionCliTest, BadRegionsAndMergesExitWithAMessageAndWriteNothing) {
   EXPECT_FALSE(std::filesystem::exists(dir / "m.pfm"));
 }
 
+TEST(RegionCliTest, APartRenderedAgainToAFullDiskLeavesTheOldPartAndItsRecord) {
+  // `ulimit -f 16` makes the disk "full" after 16 KiB: enough for a record, not for a part's
+  // pixels. The part and its record stay as they were, and they still merge.
+  TempDir dir;
+  const std::string scene = kScenes + "/cornell.json --renderer cpu --width 256 --height 256 -q";
+  for (const std::string type : {"pfm", "exr"}) {
+    SCOPED_TRACE(type);
+    const std::string part = "p0." + type, record = type == "pfm" ? "p0.pfm.json" : part;
+    ASSERT_EQ(vkray("render " + scene + " --region 0/2 -o " + part, dir.path()).exit_code, 0);
+    ASSERT_EQ(vkray("render " + scene + " --region 1/2 -o p1." + type, dir.path()).exit_code, 0);
+    const std::string pixels = file_bytes(dir / part), recorded = file_bytes(dir / record);
+    const CommandResult run = run_vkray("render " + scene + " --seed 5 --region 0/2 -o " + part, dir.path(), "ulimit -f 16");
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_NE(run.err.find(part + ": "), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find("write failed"), std::string::npos) << run.err;
+    EXPECT_EQ(file_bytes(dir / part), pixels);
+    EXPECT_EQ(file_bytes(dir / record), recorded);
+    for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
+      EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+    const CommandResult merge = vkray("merge m." + type + " " + part + " p1." + type, dir.path());
+    EXPECT_EQ(merge.exit_code, 0) << merge.err;
+  }
+}
+
+TEST(RegionCliTest, AMergeIntoOneOfItsPartsIsRefusedAndTheirFilesStay) {
+  TempDir dir;
+  const std::string scene = kScenes + "/cornell.json --renderer cpu --width 32 --height 32 -q";
+  ASSERT_EQ(vkray("render " + scene + " --region 0/2 -o p0.pfm", dir.path()).exit_code, 0);
+  ASSERT_EQ(vkray("render " + scene + " --region 1/2 -o p1.pfm", dir.path()).exit_code, 0);
+  const std::string pixels = file_bytes(dir / "p0.pfm"), record = file_bytes(dir / "p0.pfm.json");
+  for (const std::string output : {"p0.pfm", "./p0.pfm"}) {
+    const CommandResult run = vkray("merge " + output + " p0.pfm p1.pfm", dir.path());
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_NE(run.err.find("the merge would replace it; name another output"), std::string::npos) << run.err;
+  }
+  EXPECT_EQ(file_bytes(dir / "p0.pfm"), pixels);
+  EXPECT_EQ(file_bytes(dir / "p0.pfm.json"), record);
+  EXPECT_EQ(vkray("merge m.pfm p0.pfm p1.pfm", dir.path()).exit_code, 0);
+}
+
 }  // namespace
 }  // namespace vkray::test

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -173,10 +174,17 @@ struct Rendered {
   RenderResult whole;
 };
 
-// The sky scene on the CPU, whole and as parts cut by `regions`, each written to `dir` as `suffix`.
+// What a part of the sky scene records, unless a test says otherwise.
+PartRecord sky_record(const Scene& scene, const PixelRegion& region, const std::string& shader = "") {
+  return {scene_digest(scene), 48, 64, region, 2, 0, "test", "CPU reference", shader, "", ""};
+}
+
+// The sky scene on the CPU, whole and as parts cut by `regions`, each written to `dir` as `suffix`
+// with the record `edit` makes of sky_record's.
 std::vector<std::filesystem::path> write_parts(const Rendered& r, const std::vector<PixelRegion>& regions,
                                                const std::filesystem::path& dir, const std::string& suffix,
-                                               const ExrContent& content = {}, const std::string& shader = "") {
+                                               const ExrContent& content = {}, const std::string& shader = "",
+                                               const std::function<void(PartRecord&)>& edit = {}) {
   std::vector<std::filesystem::path> files;
   for (size_t i = 0; i < regions.size(); ++i) {
     RenderOptions options;
@@ -184,7 +192,8 @@ std::vector<std::filesystem::path> write_parts(const Rendered& r, const std::vec
     options.aovs = !content.passes.empty();
     options.region = regions[i];
     const RenderResult part = render_on_cpu(r.scene, options);
-    PartRecord record{scene_digest(r.scene), 48, 64, regions[i], 2, 0, "test", "CPU reference", shader, ""};
+    PartRecord record = sky_record(r.scene, regions[i], shader);
+    if (edit) edit(record);
     files.push_back(dir / ("part" + std::to_string(i) + suffix));
     write_part(files.back(), part.image, part.aovs ? &*part.aovs : nullptr, content, record);
   }
@@ -257,24 +266,121 @@ TEST(MergeTest, RefusesOverlapsAndGapsNamingThePixels) {
 TEST(MergeTest, RefusesPartsOfAnotherRenderNamingWhatDiffers) {
   TempDir dir;
   const Rendered r = rendered();
-  const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm", {}, "spirv1");
-  // Each field of the second part's record changed in turn.
-  const std::string record = file_bytes(sidecar_of(files[1]));
-  for (const auto& [from, to, says] : std::vector<std::tuple<std::string, std::string, std::string>>{
-           {scene_digest(r.scene), std::string(32, 'f'), "of another scene"},
-           {"\"width\":48", "\"width\":49", "of an image of 49 x 64, not 48 x 64"},
-           {"\"spp\":2", "\"spp\":3", "samples per pixel 3, not 2"},
-           {"\"seed\":0", "\"seed\":7", "seed 7, not 0"},
-           {"\"vkray_version\":\"test\"", "\"vkray_version\":\"other\"", "rendered by vkray other, not test"},
-           {"\"shader\":\"spirv1\"", "\"shader\":\"spirv2\"", "traced by other shaders: SPIR-V spirv2, not spirv1"}}) {
-    std::string edited = record;
-    edited.replace(edited.find(from), from.size(), to);
-    std::ofstream(sidecar_of(files[1]), std::ios::trunc) << edited;
-    const std::string message = error_of([&] { merge_part_files(dir / "m.pfm", files); });
+  const std::vector<PixelRegion> halves{{0, 0, 48, 32}, {0, 32, 48, 64}};
+  const auto files = write_parts(r, halves, dir.path(), ".pfm", {}, "spirv1");
+  // The second half written by a render that differs in each field in turn, with a record of its own.
+  for (const auto& [edit, says] : std::vector<std::pair<std::function<void(PartRecord&)>, std::string>>{
+           {[](PartRecord& p) { p.scene_digest = std::string(32, 'f'); }, "of another scene"},
+           {[](PartRecord& p) { p.width = 49; }, "of an image of 49 x 64, not 48 x 64"},
+           {[](PartRecord& p) { p.samples_per_pixel = 3; }, "samples per pixel 3, not 2"},
+           {[](PartRecord& p) { p.seed = 7; }, "seed 7, not 0"},
+           {[](PartRecord& p) { p.version = "other"; }, "rendered by vkray other, not test"},
+           {[](PartRecord& p) { p.shader = "spirv2"; }, "traced by other shaders: SPIR-V spirv2, not spirv1"}}) {
+    std::filesystem::create_directories(dir / "other");
+    const auto other = write_parts(r, halves, dir / "other", ".pfm", {}, "spirv1", edit);
+    const std::string message = error_of([&] { merge_part_files(dir / "m.pfm", {files[0], other[1]}); });
     EXPECT_NE(message.find("part1.pfm"), std::string::npos) << message;
     EXPECT_NE(message.find(says), std::string::npos) << message;
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "m.pfm"));
+}
+
+// Text `from` replaced by `to` in `file` (in an EXR, text of the same length: its header stays well-formed).
+void edit_file(const std::filesystem::path& file, const std::string& from, const std::string& to) {
+  if (is_exr(file)) ASSERT_EQ(from.size(), to.size());
+  std::string bytes = file_bytes(file);
+  const size_t at = bytes.find(from);
+  ASSERT_NE(at, std::string::npos) << from << " in " << file;
+  bytes.replace(at, from.size(), to);
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+TEST(MergeTest, ARecordEditedInAnyFieldIsRefusedNamingIt) {
+  // Whatever field of a record is changed after vkray wrote it, in a PFM's sidecar or an EXR's
+  // header, the record is refused: its hash covers every field, not only the pixels.
+  TempDir dir;
+  const Rendered r = rendered();
+  for (const std::string type : {".pfm", ".exr"}) {
+    SCOPED_TRACE(type);
+    for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+             {scene_digest(r.scene), std::string(32, 'f')},
+             {"\"width\":48", "\"width\":49"},
+             {"\"region\":[0,32,48,64]", "\"region\":[0,32,48,63]"},
+             {"\"spp\":2", "\"spp\":3"},
+             {"\"seed\":0", "\"seed\":7"},
+             {"\"vkray_version\":\"test\"", "\"vkray_version\":\"tess\""},
+             {"\"device\":\"CPU reference\"", "\"device\":\"CPU REFERENCE\""},
+             {"\"shader\":\"spirv1\"", "\"shader\":\"spirv2\""},
+             {"\"pixels\":\"", ""},
+             {"\"hash\":\"", ""}}) {
+      SCOPED_TRACE(from);
+      const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), type, {}, "spirv1");
+      const std::filesystem::path record = type == ".pfm" ? sidecar_of(files[1]) : files[1];
+      if (!to.empty()) {
+        edit_file(record, from, to);
+      } else {  // a hash: its first digit changed
+        const std::string text = file_bytes(record);
+        const std::string digits = text.substr(text.find(from) + from.size(), 32);
+        edit_file(record, from + digits, from + (digits[0] == '0' ? '1' : '0') + digits.substr(1));
+      }
+      const std::string message = error_of([&] { merge_part_files(dir / ("m" + type), files); });
+      EXPECT_NE(message.find((type == ".pfm" ? "part1.pfm.json" : "part1.exr") + std::string(": the part's record is not as vkray")),
+                std::string::npos) << message;
+      EXPECT_NE(message.find("its fields do not match its \"hash\""), std::string::npos) << message;
+      EXPECT_FALSE(std::filesystem::exists(dir / ("m" + type)));
+    }
+  }
+}
+
+TEST(MergeTest, PfmRecordsWithTheirRegionsSwappedAreRefused) {
+  // Two parts of one size whose records trade their regions would merge into the two halves
+  // swapped; records that trade places, each beside the other's pixels, likewise.
+  TempDir dir;
+  const Rendered r = rendered();
+  const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm");
+  edit_file(sidecar_of(files[0]), "\"region\":[0,0,48,32]", "\"region\":[0,32,48,64]");
+  edit_file(sidecar_of(files[1]), "\"region\":[0,32,48,64]", "\"region\":[0,0,48,32]");
+  EXPECT_NE(error_of([&] { merge_part_files(dir / "m.pfm", files); }).find("its fields do not match"), std::string::npos);
+  write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm");
+  std::filesystem::rename(sidecar_of(files[0]), dir / "record0");
+  std::filesystem::rename(sidecar_of(files[1]), sidecar_of(files[0]));
+  std::filesystem::rename(dir / "record0", sidecar_of(files[1]));
+  const std::string message = error_of([&] { merge_part_files(dir / "m.pfm", files); });
+  EXPECT_NE(message.find("part0.pfm: its pixels are not the ones its record part0.pfm.json was written with"), std::string::npos)
+      << message;
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.pfm"));
+}
+
+TEST(MergeTest, TheOutputIsNeverOneOfThePartsOrTheirRecords) {
+  // However the output is spelled or linked, a merge that would replace a part (or a PFM part's
+  // record) writes nothing, and the parts still merge.
+  TempDir dir;
+  const Rendered r = rendered();
+  const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm");
+  std::filesystem::create_directory(dir / "sub");
+  std::filesystem::create_symlink(files[0], dir / "link.pfm");
+  std::filesystem::create_symlink(sidecar_of(files[1]), dir / "record-link.pfm");
+  std::filesystem::create_hard_link(files[1], dir / "hard.pfm");
+  std::filesystem::create_directory_symlink(dir.path(), dir / "same-folder");
+  const std::string part0 = file_bytes(files[0]), record0 = file_bytes(sidecar_of(files[0]));
+  for (const std::filesystem::path& output : {files[0], dir / "sub" / ".." / "part0.pfm", dir / "." / "part1.pfm",
+                                              dir / "link.pfm", dir / "record-link.pfm", dir / "hard.pfm",
+                                              dir / "same-folder" / "part0.pfm"}) {
+    SCOPED_TRACE(output);
+    try {
+      merge_part_files(output, files);
+      ADD_FAILURE() << "merged into a part";
+    } catch (const OutputError& e) {
+      EXPECT_NE(std::string(e.what()).find("the merge would replace it; name another output"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(file_bytes(files[0]), part0);
+  EXPECT_EQ(file_bytes(sidecar_of(files[0])), record0);
+  // A part given twice, however spelled, is named as such rather than as an overlap.
+  EXPECT_NE(error_of([&] { merge_part_files(dir / "m.pfm", {files[0], files[1], dir / "sub" / ".." / "part1.pfm"}); })
+                .find("part1.pfm: is given twice (also as "),
+            std::string::npos);
+  EXPECT_EQ(merge_part_files(dir / "m.pfm", files).parts, 2u);
 }
 
 TEST(MergeTest, ACpuReferencePartJoinsGpuPartsWithAWarning) {
@@ -284,10 +390,8 @@ TEST(MergeTest, ACpuReferencePartJoinsGpuPartsWithAWarning) {
   const Rendered r = rendered();
   auto files = write_parts(r, {{0, 0, 48, 32}}, dir.path(), ".pfm", {}, "");
   std::filesystem::create_directory(dir / "gpu");
-  const auto gpu = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir / "gpu", ".pfm", {}, "spirv1");
-  std::string record = file_bytes(sidecar_of(gpu[1]));
-  record.replace(record.find("CPU reference"), std::strlen("CPU reference"), "a GPU (driver 1)");
-  std::ofstream(sidecar_of(gpu[1]), std::ios::trunc) << record;
+  const auto gpu = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir / "gpu", ".pfm", {}, "spirv1",
+                               [](PartRecord& p) { p.device = "a GPU (driver 1)"; });
   files.push_back(gpu[1]);
   EXPECT_TRUE(merge_part_files(dir / "m.pfm", files).mixed_devices);
   // The CPU part first does not let GPU parts of two shaders through.
@@ -297,19 +401,27 @@ TEST(MergeTest, ACpuReferencePartJoinsGpuPartsWithAWarning) {
   EXPECT_NE(message.find("part1.pfm: was traced by other shaders: SPIR-V spirv2, not spirv1"), std::string::npos) << message;
 }
 
-TEST(MergeTest, APfmWrittenAgainAfterItsRecordIsRefused) {
-  // The sidecar holds the hash of the pixels it was written with: another render's pixels under the
-  // same name (a rerun that failed half-way, a copy from elsewhere) do not pass for the part.
+TEST(MergeTest, APartWrittenAgainAfterItsRecordIsRefused) {
+  // A record holds the hash of the pixels it was written with: another render's pixels under the
+  // same name (a rerun that failed half-way, a copy from elsewhere) do not pass for the part,
+  // beside a PFM's sidecar or under an EXR's header attribute (its data window still the region).
   TempDir dir;
   const Rendered r = rendered();
-  const auto files = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm");
+  const auto pfm = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".pfm");
+  const auto exr = write_parts(r, {{0, 0, 48, 32}, {0, 32, 48, 64}}, dir.path(), ".exr");
   Image other(48, 32);
   other.at(5, 5) = glm::vec3(1.0f);
-  write_image(other, files[0]);
-  const std::string message = error_of([&] { merge_part_files(dir / "m.pfm", files); });
-  EXPECT_NE(message.find("part0.pfm: its pixels are not the ones its record part0.pfm.json was written with"),
-            std::string::npos) << message;
-  EXPECT_FALSE(std::filesystem::exists(dir / "m.pfm"));
+  write_image(other, pfm[0]);
+  const ExrPartHeader header{48, 64, {0, 0, 48, 32}, [record = read_exr(exr[0]).window.part_record](const std::string&) { return record; }};
+  write_exr(exr[0], other, nullptr, {}, &header);
+  for (const auto& [files, says] : std::vector<std::pair<std::vector<std::filesystem::path>, std::string>>{
+           {pfm, "part0.pfm: its pixels are not the ones its record part0.pfm.json was written with"},
+           {exr, "part0.exr: its pixels are not the ones its record (attribute \"vkray.part\") was written with"}}) {
+    const std::filesystem::path output = dir / ("m" + files[0].extension().string());
+    const std::string message = error_of([&] { merge_part_files(output, files); });
+    EXPECT_NE(message.find(says), std::string::npos) << message;
+    EXPECT_FALSE(std::filesystem::exists(output));
+  }
 }
 
 TEST(MergeTest, RefusesFilesThatAreNotPartsNamingThem) {
@@ -335,9 +447,23 @@ TEST(MergeTest, RefusesFilesThatAreNotPartsNamingThem) {
       << R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,48,64], "spp": 1, "seed": 0, "vkray_version": "0.0.9", "device": "d"})";
   EXPECT_NE(error_of([&] { read_part(files[0]); }).find("has no \"shader\" (it was written by vkray 0.0.9: render the part again"),
             std::string::npos);
-  // A record whose region is not the picture's size.
+  // A record of the build before records had a hash of their own.
   std::ofstream(sidecar_of(files[0]), std::ios::trunc)
-      << R"({"scene_digest": "x", "width": 48, "height": 64, "region": [0,0,48,32], "spp": 1, "seed": 0, "vkray_version": "v", "device": "d", "shader": "", "pixels": "x"})";
+      << R"x({"scene_digest":"ee7d9f1b0876cc1b8749e8d83c87dd95","width":48,"height":64,"region":[0,0,48,64],"spp":1,"seed":0,"vkray_version":"0.1.0 (commit 56ace8ef142e)","device":"CPU reference","shader":"","pixels":"d05a5917148f434b606ddf4277b6f93d"})x";
+  EXPECT_NE(error_of([&] { read_part(files[0]); })
+                .find("has no \"hash\" (it was written by vkray 0.1.0 (commit 56ace8ef142e): render the part again with this build)"),
+            std::string::npos);
+  // A key no build records: the hash does not cover it.
+  PartRecord record{"x", 48, 64, {0, 0, 48, 64}, 1, 0, "v", "d", "", "x", ""};
+  record.hash = part_record_hash(record);
+  std::string json = part_record_json(record);
+  json.insert(1, R"("note": "mine", )");
+  std::ofstream(sidecar_of(files[0]), std::ios::trunc) << json;
+  EXPECT_NE(error_of([&] { read_part(files[0]); }).find("has a key \"note\" that this build does not record"), std::string::npos);
+  // A record, whole, whose region is not the picture's size.
+  record.region = {0, 0, 48, 32};
+  record.hash = part_record_hash(record);
+  std::ofstream(sidecar_of(files[0]), std::ios::trunc) << part_record_json(record);
   EXPECT_NE(error_of([&] { read_part(files[0]); }).find("48 x 64 pixels, but its record names region 0,0,48,32"),
             std::string::npos);
   EXPECT_NE(error_of([] { merge_parts({}); }).find("no parts"), std::string::npos);

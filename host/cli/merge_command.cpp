@@ -10,7 +10,6 @@
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "cli/report.h"
-#include "image/image_file.h"
 #include "image/merge.h"
 
 namespace vkray::cli {
@@ -24,7 +23,6 @@ struct MergeArgs {
 
 int run_merge(const MergeArgs& args) {
   const auto start = Clock::now();
-  check_output_image(args.output);
   const MergeSummary summary = merge_part_files(args.output, args.parts);
   if (summary.passes_dropped)
     std::cerr << "vkray: warning: the parts' first-hit passes are not in " << args.output.string()

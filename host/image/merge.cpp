@@ -1,8 +1,13 @@
 #include "image/merge.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <map>
+#include <optional>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "base/errors.h"
 #include "image/image_file.h"
@@ -95,6 +100,37 @@ void check_tiling(const std::vector<Part>& parts, uint32_t width, uint32_t heigh
   }
 }
 
+// A file as the system knows it, whatever path names it: another spelling, a symbolic link (followed)
+// or a hard link names the same file. None when nothing is there.
+using FileId = std::pair<dev_t, ino_t>;
+std::optional<FileId> file_id(const std::filesystem::path& file) {
+  struct stat info {};
+  if (::stat(file.c_str(), &info) != 0) return std::nullopt;
+  return FileId{info.st_dev, info.st_ino};
+}
+
+// Refuses an output that is one of the parts or a PFM part's record (the merge would replace what it
+// reads, and a part would be lost), and a part given twice.
+void check_files(const std::filesystem::path& output, const std::vector<std::filesystem::path>& parts) {
+  std::map<FileId, std::filesystem::path> inputs;  // each part and PFM record, by what it is
+  for (const auto& part : parts) {
+    const std::optional<FileId> id = file_id(part);
+    if (!id) continue;  // read_part says what is wrong with it
+    const auto [at, added] = inputs.emplace(*id, part);
+    if (!added) throw InputError(part.string() + ": is given twice (also as " + at->second.string() + ")");
+    if (!is_pfm(part)) continue;
+    const std::filesystem::path record = sidecar_of(part);
+    if (const std::optional<FileId> record_id = file_id(record)) inputs.emplace(*record_id, record);
+  }
+  const std::optional<FileId> out = file_id(output);
+  if (!out) return;
+  const auto input = inputs.find(*out);
+  if (input != inputs.end())
+    throw OutputError(output.string() + ": is " + (input->second == output ? std::string("a part being merged")
+                                                                           : input->second.string() + ", which is being merged") +
+                      " (the same file): the merge would replace it; name another output");
+}
+
 }  // namespace
 
 MergedImage merge_parts(const std::vector<Part>& parts) {
@@ -129,7 +165,8 @@ MergedImage merge_parts(const std::vector<Part>& parts) {
 }
 
 MergeSummary merge_part_files(const std::filesystem::path& output, const std::vector<std::filesystem::path>& files) {
-  if (!is_supported_image_path(output)) throw OutputError(output.string() + ": unknown image type (expected .png, .pfm or .exr)");
+  check_output_image(output);
+  check_files(output, files);
   std::vector<Part> parts;
   parts.reserve(files.size());
   for (const auto& file : files) parts.push_back(read_part(file));

@@ -38,7 +38,9 @@ struct MergeSummary {
 
 // What `vkray merge` does: reads the part files (read_part), merges them and writes the whole image
 // to `output` (.png, .pfm or .exr, with the parts' passes and precision), which is written only when
-// all of this succeeded. Throws InputError, OutputError.
+// all of this succeeded. Throws OutputError for an output check_output_image refuses or that is one
+// of the parts or their records (compared as files: another spelling or a link of one is one),
+// InputError (a part given twice, and as merge_parts and read_part), LimitError.
 MergeSummary merge_part_files(const std::filesystem::path& output, const std::vector<std::filesystem::path>& parts);
 
 }  // namespace vkray

@@ -1,5 +1,8 @@
 #include "image/part.h"
 
+#include <algorithm>
+#include <memory>
+
 #include <nlohmann/json.hpp>
 
 #include "base/atomic_file.h"
@@ -14,16 +17,28 @@ namespace {
 // A record is a few hundred bytes; anything much larger is not one.
 constexpr uint64_t kMaxRecordBytes = 64 << 10;
 
-const char* const kRecordKeys[] = {"scene_digest", "width", "height", "region", "spp", "seed", "vkray_version", "device", "shader"};
+// Every key of a record, in the order written. A record of an older build lacks the later ones.
+const char* const kRecordKeys[] = {"scene_digest", "width", "height", "region", "spp", "seed", "vkray_version", "device",
+                                   "shader", "pixels", "hash"};
 
-std::string pixels_hash(const Image& image) {
+std::string pfm_pixels_hash(const Image& image) {
   return hash_hex(image.pixels.data(), image.pixels.size() * sizeof(glm::vec3));
 }
 
 }  // namespace
 
+std::string part_record_hash(const PartRecord& r) {
+  const auto hasher = std::make_unique<Hasher>();
+  hasher->add(std::string("vkray part record"));  // not the hash of anything else with these fields
+  hasher->add(r.scene_digest);
+  for (const uint32_t number : {r.width, r.height, r.region.x0, r.region.y0, r.region.x1, r.region.y1, r.samples_per_pixel, r.seed})
+    hasher->add(number);
+  for (const std::string* text : {&r.version, &r.device, &r.shader, &r.pixels}) hasher->add(*text);
+  return hasher->hex();
+}
+
 std::string part_record_json(const PartRecord& r) {
-  nlohmann::ordered_json json = {
+  const nlohmann::ordered_json json = {
       {"scene_digest", r.scene_digest},
       {"width", r.width},
       {"height", r.height},
@@ -33,8 +48,9 @@ std::string part_record_json(const PartRecord& r) {
       {"vkray_version", r.version},
       {"device", r.device},
       {"shader", r.shader},
+      {"pixels", r.pixels},
+      {"hash", r.hash},
   };
-  if (!r.pixels.empty()) json["pixels"] = r.pixels;
   return json.dump();
 }
 
@@ -42,13 +58,17 @@ PartRecord parse_part_record(const std::string& text, const std::filesystem::pat
   const std::string where = file.string() + ": the part's record";
   const nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (json.is_discarded() || !json.is_object()) throw InputError(where + " is not a JSON object");
-  // A part of an older build lacks what later builds record: say so, rather than only what is missing.
-  const std::string older = json.contains("vkray_version") && json["vkray_version"].is_string()
-                                ? " (it was written by vkray " + json["vkray_version"].get<std::string>() +
-                                      ": render the part again with this build)"
-                                : "";
+  // A part of another build records other things: say so, rather than only what is missing.
+  const std::string version = json.contains("vkray_version") && json["vkray_version"].is_string()
+                                  ? json["vkray_version"].get<std::string>()
+                                  : "";
+  const std::string other_build =
+      version.empty() ? "" : " (it was written by vkray " + printable(version) + ": render the part again with this build)";
   for (const char* key : kRecordKeys)
-    if (!json.contains(key)) throw InputError(where + " has no \"" + key + "\"" + older);
+    if (!json.contains(key)) throw InputError(where + " has no \"" + key + "\"" + other_build);
+  for (const auto& [key, value] : json.items())
+    if (std::find(std::begin(kRecordKeys), std::end(kRecordKeys), key) == std::end(kRecordKeys))
+      throw InputError(where + " has a key \"" + printable(key) + "\" that this build does not record" + other_build);
   const auto text_of = [&](const char* key) {
     if (!json[key].is_string()) throw InputError(where + ": \"" + key + "\" is not a string");
     return json[key].get<std::string>();
@@ -71,12 +91,16 @@ PartRecord parse_part_record(const std::string& text, const std::filesystem::pat
   r.version = text_of("vkray_version");
   r.device = text_of("device");
   r.shader = text_of("shader");
-  if (json.contains("pixels")) r.pixels = text_of("pixels");
+  r.pixels = text_of("pixels");
+  r.hash = text_of("hash");
   if (r.width == 0 || r.height == 0 || r.width > kMaxImageSide || r.height > kMaxImageSide)
     throw InputError(where + ": an image of " + std::to_string(r.width) + " x " + std::to_string(r.height) + " pixels");
   if (!r.region.within(r.width, r.height))
     throw InputError(where + ": region " + to_string(r.region) + " does not lie within the " + std::to_string(r.width) +
                      " x " + std::to_string(r.height) + " image");
+  if (part_record_hash(r) != r.hash)
+    throw InputError(where + " is not as vkray " + printable(r.version) + " wrote it: its fields do not match its \"hash\" "
+                     "(a field was changed; render the part again)");
   return r;
 }
 
@@ -88,25 +112,45 @@ std::filesystem::path sidecar_of(const std::filesystem::path& pfm) {
 
 void write_part(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content,
                 const PartRecord& record) {
+  if (image.width != record.region.width() || image.height != record.region.height())
+    throw InternalError(file.string() + ": a part's pixels do not fit its region");
+  const auto sealed = [&](const std::string& pixels_hash) {
+    PartRecord r = record;
+    r.pixels = pixels_hash;
+    r.hash = part_record_hash(r);
+    return part_record_json(r);
+  };
   if (is_exr(file)) {
-    const ExrWindow window{record.width, record.height, record.region, part_record_json(record)};
-    return write_exr(file, image, aovs, content, &window);
+    const ExrPartHeader part{record.width, record.height, record.region, sealed};
+    return write_exr(file, image, aovs, content, &part);
   }
   if (!is_pfm(file))
     throw UsageError(file.string() + ": a part of a render is an .exr or a .pfm file, so that `vkray merge` can assemble it");
   check_render_image(file, content);
-  PartRecord pfm_record = record;
-  pfm_record.pixels = pixels_hash(image);
-  const std::filesystem::path sidecar = sidecar_of(file);
-  write_file_atomically(sidecar, part_record_json(pfm_record) + "\n");
-  try {
-    write_image(image, file);
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(sidecar, ignored);
-    throw;
-  }
+  // Both written in full, then both renamed: the old pair stays whole until the new one is.
+  AtomicFile pixels(file), sidecar(sidecar_of(file));
+  write_pfm(image, pixels);
+  const std::string json = sealed(pfm_pixels_hash(image)) + "\n";
+  std::fwrite(json.data(), 1, json.size(), sidecar.get());
+  AtomicFile::commit_together({&pixels, &sidecar});
 }
+
+namespace {
+
+// The checks every part passes, whatever its file type: its pixels are of its region's size and are
+// those its record (named `record_name`) was written with.
+void check_pixels(const Part& part, const std::string& pixels_hash, const std::string& record_name) {
+  const PixelRegion& region = part.record.region;
+  if (part.image.width != region.width() || part.image.height != region.height())
+    throw InputError(part.file.string() + ": " + std::to_string(part.image.width) + " x " + std::to_string(part.image.height) +
+                     " pixels, but its record names region " + to_string(region));
+  if (pixels_hash != part.record.pixels)
+    throw InputError(part.file.string() + ": its pixels are not the ones its record " + record_name +
+                     " was written with (the image was written again or changed after the record, or the record is another "
+                     "part's)");
+}
+
+}  // namespace
 
 Part read_part(const std::filesystem::path& file) {
   Part part;
@@ -129,6 +173,7 @@ Part read_part(const std::filesystem::path& file) {
     part.image = std::move(exr.image);
     if (!exr.content.passes.empty()) part.aovs = std::move(exr.aovs);
     part.content = exr.content;
+    check_pixels(part, exr.pixels_hash, "(attribute \"vkray.part\")");
     return part;
   }
   if (!is_pfm(file))
@@ -138,16 +183,8 @@ Part read_part(const std::filesystem::path& file) {
   if (!record.error.empty())
     throw InputError(sidecar.string() + ": " + record.error + " (a PFM part's record, which `vkray render --region` writes beside it)");
   part.record = parse_part_record(record.text, sidecar);
-  if (part.record.pixels.empty())
-    throw InputError(sidecar.string() + ": the part's record has no \"pixels\", which a PFM part's record has (it was "
-                     "written by vkray " + part.record.version + ": render the part again with this build)");
   part.image = read_pfm(file);
-  if (part.image.width != part.record.region.width() || part.image.height != part.record.region.height())
-    throw InputError(file.string() + ": " + std::to_string(part.image.width) + " x " + std::to_string(part.image.height) +
-                     " pixels, but its record names region " + to_string(part.record.region));
-  if (pixels_hash(part.image) != part.record.pixels)
-    throw InputError(file.string() + ": its pixels are not the ones its record " + sidecar.filename().string() +
-                     " was written with (the image was written again, or changed, after the record)");
+  check_pixels(part, pfm_pixels_hash(part.image), sidecar.filename().string());
   return part;
 }
 

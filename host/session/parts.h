@@ -29,7 +29,8 @@ void check_render_output(const std::filesystem::path& file, const ExrContent& co
 PartRecord part_record(const Scene& scene, const RenderResult& result, const std::string& device);
 
 // Writes `result` to `file` (.png, .pfm or .exr; `content`: the passes and precision of an .exr); a
-// region of the image as a part (write_part: .exr or .pfm, else UsageError). Throws OutputError.
+// region of the image as a part (write_part: .exr or .pfm, else UsageError; a part and its record
+// replace an earlier pair together or not at all). Throws OutputError, LimitError.
 void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const ExrContent& content,
                   const std::string& device);
 

@@ -1,5 +1,10 @@
 """EXR files from `vkray render` read by tools that are not vkray: OpenImageIO (the pixels) and
-OpenEXR's own exrheader (the channel list and types)."""
+OpenEXR's own exrheader (the channel list and types); and EXR files that vkray reads (a merge's
+parts) whose header claims more than the file or the machine can hold."""
+
+import resource
+import struct
+import zlib
 
 import numpy as np
 import OpenImageIO as oiio
@@ -82,3 +87,64 @@ def test_passes_need_an_exr_file_and_nothing_is_written_otherwise(scenes, vkray_
                  check=False)
     assert result.returncode == 2 and "colour" in result.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+# ---- files that claim more than they hold ----------------------------------------------------------
+
+def write_zip_exr(path, width, height):
+    """A half-float RGB EXR of `width` x `height` pixels, ZIP-compressed, written by hand as the OpenEXR
+    file layout describes it: every block of 16 scan lines holds the same compressed zeros, so a large
+    image is a small file."""
+    def attribute(name, kind, value):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
+
+    box = struct.pack("<4i", 0, 0, width - 1, height - 1)
+    channels = b"".join(name + b"\0" + struct.pack("<iB3xii", 1, 0, 1, 1) for name in (b"B", b"G", b"R")) + b"\0"
+    header = (struct.pack("<ii", 20000630, 2) + attribute("channels", "chlist", channels)
+              + attribute("compression", "compression", b"\3") + attribute("dataWindow", "box2i", box)
+              + attribute("displayWindow", "box2i", box) + attribute("lineOrder", "lineOrder", b"\0")
+              + attribute("pixelAspectRatio", "float", struct.pack("<f", 1)) + attribute("screenWindowCenter", "v2f", bytes(8))
+              + attribute("screenWindowWidth", "float", struct.pack("<f", 1)) + b"\0")
+    blocks = (height + 15) // 16
+    # Zeros as OpenEXR's ZIP stores them: after its predictor, a first byte of 0 and then 128s.
+    data = zlib.compress(b"\0" + b"\x80" * (16 * width * 3 * 2 - 1))
+    table_end = len(header) + 8 * blocks
+    chunk = 8 + len(data)
+    with open(path, "wb") as out:
+        out.write(header)
+        out.write(b"".join(struct.pack("<Q", table_end + b * chunk) for b in range(blocks)))
+        for b in range(blocks):
+            out.write(struct.pack("<ii", 16 * b, len(data)) + data)
+
+
+def merge_in_2_gib(vkray_command, tmp_path, part):
+    """`vkray merge` of one EXR under a 2 GiB address space: too little for a 16384 x 16384 image."""
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+    return run(vkray_command, "merge", str(tmp_path / "out.exr"), str(part), check=False, preexec_fn=limit)
+
+
+def test_a_small_file_claiming_a_huge_image_is_refused_for_its_claim(vkray_command, tmp_path):
+    # 9 KiB of a file whose header says 16384 x 16384 pixels: refused for what the header claims
+    # against what the file holds, before gigabytes are allocated for it (never a bare bad_alloc).
+    whole = tmp_path / "whole.exr"
+    write_zip_exr(whole, 16384, 16384)
+    part = tmp_path / "claims.exr"
+    part.write_bytes(whole.read_bytes()[:9 * 1024])
+    result = merge_in_2_gib(vkray_command, tmp_path, part)
+    assert result.returncode == 1, result.stderr
+    assert "claims.exr: its header claims 16384 x 16384 pixels in 1024 blocks" in result.stderr, result.stderr
+    assert "bad_alloc" not in result.stderr
+    assert not (tmp_path / "out.exr").exists()
+
+
+def test_an_image_too_large_for_memory_is_out_of_host_memory(vkray_command, tmp_path):
+    # A well-formed file of 16384 x 16384 pixels (1.6 MB, compressed) that this process may not hold
+    # in memory: bad input too large for this machine, exit 1, said so.
+    part = tmp_path / "large.exr"
+    write_zip_exr(part, 16384, 16384)
+    result = merge_in_2_gib(vkray_command, tmp_path, part)
+    assert result.returncode == 1, result.stderr
+    assert "large.exr: out of host memory for its 16384 x 16384 pixels" in result.stderr, result.stderr
+    assert "bad_alloc" not in result.stderr
+    assert not (tmp_path / "out.exr").exists()
