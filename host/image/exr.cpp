@@ -292,7 +292,7 @@ HeaderLayout walk_header(std::istream& in, const std::filesystem::path& file, ui
     int32_t size = 0;
     if (!in.read(reinterpret_cast<char*>(&size), sizeof size)) refuse(file, "its header ends with the file");
     at += sizeof size;
-    if (size < 0 || uint64_t(size) > file_bytes - at)
+    if (size < 0 || at > file_bytes || uint64_t(size) > file_bytes - at)  // (a file that shrank since it was measured)
       refuse(file, "its header attribute \"" + printable(attribute) + "\" claims " + bytes_text(uint64_t(uint32_t(size))) +
                        " past byte " + std::to_string(at) + " of a file of " + bytes_text(file_bytes));
     if (type == "preview") {  // a width and a height, then 4 bytes a pixel
