@@ -1,8 +1,10 @@
 // glTF 2.0 files: what each part of a file becomes in a scene (meshes through the node hierarchy,
 // materials and textures, the camera, lights), both ways in (an object of a vkray scene, the file as
-// the scene), and every way a file can be wrong.
+// the scene), and every way a file can be wrong: its values against glTF's schema, and its URIs.
 #include <cstring>
+#include <functional>
 #include <set>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -28,6 +30,13 @@ GltfScene parse(const std::string& bytes) { return parse_gltf(bytes, "test.gltf"
 void expect_error(const GltfBuilder& b, const std::string& what) {
   const std::string message = error_of([&] { parse(b.gltf()); });
   EXPECT_NE(message.find("test.gltf: "), std::string::npos) << message;
+  EXPECT_NE(message.find(what), std::string::npos) << "expected \"" << what << "\" in: " << message;
+}
+
+// The same for the file as a .glb.
+void expect_error_in_glb(const GltfBuilder& b, const std::string& what) {
+  const std::string message = error_of([&] { parse_gltf(b.glb(), "test.glb"); });
+  EXPECT_NE(message.find("test.glb: "), std::string::npos) << message;
   EXPECT_NE(message.find(what), std::string::npos) << "expected \"" << what << "\" in: " << message;
 }
 
@@ -231,7 +240,7 @@ TEST(GltfTest, BrokenFilesNameTheElement) {
   {
     GltfBuilder b = textured_quad();
     b.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["index"] = 3;
-    expect_error(b, "materials[0].pbrMetallicRoughness.baseColorTexture: textures[3] does not exist");
+    expect_error(b, "materials[0].pbrMetallicRoughness.baseColorTexture.index: textures[3] does not exist (the file has 1)");
   }
   {
     GltfBuilder b;
@@ -284,6 +293,72 @@ TEST(GltfTest, BrokenFilesNameTheElement) {
   EXPECT_NE(cut.find("cut.glb: the header gives a length of"), std::string::npos) << cut;
 }
 
+// A value tinygltf would read as absent or as a default (a negative byteOffset as 0, an index of
+// -1 or 1.5 as "none", 2^32 as 0, a string as the default) is refused, naming its place.
+struct BadValue {
+  const char* pointer;  // into the textured quad's document
+  json value;
+  const char* expected;  // in the message
+};
+
+TEST(GltfSchemaTest, AValueTinygltfWouldTakeForAbsentOrDefaultIsRefused) {
+  const std::vector<BadValue> cases = {
+      {"/accessors/0/byteOffset", -4, "accessors[0].byteOffset: expected a whole number of bytes, at least 0 and at most 2147483648, got -4"},
+      {"/meshes/0/primitives/0/indices", -1, "meshes[0].primitives[0].indices: accessors[-1] does not exist (the file has 3)"},
+      {"/meshes/0/primitives/0/indices", 1.5, "meshes[0].primitives[0].indices: expected an index into accessors, got 1.5"},
+      {"/meshes/0/primitives/0/indices", "2", "meshes[0].primitives[0].indices: expected an index into accessors, got \"2\""},
+      {"/meshes/0/primitives/0/attributes/POSITION", 4294967296, "attributes.POSITION: accessors[4294967296] does not exist"},
+      {"/meshes/0/primitives/0/material", -1, "meshes[0].primitives[0].material: materials[-1] does not exist (the file has 1)"},
+      {"/meshes/0/primitives/0/mode", 4.0, "meshes[0].primitives[0].mode: expected one of 0, 1, 2, 3, 4, 5, 6, got 4.0"},
+      {"/meshes/0/primitives", json::object(), "meshes[0].primitives: expected an array of objects, got {}"},
+      {"/nodes/0/mesh", 0.0, "nodes[0].mesh: expected an index into meshes, got 0.0"},
+      {"/nodes/0/children", {0.5}, "nodes[0].children[0]: expected an index into nodes, got 0.5"},
+      {"/scene", -1, "scene: scenes[-1] does not exist (the file has 1)"},
+      {"/scenes/0/nodes/0", true, "scenes[0].nodes[0]: expected an index into nodes, got true"},
+      {"/accessors/0/count", "4", "accessors[0].count: expected a whole number, at least 1 and at most 2147483648, got \"4\""},
+      {"/accessors/0/count", 0, "accessors[0].count: expected a whole number, at least 1"},
+      {"/accessors/0/componentType", 5124, "accessors[0].componentType: expected one of 5120, 5121, 5122, 5123, 5125, 5126, got 5124"},
+      {"/accessors/0/normalized", "false", "accessors[0].normalized: expected true or false, got \"false\""},
+      {"/accessors/0/sparse", {{"count", -2}}, "accessors[0].sparse.count: expected a whole number, at least 1 and at most 2147483647, got -2"},
+      {"/bufferViews/1/byteStride", 6, "bufferViews[1].byteStride: expected a multiple of 4 from 4 to 252, got 6"},
+      {"/bufferViews/1/byteLength", 48.0, "bufferViews[1].byteLength: expected a whole number of bytes, at least 1 and at most 2147483648, got 48.0"},
+      {"/bufferViews/1/buffer", -1, "bufferViews[1].buffer: buffers[-1] does not exist (the file has 1)"},
+      {"/bufferViews/1/target", 34961, "bufferViews[1].target: expected one of 34962, 34963, got 34961"},
+      {"/materials/0/pbrMetallicRoughness/baseColorTexture/texCoord", -1, "baseColorTexture.texCoord: expected a whole number, at least 0"},
+      {"/materials/0/pbrMetallicRoughness/baseColorTexture/index", 0.0, "baseColorTexture.index: expected an index into textures, got 0.0"},
+      {"/materials/0/pbrMetallicRoughness/baseColorFactor/1", "1", "pbrMetallicRoughness.baseColorFactor: expected an array of 4 numbers"},
+      {"/materials/0/pbrMetallicRoughness/metallicFactor", "0", "pbrMetallicRoughness.metallicFactor: expected a number, got \"0\""},
+      {"/materials/0/alphaMode", "mask", "materials[0].alphaMode: expected one of \"OPAQUE\", \"MASK\", \"BLEND\", got \"mask\""},
+      {"/materials/0/extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", "4"}}}}, "emissiveStrength: expected a number"},
+      {"/samplers/0/magFilter", 9728.5, "samplers[0].magFilter: expected one of 9728, 9729, got 9728.5"},
+      {"/samplers/0/wrapS", -1, "samplers[0].wrapS: expected one of 33071, 33648, 10497, got -1"},
+      {"/textures/0/source", 7, "textures[0].source: images[7] does not exist (the file has 1)"},
+      {"/textures/0/sampler", -1, "textures[0].sampler: samplers[-1] does not exist (the file has 1)"},
+      {"/images/0/bufferView", -1, "images[0].bufferView: bufferViews[-1] does not exist"},
+      {"/images/0/uri", "four.png", "images[0]: give a uri or a bufferView, not both"},
+      {"/asset/version", "1.0", "asset.version: glTF 1.0; vkray reads glTF 2.0"},
+      {"/extensionsUsed", {"KHR_lights_punctual", 3}, "extensionsUsed: expected an array of names"},
+      {"/nodes/0/extensions", {{"KHR_lights_punctual", {{"light", 0}}}},
+       "nodes[0].extensions.KHR_lights_punctual.light: KHR_lights_punctual.lights[0] does not exist (the file has 0)"},
+      {"/cameras", {{{"type", "perspective"}, {"perspective", {{"yfov", "0.5"}, {"znear", 0.1}}}}}, "cameras[0].perspective.yfov: expected a number"},
+      {"/skins", {{{"joints", {0, -1}}}}, "skins[0].joints[1]: nodes[-1] does not exist (the file has 1)"},
+      {"/animations", {{{"channels", {{{"sampler", 1}, {"target", {{"node", 0}, {"path", "rotation"}}}}}}, {"samplers", {{{"input", 0}, {"output", 0}}}}}},
+       "animations[0].channels[0].sampler: animations[0].samplers[1] does not exist (the file has 1)"},
+  };
+  for (const BadValue& c : cases) {
+    SCOPED_TRACE(c.pointer);
+    GltfBuilder b = textured_quad();
+    b.doc[json::json_pointer(c.pointer)] = c.value;
+    expect_error(b, c.expected);
+    expect_error_in_glb(b, c.expected);
+  }
+  // tinygltf, as vkray, would take the matrix and ignore the scale.
+  GltfBuilder b = textured_quad();
+  b.doc["nodes"][0]["matrix"] = {2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1};
+  b.doc["nodes"][0]["scale"] = {1, 1, 1};
+  expect_error(b, "nodes[0]: a matrix and translation, rotation or scale together");
+}
+
 class GltfFileTest : public ::testing::Test {
  protected:
   test::TempDir dir_;
@@ -309,6 +384,134 @@ TEST_F(GltfFileTest, MissingBuffersAndPicturesNameTheirFile) {
   EXPECT_EQ(s.textures.size(), 1u);
   ASSERT_EQ(s.files.size(), 1u);
   EXPECT_EQ(s.files[0], dir_ / "pictures/four colours.png");
+}
+
+// The textured quad as a .gltf whose buffer is a file (`buffer_uri`, holding the buffer's bytes
+// when `bin` is given), its picture in a buffer view; `edit` may change the document first.
+std::filesystem::path write_with_buffer_file(const std::filesystem::path& gltf, const std::string& buffer_uri, const std::string& bin_name,
+                                             const std::function<void(json&)>& edit = nullptr) {
+  const GltfBuilder b = textured_quad();
+  json doc = json::parse(b.gltf());
+  doc["buffers"][0]["uri"] = buffer_uri;
+  if (!bin_name.empty()) test::write_file(gltf.parent_path() / bin_name, b.bin);
+  if (edit) edit(doc);
+  test::write_file(gltf, doc.dump());
+  return gltf;
+}
+
+TEST_F(GltfFileTest, AUriNamesTheFileItSaysOrIsRefused) {
+  test::write_file(dir_ / "four.png", test::png_bytes(test::four_colours()));
+  std::filesystem::create_directories(dir_ / "pictures");
+  test::write_file(dir_ / "pictures/four.png", test::png_bytes(test::four_colours()));
+  const auto picture_error = [&](const std::string& uri) {
+    write_with_buffer_file(dir_ / "a.gltf", "quad.bin", "quad.bin", [&](json& doc) { doc["images"][0] = {{"uri", uri}}; });
+    return error_of([&] { load_gltf(dir_ / "a.gltf"); });
+  };
+  // Each of these once read a file (four.png, pictures/four.png) that the uri does not name.
+  EXPECT_NE(picture_error("four.png%00.jpg").find("a.gltf: images[0].uri: \"four.png%00.jpg\": %00 is a NUL character"), std::string::npos);
+  EXPECT_NE(picture_error(std::string("four.png\0.jpg", 13)).find("images[0].uri: \"four.png?.jpg\" holds a NUL character"), std::string::npos);
+  EXPECT_NE(picture_error("pictures%2Ffour.png").find("images[0].uri: \"pictures%2Ffour.png\": %2F is an escaped separator"), std::string::npos);
+  EXPECT_NE(picture_error("pictures%5cfour.png").find("%5c is an escaped separator"), std::string::npos);
+  // Neither a broken escape, nor a scheme or host vkray does not read.
+  EXPECT_NE(picture_error("four%2.png").find("images[0].uri: \"four%2.png\": a '%' not followed by two hexadecimal digits"), std::string::npos);
+  EXPECT_NE(picture_error("http://example.com/four.png").find("images[0].uri: http: URIs are not read"), std::string::npos);
+  EXPECT_NE(picture_error("//example.com/four.png").find("names a host"), std::string::npos);
+  EXPECT_NE(picture_error("data:image/png,%89PNG").find("images[0].uri: a data: URI that is not base64"), std::string::npos);
+  EXPECT_NE(picture_error("data:image/png;base64,iVBO*w0K").find("a data: URI whose data is not base64"), std::string::npos);
+  // A buffer's uri, too, before any file is read: the NUL once read quad.bin.
+  write_with_buffer_file(dir_ / "b.gltf", "quad.bin%00.txt", "quad.bin");
+  const std::string nul = error_of([&] { load_gltf(dir_ / "b.gltf"); });
+  EXPECT_NE(nul.find("b.gltf: buffers[0].uri: \"quad.bin%00.txt\": %00 is a NUL character"), std::string::npos) << nul;
+  write_with_buffer_file(dir_ / "b.gltf", "short.bin", "", [&](json&) { test::write_file(dir_ / "short.bin", "12345678"); });
+  const std::string size = error_of([&] { load_gltf(dir_ / "b.gltf"); });
+  EXPECT_NE(size.find("b.gltf: buffers[0] (short.bin): it holds 8 bytes, and byteLength says"), std::string::npos) << size;
+}
+
+TEST_F(GltfFileTest, EscapesAreDecodedOnceByRfc3986AndOnlyTheFileBesideIsRead) {
+  // A '+' is a '+' (tinygltf read it as a space, as a web form does): "a+b.bin" is read, not "a b.bin".
+  const GltfBuilder b = textured_quad();
+  std::string other = b.bin;
+  std::memset(other.data() + b.doc["bufferViews"][1]["byteOffset"].get<size_t>(), 0, 48);  // its POSITIONs all zero
+  test::write_file(dir_ / "a b.bin", other);
+  write_with_buffer_file(dir_ / "plus.gltf", "a+b.bin", "a+b.bin");
+  const GltfScene plus = load_gltf(dir_ / "plus.gltf");
+  ASSERT_EQ(plus.triangles.size(), 2u);
+  EXPECT_EQ(plus.triangles[0].v[2], glm::vec3(1, 1, 0));
+  ASSERT_FALSE(plus.files.empty());
+  EXPECT_EQ(plus.files[0], dir_ / "a+b.bin");
+  // "%20" is a space.
+  write_with_buffer_file(dir_ / "space.gltf", "a%20b.bin", "");
+  const GltfScene space = load_gltf(dir_ / "space.gltf");
+  ASSERT_EQ(space.triangles.size(), 2u);
+  EXPECT_EQ(space.triangles[0].v[2], glm::vec3(0, 0, 0));  // "a b.bin", whose POSITIONs are zero
+  // A buffer missing beside the file is not looked for in the working directory.
+  std::filesystem::create_directories(dir_ / "model");
+  write_with_buffer_file(dir_ / "model/m.gltf", "only-in-cwd.bin", "");
+  test::write_file(dir_ / "only-in-cwd.bin", b.bin);
+  const std::filesystem::path cwd = std::filesystem::current_path();
+  std::filesystem::current_path(dir_.path());
+  const std::string missing = error_of([&] { load_gltf(dir_ / "model/m.gltf"); });
+  std::filesystem::current_path(cwd);
+  EXPECT_NE(missing.find("m.gltf: buffers[0] (only-in-cwd.bin): buffer file not found"), std::string::npos) << missing;
+}
+
+TEST_F(GltfFileTest, PathsMayLeaveTheFolderAndDataUrisOfAnyTypeAreRead) {
+  // As a scene file's paths: "..", a subfolder, or an absolute path, resolved from the file's folder.
+  const GltfBuilder b = textured_quad();
+  test::write_file(dir_ / "quad.bin", b.bin);
+  test::write_file(dir_ / "four.png", test::png_bytes(test::four_colours()));
+  std::filesystem::create_directories(dir_ / "model");
+  write_with_buffer_file(dir_ / "model/up.gltf", "../quad.bin", "", [&](json& doc) { doc["images"][0] = {{"uri", (dir_ / "four.png").string()}}; });
+  const GltfScene up = load_gltf(dir_ / "model/up.gltf");
+  EXPECT_EQ(up.textures.size(), 1u);
+  EXPECT_EQ(up.files, (std::vector<std::filesystem::path>{dir_ / "quad.bin", dir_ / "four.png"}));
+  // data: URIs whose type tinygltf does not know (image/jpg, a made-up buffer type) are read all the same.
+  const auto base64_of = [](const std::string& bytes) {
+    GltfBuilder holder;  // its buffer, as the data: URI gltf() writes
+    holder.bin = bytes;
+    return json::parse(holder.gltf())["buffers"][0]["uri"].get<std::string>().substr(std::strlen("data:application/octet-stream;base64,"));
+  };
+  json doc = json::parse(b.gltf());
+  doc["buffers"][0]["uri"] = "data:application/x-vkray-test;base64," + base64_of(b.bin);
+  doc["images"][0] = {{"uri", "DATA:image/jpg;base64," + base64_of(test::png_bytes(test::four_colours()))}};
+  const GltfScene data = parse_gltf(doc.dump(), dir_ / "data.gltf");
+  EXPECT_EQ(data.textures.size(), 1u);
+  EXPECT_EQ(data.triangles.size(), 2u);
+  EXPECT_TRUE(data.files.empty());
+  // A data: URI holding other than byteLength bytes.
+  doc["buffers"][0]["byteLength"] = b.bin.size() + 4;
+  const std::string length = error_of([&] { parse_gltf(doc.dump(), dir_ / "data.gltf"); });
+  EXPECT_NE(length.find("buffers[0]: its data: URI holds " + std::to_string(b.bin.size()) + " bytes, and byteLength says"), std::string::npos) << length;
+}
+
+// A .glb file's bytes with its JSON chunk replaced by `doc`.
+std::string with_json(const std::string& glb, const json& doc) {
+  uint32_t json_length;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  std::string text = doc.dump();
+  while (text.size() % 4) text += ' ';
+  std::string out = glb.substr(0, 12);
+  const auto u32 = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  u32(uint32_t(text.size()));
+  u32(0x4E4F534Au);
+  out += text + glb.substr(20 + json_length);
+  const auto total = uint32_t(out.size());
+  std::memcpy(out.data() + 8, &total, 4);
+  return out;
+}
+
+TEST(GltfTest, ABufferWithoutAUriIsOnlyAGlbFilesBinaryChunk) {
+  // tinygltf gave every buffer without a uri the binary chunk.
+  const GltfBuilder b = textured_quad();
+  json doc = json::parse(b.gltf());
+  doc["buffers"].push_back({{"byteLength", 4}});
+  doc["bufferViews"].push_back({{"buffer", 1}, {"byteLength", 4}});
+  doc["buffers"][0].erase("uri");
+  const std::string glb = with_json(b.glb(), doc);
+  const std::string second = error_of([&] { parse_gltf(glb, "two.glb"); });
+  EXPECT_NE(second.find("two.glb: buffers[1]: no uri: only buffers[0] of a .glb file is its binary chunk"), std::string::npos) << second;
+  const std::string gltf = error_of([&] { parse_gltf(doc.dump(), "two.gltf"); });
+  EXPECT_NE(gltf.find("two.gltf: buffers[0]: no uri: a .gltf file's buffers are files or data: URIs"), std::string::npos) << gltf;
 }
 
 TEST_F(GltfFileTest, AnObjectOfAVkraySceneIsPlacedByItsTransform) {

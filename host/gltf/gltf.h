@@ -1,5 +1,7 @@
 // glTF 2.0 files: a .gltf with its buffers and pictures, or a .glb. tinygltf (Debian's libtinygltf-dev)
-// parses them; vkray checks every index, accessor and size before it reads anything through them, and
+// parses them. Before it does, vkray checks every value of the document against glTF's schema (so that
+// nothing tinygltf would read leniently, as absent or as a default, gets through) and resolves every
+// URI itself; after it, every accessor range and index value before it reads anything through them. It
 // places the meshes of the default scene's node hierarchy in the file's world space. The metallic-
 // roughness material's base colour and emission (with their textures) become vkray's diffuse
 // materials; what vkray cannot render is named in one warning each.

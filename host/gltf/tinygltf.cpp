@@ -3,3 +3,11 @@
 // code.
 #define TINYGLTF_IMPLEMENTATION
 #include "gltf/tinygltf.h"
+
+namespace vkray {
+
+std::string tinygltf_buffer_request(const std::string& base_dir, const std::string& uri) {
+  return tinygltf::JoinPath(base_dir, tinygltf::dlib::urldecode(uri));
+}
+
+}  // namespace vkray
