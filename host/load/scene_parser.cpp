@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include <glm/gtc/constants.hpp>
 
@@ -131,11 +132,14 @@ void SceneParser::parse_camera(const Value& v) {
   // A lens in air is at most f/0.5 (a numerical aperture of 1), so its radius is at most its focal
   // length, which is at most the distance it focuses at. Past that, rays leave the lens far from the
   // scene they light, where 32-bit floats place them too coarsely for the scene's epsilon.
-  if (cam.aperture_radius > cam.focus_distance)
+  if (cam.aperture_radius > cam.focus_distance) {
+    std::ostringstream focus;
+    focus << cam.focus_distance;
     fail(v["aperture_radius"], "an aperture radius of " + brief(v["aperture_radius"].j) + " is past the focus distance (" +
-                                   std::to_string(cam.focus_distance) +
+                                   focus.str() +
                                    "): a thin lens's aperture radius is at most the distance it focuses at (f/0.5, the "
                                    "widest a lens in air can be)");
+  }
   if (v.has("focus_distance") && cam.aperture_radius == 0.0f)
     warn(v["focus_distance"], "a pinhole camera (aperture_radius 0) is sharp everywhere: focus_distance has no effect");
 }
