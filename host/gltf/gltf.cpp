@@ -1,12 +1,10 @@
 #include "gltf/gltf.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <deque>
 #include <map>
 #include <set>
 
@@ -18,9 +16,11 @@
 #include "base/grow.h"
 #include "base/input_file.h"
 #include "base/interrupt.h"
+#include "base/json_document.h"
+#include "gltf/gltf_schema.h"
+#include "gltf/gltf_uri.h"
 #include "gltf/tinygltf.h"
 #include "image/decode.h"
-#include "base/json_document.h"
 
 namespace vkray {
 namespace {
@@ -32,105 +32,6 @@ using glm::dvec3;
 const std::set<std::string> kReadExtensions = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
 
 std::string element(const char* array, size_t index) { return std::string(array) + "[" + std::to_string(index) + "]"; }
-
-// ---- URIs: where a buffer's or a picture's bytes are ------------------------------------------------
-// A uri is a data: URI in base64, or a relative reference (RFC 3986) resolved against the glTF file's
-// folder with its percent-escapes decoded once: a subfolder, "..", or an absolute path, as a scene
-// file's paths may be. Refused, naming the key: a NUL, raw or as %00 (the file opened would be the
-// name cut short there); an escaped separator, %2F or %5C (a folder the name did not have); a '%'
-// without two hex digits; a scheme other than data: (http:, file:, ...) or a host ("//host/x"); a
-// data: URI that is not base64 or holds no bytes.
-struct UriTarget {
-  std::string_view base64;     // a data: URI's payload, checked to be base64 (points into the uri), or
-  std::filesystem::path file;  // the file the uri names
-  bool data() const { return !base64.empty(); }
-};
-
-bool base64_digit(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '/'; }
-
-// The payload without its '=' padding, or empty when it is not base64 (RFC 4648, padded or not).
-std::string_view base64_body(std::string_view payload) {
-  std::string_view body = payload;
-  while (!body.empty() && body.back() == '=' && payload.size() - body.size() < 2) body.remove_suffix(1);
-  const bool padded = body.size() < payload.size();
-  const bool whole = padded ? payload.size() % 4 == 0 : body.size() % 4 != 1;
-  return whole && std::all_of(body.begin(), body.end(), base64_digit) ? body : std::string_view();
-}
-
-size_t base64_size(std::string_view payload) { return base64_body(payload).size() * 6 / 8; }
-
-std::string decode_base64(std::string_view payload) {
-  std::string out;
-  out.reserve(base64_size(payload));
-  uint32_t bits = 0;
-  int count = 0;
-  for (const char c : base64_body(payload)) {
-    const uint32_t digit = c >= 'A' && c <= 'Z' ? uint32_t(c - 'A') : c >= 'a' && c <= 'z' ? uint32_t(c - 'a' + 26)
-                         : c >= '0' && c <= '9' ? uint32_t(c - '0' + 52) : c == '+' ? 62u : 63u;
-    bits = (bits << 6) | digit;
-    if ((count += 6) >= 8) out += char((bits >> (count -= 8)) & 0xff);
-  }
-  return out;
-}
-
-std::string lowered(std::string text) {
-  for (char& c : text) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return text;
-}
-
-// A buffer tinygltf will ask the file callbacks for, and what vkray resolved its uri to.
-struct BufferRequest {
-  std::string name;            // "buffers[2] (mesh.bin)", for messages
-  uint64_t byte_length = 0;    // what the file must hold
-  std::string base64;          // a data: URI tinygltf does not decode itself, or
-  std::filesystem::path file;  // the file the uri names
-};
-
-// tinygltf's file callbacks: each request answered with what vkray resolved, read with vkray's
-// checks (regular files, a size limit, Ctrl-C), or nothing at all. No other path is read: not
-// tinygltf's second guess in the working directory, nor a name decoded by its rules.
-struct FileAccess {
-  bool allowed = true;
-  std::map<std::string, std::deque<BufferRequest>> requests;  // by the path tinygltf asks for (tinygltf_buffer_request)
-  std::vector<std::filesystem::path> read;
-  std::string error;  // the first failure, naming the buffer: reported instead of tinygltf's words
-};
-
-bool file_exists(const std::string& path, void* user) { return static_cast<FileAccess*>(user)->requests.count(path) > 0; }
-
-std::string expand_path(const std::string& path, void*) { return path; }  // no shell expansion (wordexp) for a file's URIs
-
-bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
-  auto* access = static_cast<FileAccess*>(user);
-  const auto refuse = [&](const std::string& why) {
-    if (access->error.empty()) access->error = why;
-    if (err) *err += why + "\n";
-    return false;
-  };
-  const auto found = access->requests.find(path);
-  if (found == access->requests.end() || found->second.empty()) return refuse("tinygltf asked for a file vkray did not resolve: " + printable(path, 200));
-  const BufferRequest request = std::move(found->second.front());
-  found->second.pop_front();
-  std::string bytes;
-  if (!request.base64.empty()) {
-    bytes = decode_base64(request.base64);
-  } else {
-    if (!access->allowed) return refuse(request.name + ": external files are not read here");
-    InputFile input = read_input_file(request.file, kMaxGltfFileBytes);
-    if (!input.error.empty()) return refuse(request.name + ": " + (input.error == "not found" ? "buffer file not found" : input.error));
-    access->read.push_back(request.file);
-    bytes = std::move(input.text);
-  }
-  if (bytes.size() != request.byte_length)
-    return refuse(request.name + ": it holds " + std::to_string(bytes.size()) + " bytes, and byteLength says " + std::to_string(request.byte_length));
-  out->assign(bytes.begin(), bytes.end());
-  return true;
-}
-
-bool write_whole_file(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
-  if (err) *err += "vkray writes no glTF files\n";
-  return false;
-}
 
 // Keeps a picture's bytes as they are (image.image); vkray decodes the pictures a material uses.
 bool keep_encoded(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes, int size, void*) {
@@ -232,417 +133,9 @@ const char* type_name(int type) {
   return "an unknown type";
 }
 
-// ---- The document's values, checked against glTF 2.0's schema before tinygltf reads them ---------
-// tinygltf takes a value of the wrong kind for an absent one: a negative byteOffset reads as 0, a
-// fractional or negative index as "none", an index past 2^31 wraps around, a string where a number
-// belongs leaves the default, a bad element ends an integer array early, and a primitive it cannot
-// parse is dropped from its mesh. So every value tinygltf reads is checked here first, against the
-// schema of glTF 2.0 and of the extensions vkray reads: an index (glTFid) names an element that
-// exists; offsets, lengths, counts and strides are whole numbers in range; an enumeration holds one
-// of its values; every other key has its JSON kind. The first value that does not is refused,
-// naming its place in the document ("accessors[3].byteOffset").
-class SchemaCheck {
- public:
-  using json = nlohmann::json;
-  SchemaCheck(const json& doc, const std::filesystem::path& file) : doc_(doc), file_(file) {}
-  void run() const;
-
- private:
-  // The largest byte offset, length or count: a buffer holds at most what vkray reads of a file.
-  static constexpr uint64_t kMaxBytes = kMaxGltfFileBytes;
-  static constexpr uint64_t kMaxInt = INT32_MAX;  // what tinygltf holds in an int (texCoord, sparse counts)
-
-  [[noreturn]] void fail(const std::string& at, const std::string& what) const {
-    throw SceneError(file_.string() + ": " + at + ": " + what);
-  }
-  void expect(bool ok, const json& value, const std::string& at, const std::string& expected) const {
-    if (!ok) fail(at, "expected " + expected + ", got " + brief(value));
-  }
-  static std::string path(const std::string& at, const std::string& key) { return at.empty() ? key : at + "." + key; }
-  // The value of `key` in `object`, or null when it is absent (refused when required).
-  const json* find(const json& object, const std::string& at, const char* key, bool required = false) const;
-  // The number of elements of a root array ("accessors"), 0 when the file has none.
-  size_t count(const char* array) const {
-    const auto it = doc_.find(array);
-    return it == doc_.end() ? 0 : it->size();
-  }
-
-  // One key of each kind; absent keys pass unless required.
-  void index(const json& value, const std::string& at, const std::string& array, size_t size) const;
-  void index_key(const json& o, const std::string& at, const char* key, const char* array, bool required = false) const;
-  void indices_key(const json& o, const std::string& at, const char* key, const char* array, bool required = false) const;
-  void whole_key(const json& o, const std::string& at, const char* key, uint64_t min, uint64_t max, bool required = false,
-                 const char* unit = "") const;
-  void enum_key(const json& o, const std::string& at, const char* key, std::initializer_list<int> values, bool required = false) const;
-  void enum_key(const json& o, const std::string& at, const char* key, std::initializer_list<const char*> values,
-                bool required = false) const;
-  void number_key(const json& o, const std::string& at, const char* key, bool required = false) const;
-  void numbers_key(const json& o, const std::string& at, const char* key, size_t min_size, size_t max_size) const;
-  void string_key(const json& o, const std::string& at, const char* key, bool required = false) const;
-  void bool_key(const json& o, const std::string& at, const char* key) const;
-  const json* object_key(const json& o, const std::string& at, const char* key, bool required = false) const;
-  // `name`, `extensions` (an object of objects) and `extras`, which every object may have.
-  void common(const json& o, const std::string& at) const;
-  // Each element of an array of objects at `key` of `o`, checked by `check(element, its place)`.
-  template <typename Check>
-  void each(const json& o, const std::string& at, const char* key, Check check, bool required = false) const;
-
-  void asset(const json& a, const std::string& at) const;
-  void accessor(const json& a, const std::string& at) const;
-  void animation(const json& a, const std::string& at) const;
-  void buffer(const json& b, const std::string& at) const;
-  void buffer_view(const json& v, const std::string& at) const;
-  void camera(const json& c, const std::string& at) const;
-  void image(const json& i, const std::string& at) const;
-  void material(const json& m, const std::string& at) const;
-  void texture_info(const json& o, const std::string& at, const char* key, const char* extra_number = nullptr) const;
-  void mesh(const json& m, const std::string& at) const;
-  void node(const json& n, const std::string& at) const;
-  void sampler(const json& s, const std::string& at) const;
-  void scene(const json& s, const std::string& at) const;
-  void skin(const json& s, const std::string& at) const;
-  void texture(const json& t, const std::string& at) const;
-  void light(const json& l, const std::string& at) const;
-
-  const json& doc_;
-  const std::filesystem::path& file_;
-};
-
-const nlohmann::json* SchemaCheck::find(const json& object, const std::string& at, const char* key, bool required) const {
-  const auto it = object.find(key);
-  if (it != object.end()) return &*it;
-  if (required) fail(at.empty() ? "top level" : at, std::string("missing required key \"") + key + "\"");
-  return nullptr;
-}
-
-void SchemaCheck::index(const json& value, const std::string& at, const std::string& array, size_t size) const {
-  expect(value.is_number_integer(), value, at, "an index into " + array);
-  if (value.is_number_unsigned() && value.get<uint64_t>() < size) return;
-  const std::string number = value.is_number_unsigned() ? std::to_string(value.get<uint64_t>()) : std::to_string(value.get<int64_t>());
-  fail(at, array + "[" + number + "] does not exist (the file has " + std::to_string(size) + ")");
-}
-
-void SchemaCheck::index_key(const json& o, const std::string& at, const char* key, const char* array, bool required) const {
-  if (const json* v = find(o, at, key, required)) index(*v, path(at, key), array, count(array));
-}
-
-void SchemaCheck::indices_key(const json& o, const std::string& at, const char* key, const char* array, bool required) const {
-  const json* v = find(o, at, key, required);
-  if (!v) return;
-  expect(v->is_array(), *v, path(at, key), "an array of indices into " + std::string(array));
-  for (size_t i = 0; i < v->size(); ++i) index((*v)[i], path(at, key) + "[" + std::to_string(i) + "]", array, count(array));
-}
-
-void SchemaCheck::whole_key(const json& o, const std::string& at, const char* key, uint64_t min, uint64_t max, bool required,
-                            const char* unit) const {
-  const json* v = find(o, at, key, required);
-  if (!v) return;
-  const bool ok = v->is_number_unsigned() && v->get<uint64_t>() >= min && v->get<uint64_t>() <= max;
-  expect(ok, *v, path(at, key),
-         std::string("a whole number") + unit + ", at least " + std::to_string(min) + " and at most " + std::to_string(max));
-}
-
-void SchemaCheck::enum_key(const json& o, const std::string& at, const char* key, std::initializer_list<int> values, bool required) const {
-  const json* v = find(o, at, key, required);
-  if (!v) return;
-  std::string list;
-  for (const int value : values) {
-    if (v->is_number_integer() && v->get<int64_t>() == value) return;
-    list += (list.empty() ? "" : ", ") + std::to_string(value);
-  }
-  fail(path(at, key), "expected one of " + list + ", got " + brief(*v));
-}
-
-void SchemaCheck::enum_key(const json& o, const std::string& at, const char* key, std::initializer_list<const char*> values,
-                           bool required) const {
-  const json* v = find(o, at, key, required);
-  if (!v) return;
-  std::string list;
-  for (const char* value : values) {
-    if (v->is_string() && v->get_ref<const std::string&>() == value) return;
-    list += (list.empty() ? "\"" : ", \"") + std::string(value) + "\"";
-  }
-  fail(path(at, key), "expected one of " + list + ", got " + brief(*v));
-}
-
-void SchemaCheck::number_key(const json& o, const std::string& at, const char* key, bool required) const {
-  if (const json* v = find(o, at, key, required)) expect(v->is_number(), *v, path(at, key), "a number");
-}
-
-void SchemaCheck::numbers_key(const json& o, const std::string& at, const char* key, size_t min_size, size_t max_size) const {
-  const json* v = find(o, at, key);
-  if (!v) return;
-  const std::string size = min_size == max_size ? std::to_string(min_size)
-                         : max_size == SIZE_MAX ? "at least " + std::to_string(min_size)
-                                                : std::to_string(min_size) + " to " + std::to_string(max_size);
-  expect(v->is_array() && v->size() >= min_size && v->size() <= max_size && std::all_of(v->begin(), v->end(), [](const json& x) { return x.is_number(); }),
-         *v, path(at, key), "an array of " + size + " numbers");
-}
-
-void SchemaCheck::string_key(const json& o, const std::string& at, const char* key, bool required) const {
-  if (const json* v = find(o, at, key, required)) expect(v->is_string(), *v, path(at, key), "a string");
-}
-
-void SchemaCheck::bool_key(const json& o, const std::string& at, const char* key) const {
-  if (const json* v = find(o, at, key)) expect(v->is_boolean(), *v, path(at, key), "true or false");
-}
-
-const nlohmann::json* SchemaCheck::object_key(const json& o, const std::string& at, const char* key, bool required) const {
-  const json* v = find(o, at, key, required);
-  if (v) expect(v->is_object(), *v, path(at, key), "an object");
-  return v;
-}
-
-void SchemaCheck::common(const json& o, const std::string& at) const {
-  string_key(o, at, "name");
-  if (const json* extensions = object_key(o, at, "extensions"))
-    for (const auto& [name, value] : extensions->items()) expect(value.is_object(), value, path(at, "extensions." + name), "an object");
-}
-
-template <typename Check>
-void SchemaCheck::each(const json& o, const std::string& at, const char* key, Check check, bool required) const {
-  const json* v = find(o, at, key, required);
-  if (!v) return;
-  const std::string where = path(at, key);
-  expect(v->is_array(), *v, where, "an array of objects");
-  for (size_t i = 0; i < v->size(); ++i) {
-    const std::string element_at = where + "[" + std::to_string(i) + "]";
-    expect((*v)[i].is_object(), (*v)[i], element_at, "an object");
-    common((*v)[i], element_at);
-    check((*v)[i], element_at);
-  }
-}
-
-void SchemaCheck::asset(const json& a, const std::string& at) const {
-  string_key(a, at, "version", true);
-  string_key(a, at, "minVersion");
-  string_key(a, at, "generator");
-  string_key(a, at, "copyright");
-  // "2.0", "2.1", ...: a later minor version adds only what a 2.0 reader may ignore, unless minVersion asks for it.
-  const std::string& version = a["version"].get_ref<const std::string&>();
-  if (version.rfind("2.", 0) != 0) fail(path(at, "version"), "glTF " + printable(version) + "; vkray reads glTF 2.0");
-  if (a.contains("minVersion") && a["minVersion"] != "2.0")
-    fail(path(at, "minVersion"), "the file needs a reader of glTF " + printable(a["minVersion"].get<std::string>()) + "; vkray reads glTF 2.0");
-}
-
-void SchemaCheck::accessor(const json& a, const std::string& at) const {
-  index_key(a, at, "bufferView", "bufferViews");
-  whole_key(a, at, "byteOffset", 0, kMaxBytes, false, " of bytes");
-  enum_key(a, at, "componentType", {5120, 5121, 5122, 5123, 5125, 5126}, true);
-  bool_key(a, at, "normalized");
-  whole_key(a, at, "count", 1, kMaxBytes, true);
-  enum_key(a, at, "type", {"SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"}, true);
-  numbers_key(a, at, "max", 1, 16);
-  numbers_key(a, at, "min", 1, 16);
-  if (const json* sparse = object_key(a, at, "sparse")) {
-    const std::string s = path(at, "sparse");
-    common(*sparse, s);
-    whole_key(*sparse, s, "count", 1, kMaxInt, true);
-    const json& ind = *object_key(*sparse, s, "indices", true);
-    common(ind, path(s, "indices"));
-    index_key(ind, path(s, "indices"), "bufferView", "bufferViews", true);
-    whole_key(ind, path(s, "indices"), "byteOffset", 0, kMaxInt, false, " of bytes");
-    enum_key(ind, path(s, "indices"), "componentType", {5121, 5123, 5125}, true);
-    const json& values = *object_key(*sparse, s, "values", true);
-    common(values, path(s, "values"));
-    index_key(values, path(s, "values"), "bufferView", "bufferViews", true);
-    whole_key(values, path(s, "values"), "byteOffset", 0, kMaxInt, false, " of bytes");
-  }
-}
-
-void SchemaCheck::animation(const json& a, const std::string& at) const {
-  const size_t samplers = a.contains("samplers") && a["samplers"].is_array() ? a["samplers"].size() : 0;
-  each(a, at, "channels", [&](const json& c, const std::string& c_at) {
-    if (const json* s = find(c, c_at, "sampler", true)) index(*s, path(c_at, "sampler"), path(at, "samplers"), samplers);
-    const json& target = *object_key(c, c_at, "target", true);
-    common(target, path(c_at, "target"));
-    index_key(target, path(c_at, "target"), "node", "nodes");
-    enum_key(target, path(c_at, "target"), "path", {"translation", "rotation", "scale", "weights"}, true);
-  }, true);
-  each(a, at, "samplers", [&](const json& s, const std::string& s_at) {
-    index_key(s, s_at, "input", "accessors", true);
-    enum_key(s, s_at, "interpolation", {"LINEAR", "STEP", "CUBICSPLINE"});
-    index_key(s, s_at, "output", "accessors", true);
-  }, true);
-}
-
-void SchemaCheck::buffer(const json& b, const std::string& at) const {
-  string_key(b, at, "uri");
-  whole_key(b, at, "byteLength", 1, kMaxBytes, true, " of bytes");
-}
-
-void SchemaCheck::buffer_view(const json& v, const std::string& at) const {
-  index_key(v, at, "buffer", "buffers", true);
-  whole_key(v, at, "byteOffset", 0, kMaxBytes, false, " of bytes");
-  whole_key(v, at, "byteLength", 1, kMaxBytes, true, " of bytes");
-  if (const json* stride = find(v, at, "byteStride"))
-    expect(stride->is_number_unsigned() && *stride >= 4 && *stride <= 252 && stride->get<uint64_t>() % 4 == 0, *stride,
-           path(at, "byteStride"), "a multiple of 4 from 4 to 252");
-  enum_key(v, at, "target", {34962, 34963});
-}
-
-void SchemaCheck::camera(const json& c, const std::string& at) const {
-  enum_key(c, at, "type", {"perspective", "orthographic"}, true);
-  const bool perspective = c["type"] == "perspective";
-  // The object the type names is required; the other one is not read.
-  if (const json* p = object_key(c, at, "perspective", perspective)) {
-    common(*p, path(at, "perspective"));
-    for (const char* key : {"yfov", "znear"}) number_key(*p, path(at, "perspective"), key, true);
-    for (const char* key : {"aspectRatio", "zfar"}) number_key(*p, path(at, "perspective"), key);
-  }
-  if (const json* o = object_key(c, at, "orthographic", !perspective)) {
-    common(*o, path(at, "orthographic"));
-    for (const char* key : {"xmag", "ymag", "zfar", "znear"}) number_key(*o, path(at, "orthographic"), key, true);
-  }
-}
-
-void SchemaCheck::image(const json& i, const std::string& at) const {
-  string_key(i, at, "uri");
-  string_key(i, at, "mimeType");
-  index_key(i, at, "bufferView", "bufferViews");
-  if (i.contains("uri") == i.contains("bufferView"))
-    fail(at, i.contains("uri") ? "give a uri or a bufferView, not both" : "no picture: give a uri or a bufferView");
-}
-
-void SchemaCheck::texture_info(const json& o, const std::string& at, const char* key, const char* extra_number) const {
-  const json* info = object_key(o, at, key);
-  if (!info) return;
-  const std::string where = path(at, key);
-  common(*info, where);
-  index_key(*info, where, "index", "textures", true);
-  whole_key(*info, where, "texCoord", 0, kMaxInt);
-  if (extra_number) number_key(*info, where, extra_number);
-}
-
-void SchemaCheck::material(const json& m, const std::string& at) const {
-  if (const json* pbr = object_key(m, at, "pbrMetallicRoughness")) {
-    const std::string where = path(at, "pbrMetallicRoughness");
-    common(*pbr, where);
-    numbers_key(*pbr, where, "baseColorFactor", 4, 4);
-    texture_info(*pbr, where, "baseColorTexture");
-    number_key(*pbr, where, "metallicFactor");
-    number_key(*pbr, where, "roughnessFactor");
-    texture_info(*pbr, where, "metallicRoughnessTexture");
-  }
-  texture_info(m, at, "normalTexture", "scale");
-  texture_info(m, at, "occlusionTexture", "strength");
-  texture_info(m, at, "emissiveTexture");
-  numbers_key(m, at, "emissiveFactor", 3, 3);
-  enum_key(m, at, "alphaMode", {"OPAQUE", "MASK", "BLEND"});
-  number_key(m, at, "alphaCutoff");
-  bool_key(m, at, "doubleSided");
-  if (m.contains("extensions") && m["extensions"].contains("KHR_materials_emissive_strength"))
-    number_key(m["extensions"]["KHR_materials_emissive_strength"], path(at, "extensions.KHR_materials_emissive_strength"), "emissiveStrength");
-}
-
-void SchemaCheck::mesh(const json& m, const std::string& at) const {
-  // An attributes object: each value the index of an accessor.
-  const auto attributes = [&](const json& a, const std::string& where) {
-    expect(a.is_object(), a, where, "an object of accessor indices");
-    for (const auto& [name, value] : a.items()) index(value, path(where, name), "accessors", count("accessors"));
-  };
-  each(m, at, "primitives", [&](const json& p, const std::string& p_at) {
-    attributes(*find(p, p_at, "attributes", true), path(p_at, "attributes"));
-    index_key(p, p_at, "indices", "accessors");
-    index_key(p, p_at, "material", "materials");
-    enum_key(p, p_at, "mode", {0, 1, 2, 3, 4, 5, 6});
-    if (const json* targets = find(p, p_at, "targets")) {
-      expect(targets->is_array(), *targets, path(p_at, "targets"), "an array of objects");
-      for (size_t t = 0; t < targets->size(); ++t) attributes((*targets)[t], path(p_at, "targets") + "[" + std::to_string(t) + "]");
-    }
-  }, true);
-  numbers_key(m, at, "weights", 1, SIZE_MAX);
-}
-
-void SchemaCheck::node(const json& n, const std::string& at) const {
-  index_key(n, at, "camera", "cameras");
-  indices_key(n, at, "children", "nodes");
-  index_key(n, at, "skin", "skins");
-  index_key(n, at, "mesh", "meshes");
-  numbers_key(n, at, "matrix", 16, 16);
-  numbers_key(n, at, "rotation", 4, 4);
-  numbers_key(n, at, "scale", 3, 3);
-  numbers_key(n, at, "translation", 3, 3);
-  numbers_key(n, at, "weights", 1, SIZE_MAX);
-  // tinygltf, as vkray, would take the matrix and ignore the others.
-  if (n.contains("matrix") && (n.contains("translation") || n.contains("rotation") || n.contains("scale")))
-    fail(at, "a matrix and translation, rotation or scale together: give one or the other");
-  if (n.contains("extensions") && n["extensions"].contains("KHR_lights_punctual")) {
-    const json& ext = n["extensions"]["KHR_lights_punctual"];
-    const json* lights = doc_.contains("extensions") ? &doc_["extensions"] : nullptr;
-    lights = lights && lights->contains("KHR_lights_punctual") ? &(*lights)["KHR_lights_punctual"] : nullptr;
-    const size_t size = lights && lights->contains("lights") ? (*lights)["lights"].size() : 0;
-    index(*find(ext, path(at, "extensions.KHR_lights_punctual"), "light", true), path(at, "extensions.KHR_lights_punctual.light"),
-          "KHR_lights_punctual.lights", size);
-  }
-}
-
-void SchemaCheck::sampler(const json& s, const std::string& at) const {
-  enum_key(s, at, "magFilter", {9728, 9729});
-  enum_key(s, at, "minFilter", {9728, 9729, 9984, 9985, 9986, 9987});
-  enum_key(s, at, "wrapS", {33071, 33648, 10497});
-  enum_key(s, at, "wrapT", {33071, 33648, 10497});
-}
-
-void SchemaCheck::scene(const json& s, const std::string& at) const { indices_key(s, at, "nodes", "nodes"); }
-
-void SchemaCheck::skin(const json& s, const std::string& at) const {
-  index_key(s, at, "inverseBindMatrices", "accessors");
-  index_key(s, at, "skeleton", "nodes");
-  indices_key(s, at, "joints", "nodes", true);
-}
-
-void SchemaCheck::texture(const json& t, const std::string& at) const {
-  index_key(t, at, "sampler", "samplers");
-  index_key(t, at, "source", "images");
-}
-
-void SchemaCheck::light(const json& l, const std::string& at) const {
-  enum_key(l, at, "type", {"directional", "point", "spot"}, true);
-  numbers_key(l, at, "color", 3, 3);
-  number_key(l, at, "intensity");
-  number_key(l, at, "range");
-  if (const json* spot = object_key(l, at, "spot", l["type"] == "spot")) {
-    common(*spot, path(at, "spot"));
-    number_key(*spot, path(at, "spot"), "innerConeAngle");
-    number_key(*spot, path(at, "spot"), "outerConeAngle");
-  }
-}
-
-void SchemaCheck::run() const {
-  // The root's arrays first, so that an index can be checked against the array it names.
-  for (const char* array : {"accessors", "animations", "buffers", "bufferViews", "cameras", "images", "materials", "meshes", "nodes",
-                            "samplers", "scenes", "skins", "textures"})
-    if (const json* v = find(doc_, "", array)) expect(v->is_array(), *v, array, "an array of objects");
-  for (const char* list : {"extensionsUsed", "extensionsRequired"})
-    if (const json* v = find(doc_, "", list))
-      expect(v->is_array() && std::all_of(v->begin(), v->end(), [](const json& x) { return x.is_string(); }), *v, list, "an array of names");
-  common(doc_, "");
-  asset(*object_key(doc_, "", "asset", true), "asset");
-  index_key(doc_, "", "scene", "scenes");
-  if (doc_.contains("extensions") && doc_["extensions"].contains("KHR_lights_punctual"))  // before the nodes that name them
-    each(doc_["extensions"]["KHR_lights_punctual"], "extensions.KHR_lights_punctual", "lights",
-         [&](const json& v, const std::string& at) { light(v, at); });
-  each(doc_, "", "accessors", [&](const json& v, const std::string& at) { accessor(v, at); });
-  each(doc_, "", "animations", [&](const json& v, const std::string& at) { animation(v, at); });
-  each(doc_, "", "buffers", [&](const json& v, const std::string& at) { buffer(v, at); });
-  each(doc_, "", "bufferViews", [&](const json& v, const std::string& at) { buffer_view(v, at); });
-  each(doc_, "", "cameras", [&](const json& v, const std::string& at) { camera(v, at); });
-  each(doc_, "", "images", [&](const json& v, const std::string& at) { image(v, at); });
-  each(doc_, "", "materials", [&](const json& v, const std::string& at) { material(v, at); });
-  each(doc_, "", "meshes", [&](const json& v, const std::string& at) { mesh(v, at); });
-  each(doc_, "", "nodes", [&](const json& v, const std::string& at) { node(v, at); });
-  each(doc_, "", "samplers", [&](const json& v, const std::string& at) { sampler(v, at); });
-  each(doc_, "", "scenes", [&](const json& v, const std::string& at) { scene(v, at); });
-  each(doc_, "", "skins", [&](const json& v, const std::string& at) { skin(v, at); });
-  each(doc_, "", "textures", [&](const json& v, const std::string& at) { texture(v, at); });
-}
-
 class GltfReader {
  public:
-  GltfReader(const std::filesystem::path& file, const GltfLimits& limits) : file_(file), limits_(limits) {
-    access_.allowed = limits.read_files;
-  }
+  GltfReader(const std::filesystem::path& file, const GltfLimits& limits) : file_(file), limits_(limits) {}
 
   GltfScene read(std::string_view bytes);
 
@@ -660,10 +153,6 @@ class GltfReader {
   bool check_glb(std::string_view bytes) const;
   void check_buffer_views(const nlohmann::json& doc) const;
   void check_required_extensions(const nlohmann::json& doc) const;
-  UriTarget resolve_uri(const std::string& uri, const std::string& where) const;
-  // Every buffer's bytes resolved (its uri, or a .glb's binary chunk), and every picture's uri checked.
-  void resolve_buffers(const nlohmann::json& doc, bool binary, bool has_binary_chunk);
-  void check_image_uris(const nlohmann::json& doc) const;
   void warn_used_extensions();
   // `integers`: whether integer components may be read as they are (indices); otherwise an integer
   // component must be normalized (texture coordinates).
@@ -681,7 +170,6 @@ class GltfReader {
 
   const std::filesystem::path& file_;
   GltfLimits limits_;
-  FileAccess access_;
   tinygltf::Model model_;
   GltfScene scene_;
   std::set<std::string> warned_;
@@ -732,81 +220,6 @@ void GltfReader::check_buffer_views(const nlohmann::json& doc) const {
       fail(element("bufferViews", v), "bytes " + std::to_string(offset) + " + " + std::to_string(length) + " run past the end of " +
                                           element("buffers", buffer) + " (" + std::to_string(size) + " bytes)");
   }
-}
-
-UriTarget GltfReader::resolve_uri(const std::string& uri, const std::string& where) const {
-  const std::string quoted = "\"" + printable(uri, 200) + "\"";
-  if (uri.find('\0') != std::string::npos) fail(where, quoted + " holds a NUL character, which no file name can");
-  // A scheme: a letter, then letters, digits, '+', '-' or '.', up to a ':' (RFC 3986, 3.1).
-  const size_t colon = uri.find(':');
-  const bool has_scheme = colon != std::string::npos && colon > 0 && std::isalpha(static_cast<unsigned char>(uri[0])) &&
-                          std::all_of(uri.begin(), uri.begin() + std::ptrdiff_t(colon), [](char c) {
-                            return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '-' || c == '.';
-                          });
-  if (has_scheme) {
-    if (lowered(uri.substr(0, colon)) != "data")
-      fail(where, printable(uri.substr(0, colon + 1), 40) + " URIs are not read: vkray reads data: URIs and paths relative to the file");
-    const size_t comma = uri.find(',');
-    const std::string header = lowered(uri.substr(0, comma));
-    if (comma == std::string::npos || header.size() < 7 || header.compare(header.size() - 7, 7, ";base64") != 0)
-      fail(where, "a data: URI that is not base64; vkray reads data:<type>;base64,<data>");
-    const std::string_view payload = std::string_view(uri).substr(comma + 1);
-    if (base64_body(payload).empty()) fail(where, "a data: URI whose data is not base64, or is empty");
-    return {payload, {}};
-  }
-  if (uri.rfind("//", 0) == 0) fail(where, quoted + " names a host; vkray reads data: URIs and paths relative to the file");
-  // Percent-escapes decoded once, each to the byte it names.
-  std::string path;
-  for (size_t i = 0; i < uri.size(); ++i) {
-    if (uri[i] != '%') {
-      path += uri[i];
-      continue;
-    }
-    if (i + 2 >= uri.size() || !std::isxdigit(static_cast<unsigned char>(uri[i + 1])) || !std::isxdigit(static_cast<unsigned char>(uri[i + 2])))
-      fail(where, quoted + ": a '%' not followed by two hexadecimal digits");
-    const char byte = char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
-    if (byte == '\0') fail(where, quoted + ": %00 is a NUL character, which no file name can hold (the name would end there)");
-    if (byte == '/' || byte == '\\')
-      fail(where, quoted + ": %" + uri.substr(i + 1, 2) + " is an escaped separator, which would name another folder");
-    path += byte;
-    i += 2;
-  }
-  if (path.empty()) fail(where, "an empty uri names no file");
-  return {{}, (file_.parent_path() / path).lexically_normal()};
-}
-
-void GltfReader::resolve_buffers(const nlohmann::json& doc, bool binary, bool has_binary_chunk) {
-  if (!doc.contains("buffers")) return;
-  const std::string base_dir = file_.parent_path().string();
-  const nlohmann::json& buffers = doc["buffers"];
-  for (size_t b = 0; b < buffers.size(); ++b) {
-    const uint64_t byte_length = buffers[b]["byteLength"].get<uint64_t>();
-    if (!buffers[b].contains("uri")) {
-      // tinygltf would give every buffer without a uri the binary chunk.
-      if (!binary) fail(element("buffers", b), "no uri: a .gltf file's buffers are files or data: URIs");
-      if (b != 0) fail(element("buffers", b), "no uri: only buffers[0] of a .glb file is its binary chunk");
-      if (!has_binary_chunk) fail(element("buffers", b), "no uri, and the .glb file has no binary chunk");
-      continue;
-    }
-    const std::string& uri = buffers[b]["uri"].get_ref<const std::string&>();
-    const UriTarget target = resolve_uri(uri, element("buffers", b) + ".uri");
-    BufferRequest request{element("buffers", b) + " (" + printable(uri, 60) + ")", byte_length, "", target.file};
-    if (target.data()) {
-      if (base64_size(target.base64) != byte_length)
-        fail(element("buffers", b), "its data: URI holds " + std::to_string(base64_size(target.base64)) + " bytes, and byteLength says " +
-                                        std::to_string(byte_length));
-      if (tinygltf::IsDataURI(uri)) continue;  // one tinygltf decodes itself, found strict base64 above
-      request.base64 = std::string(target.base64);
-    }
-    access_.requests[tinygltf_buffer_request(base_dir, uri)].push_back(std::move(request));
-  }
-}
-
-void GltfReader::check_image_uris(const nlohmann::json& doc) const {
-  if (!doc.contains("images")) return;
-  const nlohmann::json& images = doc["images"];
-  for (size_t i = 0; i < images.size(); ++i)
-    if (images[i].contains("uri")) resolve_uri(images[i]["uri"].get<std::string>(), element("images", i) + ".uri");
 }
 
 // Before tinygltf, which would otherwise report what the extension changes (a Draco-compressed
@@ -1178,7 +591,7 @@ int32_t GltfReader::image_texture(int image, const std::string& where) {
   // A uri tinygltf left as it is: a file, or a data: URI of a type tinygltf does not decode.
   const bool by_uri = img.bufferView < 0 && img.image.empty();
   if (by_uri && img.uri.empty()) fail(element("images", size_t(image)), "no picture (neither a uri nor a bufferView with data)");
-  const UriTarget target = by_uri ? resolve_uri(img.uri, element("images", size_t(image)) + ".uri") : UriTarget{};
+  const UriTarget target = by_uri ? resolve_uri(img.uri, file_, element("images", size_t(image)) + ".uri") : UriTarget{};
   const std::string source = img.bufferView >= 0 ? "view " + std::to_string(img.bufferView)
                            : by_uri && !target.data() ? "file " + target.file.string() : "";
   if (const auto found = sources_.find(source); !source.empty() && found != sources_.end()) return image_textures_[image] = found->second;
@@ -1190,7 +603,7 @@ int32_t GltfReader::image_texture(int image, const std::string& where) {
     if (target.data()) {
       external = decode_base64(target.base64);
     } else {
-      if (!access_.allowed) fail(element("images", size_t(image)), "external files are not read here: " + printable(img.uri, 200));
+      if (!limits_.read_files) fail(element("images", size_t(image)), "external files are not read here: " + printable(img.uri, 200));
       InputFile input = read_input_file(target.file, kMaxPictureFileBytes);
       if (!input.error.empty()) throw SceneError(name + ": " + (input.error == "not found" ? "picture file not found" : input.error));
       scene_.files.push_back(target.file);
@@ -1296,14 +709,13 @@ GltfScene GltfReader::read(std::string_view bytes) {
     doc = parse_json_document(bytes, file_);
   }
   if (!doc.is_object()) fail("", "the JSON is not an object");
-  SchemaCheck(doc, file_).run();
+  check_gltf_schema(doc, file_);
   check_buffer_views(doc);
   check_required_extensions(doc);
-  resolve_buffers(doc, binary, has_binary_chunk);
-  check_image_uris(doc);
+  GltfFiles files(doc, file_, limits_.read_files, binary, has_binary_chunk);
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(keep_encoded, nullptr);
-  loader.SetFsCallbacks(tinygltf::FsCallbacks{file_exists, expand_path, read_whole_file, write_whole_file, &access_});
+  loader.SetFsCallbacks(files.callbacks());
   std::string err, warn;
   const std::string base_dir = file_.parent_path().string();
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
@@ -1320,13 +732,13 @@ GltfScene GltfReader::read(std::string_view bytes) {
   } catch (const std::exception& e) {  // tinygltf's own slips (std::out_of_range from .at()): the file's fault
     fail("", std::string("tinygltf could not read the file: ") + e.what());
   }
-  if (!access_.error.empty()) fail("", access_.error);  // a buffer vkray resolved could not be read
+  if (!files.error().empty()) fail("", files.error());  // a buffer vkray resolved could not be read
   if (!ok) {
     std::string message = err.empty() ? "tinygltf could not read the file" : err;
     std::replace(message.begin(), message.end(), '\n', ' ');
     fail("", printable(message, 400));
   }
-  scene_.files = access_.read;
+  scene_.files = files.read();
   warn_used_extensions();
   walk_nodes();
   return std::move(scene_);

@@ -1,10 +1,10 @@
 // glTF 2.0 files: a .gltf with its buffers and pictures, or a .glb. tinygltf (Debian's libtinygltf-dev)
 // parses them. Before it does, vkray checks every value of the document against glTF's schema (so that
-// nothing tinygltf would read leniently, as absent or as a default, gets through) and resolves every
-// URI itself; after it, every accessor range and index value before it reads anything through them. It
-// places the meshes of the default scene's node hierarchy in the file's world space. The metallic-
-// roughness material's base colour and emission (with their textures) become vkray's diffuse
-// materials; what vkray cannot render is named in one warning each.
+// nothing tinygltf would read leniently, as absent or as a default, gets through: gltf_schema.h) and
+// resolves every URI itself (gltf_uri.h); after it, every accessor range and index value before it
+// reads anything through them. It places the meshes of the default scene's node hierarchy in the
+// file's world space. The metallic-roughness material's base colour and emission (with their
+// textures) become vkray's diffuse materials; what vkray cannot render is named in one warning each.
 #pragma once
 
 #include <cstddef>
