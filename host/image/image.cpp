@@ -229,10 +229,11 @@ uint8_t encode_srgb8(float linear) {
   return static_cast<uint8_t>(bucket.value + (linear >= bucket.rise ? 1 : 0));
 }
 
-float decode_srgb8(uint8_t encoded) {
-  const float c = float(encoded) / 255.0f;
-  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+float decode_srgb(float encoded) {
+  return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
 }
+
+float decode_srgb8(uint8_t encoded) { return decode_srgb(float(encoded) / 255.0f); }
 
 LimitError out_of_host_memory(const std::filesystem::path& file, uint32_t width, uint32_t height) {
   return LimitError(file.string() + ": out of host memory for its " + std::to_string(width) + " x " +

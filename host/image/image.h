@@ -32,6 +32,9 @@ struct Image {
 // in [0, 1] that matters: each threshold and its neighbours).
 uint8_t encode_srgb8(float linear);
 uint8_t encode_srgb8_by_formula(float linear);
+// The sRGB transfer function, from an encoded fraction of full scale to linear light;
+// decode_srgb8(v) is decode_srgb(v / 255.0f).
+float decode_srgb(float encoded);
 float decode_srgb8(uint8_t encoded);
 
 // PNG (8-bit sRGB) and PFM (32-bit float linear, rows bottom to top, little-endian) files, each

@@ -1,6 +1,5 @@
 #include "scene/texture.h"
 
-#include <cmath>
 #include <vector>
 
 #include <Imath/half.h>
@@ -8,26 +7,21 @@
 #include "base/errors.h"
 #include "base/input_file.h"
 #include "image/decode.h"
+#include "image/image.h"
 
 namespace vkray {
 namespace {
 
 uint16_t half_bits(float value) { return Imath::half(value).bits(); }
 
-// The sRGB transfer function, from an encoded fraction of full scale to linear light: the formula
-// of decode_srgb8, which an 8-bit sample v and a 16-bit one v * 257 meet with the same float
-// (v / 255 and 257 v / 65535 are one quotient, rounded once), so both depths decode alike.
-float srgb_to_linear(float encoded) {
-  return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
-}
-
 // Each sample value of a depth once, decoded from sRGB (colour) or taken as linear (data and alpha),
-// rounded to a half float.
+// rounded to a half float. An 8-bit sample v and a 16-bit one v * 257 reach decode_srgb as the same
+// float (v / 255 and 257 v / 65535 are one quotient, rounded once), so both depths decode alike.
 std::vector<uint16_t> sample_halves(uint32_t max_value, bool srgb) {
   std::vector<uint16_t> halves(size_t(max_value) + 1);
   for (uint32_t v = 0; v <= max_value; ++v) {
     const float fraction = float(v) / float(max_value);
-    halves[v] = half_bits(srgb ? srgb_to_linear(fraction) : fraction);
+    halves[v] = half_bits(srgb ? decode_srgb(fraction) : fraction);
   }
   return halves;
 }
