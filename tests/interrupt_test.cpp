@@ -1,8 +1,17 @@
 // The interrupt request (base/interrupt.h) is polled by every long loop of the library: with a
 // request standing, each stage throws Cancelled at once instead of running on. signal_test.cpp
 // checks the same end to end, by the clock; these check each stage on its own.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -74,6 +83,104 @@ TEST_F(InterruptTest, ClearingTheRequestLetsWorkGoOn) {
   request_interrupt();
   clear_interrupt();
   EXPECT_NO_THROW(cpu::render_reference(cornell_, {16, 16, 1}));
+}
+
+// ---- Work in flight (a face that runs several at once: a render on each of several threads) ----
+
+TEST_F(InterruptTest, ARequestStandsUntilEveryPieceInFlightHasEnded) {
+  auto first = std::make_unique<WorkInFlight>();
+  auto second = std::make_unique<WorkInFlight>();
+  request_interrupt();
+  first.reset();
+  EXPECT_TRUE(interrupt_requested()) << "the second piece has not seen the request yet";
+  second.reset();
+  EXPECT_FALSE(interrupt_requested());
+}
+
+TEST_F(InterruptTest, APieceStartedWhileOthersStopWaitsForThemAndThenRuns) {
+  auto stopping = std::make_unique<WorkInFlight>();
+  request_interrupt();
+  std::atomic<bool> started{false}, saw_request{true};
+  std::thread later([&] {
+    const WorkInFlight piece;
+    saw_request = interrupt_requested();
+    started = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_FALSE(started) << "a piece started while the request stopped another";
+  stopping.reset();
+  later.join();
+  EXPECT_TRUE(started);
+  EXPECT_FALSE(saw_request);
+}
+
+TEST_F(InterruptTest, ARequestWithNothingInFlightIsForgottenByTheNextPiece) {
+  request_interrupt();
+  const WorkInFlight piece;
+  EXPECT_FALSE(interrupt_requested());
+  EXPECT_NO_THROW(cpu::render_reference(cornell_, {8, 8, 1}));
+}
+
+TEST_F(InterruptTest, StoppingWorkInFlightWaitsUntilItHasEnded) {
+  std::atomic<bool> registered{false}, stopped{false};
+  std::thread piece([&] {
+    const WorkInFlight in_flight;
+    registered = true;
+    while (!interrupt_requested()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // unwinding takes a while
+    stopped = true;
+  });
+  while (!registered) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  stop_work_in_flight();
+  EXPECT_TRUE(stopped);
+  piece.join();
+  EXPECT_FALSE(interrupt_requested());
+}
+
+// Runs `child` in a process made by fork() and returns its exit status, or -1 when it has not ended
+// within 10 s (it is killed then): a child that waits for the parent's threads waits for ever.
+int in_forked_child(const std::function<int()>& child) {
+  const pid_t pid = ::fork();
+  if (pid == 0) ::_exit(child());
+  for (int i = 0; i < 1000; ++i) {
+    int status = 0;
+    if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, nullptr, 0);
+  return -1;
+}
+
+TEST_F(InterruptTest, AForkedChildStartsWithNoWorkInFlightAndNoRequest) {
+  const WorkInFlight parents;
+  request_interrupt();  // the parent's piece is stopping: a piece of the parent's would wait for it
+  EXPECT_EQ(in_forked_child([] {
+              if (interrupt_requested()) return 1;
+              const WorkInFlight childs;  // the parent's piece is not in this process to end
+              request_interrupt();
+              return interrupt_requested() ? 0 : 2;
+            }),
+            0);
+  EXPECT_TRUE(interrupt_requested()) << "the child's request is its own";
+  uint64_t count = 0;
+  EXPECT_EQ(::read(interrupt_fd(), &count, sizeof count), ssize_t(sizeof count));
+  EXPECT_EQ(count, 1u) << "the parent's descriptor counted the child's request";
+}
+
+TEST_F(InterruptTest, AForkedChildDoesNotRemoveTheParentsTemporaryFiles) {
+  const test::TempDir dir;
+  std::string pattern = (dir / "out.png.XXXXXX").string();
+  const int fd = create_temporary_file(pattern);
+  ASSERT_GE(fd, 0);
+  EXPECT_EQ(in_forked_child([] {
+              remove_temporary_files();  // a forced exit of the child
+              return 0;
+            }),
+            0);
+  EXPECT_TRUE(std::filesystem::exists(pattern));
+  unregister_temporary_file(pattern);
+  ::close(fd);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "base/interrupt.h"
 
+#include <pthread.h>
 #include <sys/eventfd.h>
 #include <stdlib.h>
 #include <unistd.h>
@@ -8,10 +9,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
 #include <mutex>
 #include <vector>
 
 #include "base/errors.h"
+#include "base/threads.h"
 
 namespace vkray {
 namespace {
@@ -19,17 +22,41 @@ namespace {
 std::atomic<bool> requested{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "request_interrupt() must be async-signal-safe");
 // Created before main(), so that request_interrupt() never has to create it.
-const int event_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+int event_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
 
 struct TemporaryFiles {
   std::mutex mutex;
   std::vector<std::filesystem::path> files;
   bool closed = false;  // set by remove_temporary_files(): the process is about to end
 };
-TemporaryFiles& temporary_files() {
-  static TemporaryFiles* files = new TemporaryFiles;  // never destroyed: a forced exit may use it late
-  return *files;
+PerProcess<TemporaryFiles>& temporary_files_slot() {
+  static PerProcess<TemporaryFiles> files;  // a forced exit may use it late
+  return files;
 }
+TemporaryFiles& temporary_files() { return temporary_files_slot().get(); }
+
+struct Flight {
+  std::mutex mutex;
+  std::condition_variable ended;  // notified when the count falls to 0
+  size_t count = 0;
+};
+PerProcess<Flight>& flight_slot() {
+  static PerProcess<Flight> flight;
+  return flight;
+}
+Flight& flight() { return flight_slot().get(); }
+
+// A forked child has one thread, the one that called fork(): the parent's work in flight, its
+// request and its temporary files (which the child must not remove) stay the parent's, and the
+// parent's descriptor would share its counter.
+void in_forked_child() noexcept {
+  requested.store(false, std::memory_order_relaxed);
+  ::close(event_fd);
+  event_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+  temporary_files_slot().remake();
+  flight_slot().remake();
+}
+[[maybe_unused]] const int fork_handler = ::pthread_atfork(nullptr, nullptr, in_forked_child);
 
 }  // namespace
 
@@ -47,6 +74,30 @@ void clear_interrupt() noexcept {
 int interrupt_fd() noexcept { return event_fd; }
 void throw_if_interrupted() {
   if (interrupt_requested()) throw Cancelled();
+}
+
+WorkInFlight::WorkInFlight() {
+  Flight& f = flight();
+  std::unique_lock lock(f.mutex);
+  f.ended.wait(lock, [&] { return f.count == 0 || !interrupt_requested(); });
+  if (f.count == 0 && interrupt_requested()) clear_interrupt();  // nothing was in flight to stop
+  ++f.count;
+}
+
+WorkInFlight::~WorkInFlight() {
+  Flight& f = flight();
+  const std::lock_guard lock(f.mutex);
+  if (--f.count > 0) return;
+  if (interrupt_requested()) clear_interrupt();
+  f.ended.notify_all();
+}
+
+void stop_work_in_flight() noexcept {
+  Flight& f = flight();
+  std::unique_lock lock(f.mutex);
+  if (f.count == 0) return;
+  request_interrupt();
+  f.ended.wait(lock, [&] { return f.count == 0; });
 }
 
 int create_temporary_file(std::string& pattern) {

@@ -3,6 +3,10 @@
 // of the library (reading files, parsing meshes, building the BVH, packing, both renderers, writing
 // images) polls it and throws Cancelled, so whatever stage a signal arrives in ends within a
 // fraction of a second, unwinding normally and writing nothing.
+//
+// A child made by fork() starts with no request, no work in flight and no temporary files of its
+// own: the parent's threads did not come along, and what they held must not stall or remove anything
+// in the child.
 #pragma once
 
 #include <filesystem>
@@ -21,6 +25,23 @@ void clear_interrupt() noexcept;
 int interrupt_fd() noexcept;
 // Throws Cancelled when a stop was requested.
 void throw_if_interrupted();
+
+// ---- Work in flight ------------------------------------------------------------------------------
+// A face that runs several pieces of work at once (the Python module: a render on each of several
+// threads) marks each with a WorkInFlight while it runs. A request then stands until every piece in
+// flight when it came has ended, and a piece that starts meanwhile waits for that first: no piece's
+// end can hide the request from another, and none starts already stopped. A request that finds
+// nothing in flight (a Ctrl-C between renders) is forgotten when the next piece starts. A face that
+// runs one piece and then exits (the command line) needs none of this.
+class WorkInFlight {
+ public:
+  WorkInFlight();
+  ~WorkInFlight();
+  WorkInFlight(const WorkInFlight&) = delete;
+  WorkInFlight& operator=(const WorkInFlight&) = delete;
+};
+// Requests a stop when work is in flight and waits until none is (a process about to end).
+void stop_work_in_flight() noexcept;
 
 // ---- Files that must not outlive a forced exit -----------------------------------------------------
 // A temporary output is created here and registered while it exists. If a stage cannot stop in time

@@ -1,5 +1,7 @@
 #include "gpu/instance.h"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <mutex>
 #include <string>
@@ -7,6 +9,7 @@
 #include <vector>
 
 #include "base/errors.h"
+#include "base/threads.h"
 
 namespace vkray::gpu {
 namespace {
@@ -39,6 +42,21 @@ std::shared_ptr<Instance> make_instance(bool validation) {
   return result;
 }
 
+// The instances of this process. Never destroyed: destroying them in static teardown could race a
+// device left running work (Context::abandon_work()), and nobody would read the validation layer's
+// report then. A child made by fork() starts with none: the parent's instances came along without
+// the driver's threads (lavapipe's compute threads, for one), so a device made from them waits for
+// ever for its first submission; they are left as they are, never used nor destroyed there.
+struct Instances {
+  std::mutex mutex;  // a fresh one in a forked child: a parent's thread may have held this one
+  std::shared_ptr<Instance> slots[2];  // without, with validation
+};
+Instances& instances() {
+  static PerProcess<Instances> all;
+  [[maybe_unused]] static const int remade = ::pthread_atfork(nullptr, nullptr, [] { all.remake(); });
+  return all.get();
+}
+
 }  // namespace
 
 std::string api_version_string(uint32_t v) {
@@ -47,12 +65,9 @@ std::string api_version_string(uint32_t v) {
 }
 
 std::shared_ptr<const Instance> shared_instance(bool validation) {
-  static std::mutex mutex;
-  // Never destroyed: destroying them in static teardown could race a device left running work
-  // (Context::abandon_work()), and nobody would read the validation layer's report then.
-  static auto* const instances = new std::shared_ptr<Instance>[2];
-  std::lock_guard lock(mutex);
-  auto& slot = instances[validation ? 1 : 0];
+  Instances& all = instances();
+  const std::lock_guard lock(all.mutex);
+  auto& slot = all.slots[validation ? 1 : 0];
   if (!slot) slot = make_instance(validation);
   return slot;
 }

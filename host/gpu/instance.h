@@ -9,6 +9,11 @@
 // instances after about 60 such cycles in one process (vkCreateInstance: ErrorIncompatibleDriver,
 // for every test after that), and other projects report the same driver corrupting state over
 // repeated instance cycles. Devices are still created and destroyed per Context.
+//
+// A child made by fork() makes instances of its own: the parent's came along without the driver's
+// threads, and a device made from them would wait for ever for its first submission. A Context the
+// parent opened is of no use in the child (its device is the parent's) and must not be destroyed
+// there either: the driver would wait for threads that are not there.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +31,7 @@ struct Instance {
 
 // The instance for `validation` (VK_LAYER_KHRONOS_validation with synchronization validation and
 // VK_EXT_debug_utils, or neither). Throws DeviceError when the loader is older than Vulkan 1.2 or the
-// layer is missing; a later call tries again. Thread-safe.
+// layer is missing; a later call tries again. Thread-safe; in a forked child, the child's own.
 std::shared_ptr<const Instance> shared_instance(bool validation);
 
 // A Vulkan version number as "1.3.230".
