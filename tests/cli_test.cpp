@@ -292,12 +292,36 @@ TEST(CliTest, IntegersAreDecimal) {
   const Result run = vkray("render --width 0100 --height 00064 --spp 010 -q -o out.png", dir.path());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   expect_png_size(dir / "out.png", 100, 64);
-  for (const char* value : {"0x40", "+5", "-5", "1e2", "64px", "' 64'"}) {
+  for (const char* value : {"0x40", "+5", "1e2", "64px", "' 64'", "-", "--5"}) {
     const Result bad = vkray(std::string("render --width ") + value + " -o bad.png", dir.path());
     EXPECT_EQ(bad.exit_code, 2) << value;
     EXPECT_NE(bad.err.find("--width: expected a decimal integer"), std::string::npos) << bad.err;
   }
   EXPECT_EQ(vkray("bench --repeat 0x2", dir.path()).exit_code, 2);
+  EXPECT_EQ(vkray("bench --repeat -2", dir.path()).exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.png"));
+}
+
+// A number out of its range, negative or past any integer type, is refused with the library's limit
+// (session/options.h) and its message, the one the Python module raises as vkray.UsageError.
+TEST(CliTest, NumbersOutOfRangeSayTheirLimit) {
+  TempDir dir;
+  const std::pair<const char*, const char*> cases[] = {
+      {"render --width -5 -o bad.png", "--width: expected an integer from 1 to 16384, got -5"},
+      {"render --height 16385 -o bad.png", "--height: expected an integer from 1 to 16384, got 16385"},
+      {"render --spp 99999999999999999999999 -o bad.png", "--spp: expected an integer from 1 to 65536, got 99999999999999999999999"},
+      {"render --seed -1 -o bad.png", "--seed: expected an integer from 0 to 4294967295, got -1"},
+      {"render --seed 4294967296 -o bad.png", "--seed: expected an integer from 0 to 4294967295, got 4294967296"},
+      {"render --renderer cpu --threads 1000000 -o bad.png", "--threads: expected an integer from 1 to 256, got 1000000"},
+      {"parity --threads 0", "--threads: expected an integer from 1 to 256, got 0"},
+      {"render --tile-timeout 0 -o bad.png", "--tile-timeout: expected an integer from 1 to 3600000, got 0"},
+  };
+  for (const auto& [args, message] : cases) {
+    const Result bad = vkray(args, dir.path());
+    EXPECT_EQ(bad.exit_code, 2) << args;
+    EXPECT_NE(bad.err.find(message), std::string::npos) << bad.err;
+  }
+  EXPECT_EQ(vkray("render --seed 4294967295 --width 8 --height 8 -q -o max-seed.png", dir.path()).exit_code, 0);
   EXPECT_FALSE(std::filesystem::exists(dir / "bad.png"));
 }
 

@@ -11,14 +11,47 @@ namespace vkray::cli {
 
 const std::string kExitCodes = exit_codes_help();
 
+namespace {
+
+constexpr const char* kLimitCheck = "limit";
+
+// The library's limit (session/options.h) as a check of the flag's text, with the library's message,
+// negative numbers included. What is not an integer at all is the decimal rule's (apply_value_rules).
+CLI::Validator within(const ArgumentLimit& limit) {
+  return CLI::Validator(
+      [limit](std::string& text) -> std::string {
+        const bool negative = text.starts_with('-');
+        const std::string_view digits = std::string_view(text).substr(negative ? 1 : 0);
+        if (digits.empty() || digits.find_first_not_of("0123456789") != std::string_view::npos) return "";
+        const std::string_view significant = digits.substr(std::min(digits.find_first_not_of('0'), digits.size()));
+        if (negative || significant.size() > 10) return limit.expected(text);  // past every limit, and an int64_t
+        return limit.contains(significant.empty() ? 0 : std::stoll(std::string(significant))) ? "" : limit.expected(text);
+      },
+      "UINT in [" + std::to_string(limit.min) + " - " + std::to_string(limit.max) + "]", kLimitCheck);
+}
+
+// Whether the option has a within() check, which says what is wrong with a negative number.
+bool has_limit(CLI::Option& option) {
+  try {
+    option.get_validator(kLimitCheck);
+    return true;
+  } catch (const CLI::OptionNotFound&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 void add_scene_flags(CLI::App& command, SceneFlags& flags) {
   command.add_option("scene", flags.scene, "Scene file (default: the Cornell box, scenes/cornell.json)");
-  command.add_option("--width", flags.width, "Image width in pixels (overrides the scene)")->check(CLI::Range(1u, kMaxImageSide));
-  command.add_option("--height", flags.height, "Image height in pixels (overrides the scene)")->check(CLI::Range(1u, kMaxImageSide));
-  command.add_option("--spp", flags.spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1u, kMaxSamplesPerPixel));
-  command.add_option("--seed", flags.seed,
-                     "Seed of the sample streams (overrides the scene's; default 0): renders with different seeds are "
-                     "independent and can be averaged");
+  command.add_option("--width", flags.width, "Image width in pixels (overrides the scene)")->check(within(kWidthArgument));
+  command.add_option("--height", flags.height, "Image height in pixels (overrides the scene)")->check(within(kHeightArgument));
+  command.add_option("--spp", flags.spp, "Samples per pixel (overrides the scene)")->check(within(kSppArgument));
+  command
+      .add_option("--seed", flags.seed,
+                  "Seed of the sample streams (overrides the scene's; default 0): renders with different seeds are "
+                  "independent and can be averaged")
+      ->check(within(kSeedArgument));
 }
 
 void add_region_flag(CLI::App& command, SceneFlags& flags) {
@@ -52,7 +85,7 @@ void add_gpu_flags(CLI::App& command, GpuFlags& flags, bool inline_scene) {
       .add_option("--tile-timeout", flags.tile_timeout_ms,
                   "Longest one GPU submission (a tile) may run, in milliseconds, before the render fails with exit 3 "
                   "(default 60000)")
-      ->check(CLI::Range(1, 3600000));
+      ->check(within(kTileTimeoutArgument));
   if (!inline_scene) return;
   static const std::map<std::string, InlineScene> names{
       {"auto", InlineScene::automatic}, {"always", InlineScene::always}, {"never", InlineScene::never}};
@@ -67,18 +100,22 @@ void add_gpu_flags(CLI::App& command, GpuFlags& flags, bool inline_scene) {
 }
 
 void add_cpu_flags(CLI::App& command, CpuFlags& flags, const std::string& description) {
-  command.add_option("--threads", flags.threads, description)->check(CLI::Range(1, 256));
+  command.add_option("--threads", flags.threads, description)->check(within(kThreadsArgument));
 }
 
 void apply_value_rules(CLI::App& app) {
-  const CLI::Validator decimal(
-      [](std::string& value) -> std::string {
-        if (value.empty() || value.find_first_not_of("0123456789") != std::string::npos)
-          return "expected a decimal integer, got \"" + printable(value) + "\"";
-        value.erase(0, std::min(value.find_first_not_of('0'), value.size() - 1));
-        return "";
-      },
-      "");
+  // `limited`: a negative number is left for the limit to refuse.
+  const auto decimal = [](bool limited) {
+    return CLI::Validator(
+        [limited](std::string& value) -> std::string {
+          const size_t start = limited && value.starts_with('-') ? 1 : 0;
+          if (value.size() == start || value.find_first_not_of("0123456789", start) != std::string::npos)
+            return "expected a decimal integer, got \"" + printable(value) + "\"";
+          if (start == 0) value.erase(0, std::min(value.find_first_not_of('0'), value.size() - 1));
+          return "";
+        },
+        "");
+  };
   const CLI::Validator not_empty([](std::string& value) { return value.empty() ? "the value is empty" : ""; }, "");
   for (CLI::App* command : app.get_subcommands({})) {
     apply_value_rules(*command);
@@ -86,7 +123,7 @@ void apply_value_rules(CLI::App& app) {
       if (option->get_expected_min() == 0) continue;  // a flag
       // "UINT", or "UINT:INT in [1 - 16384]" with a range check.
       const std::string type = option->get_type_name().substr(0, option->get_type_name().find(':'));
-      if (type == "INT" || type == "UINT") option->transform(decimal);
+      if (type == "INT" || type == "UINT") option->transform(decimal(has_limit(*option)));
       else if (type == "TEXT") option->check(not_empty);
     }
   }

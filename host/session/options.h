@@ -8,13 +8,40 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 
+#include "base/errors.h"
+#include "base/threads.h"
 #include "image/aovs.h"
 #include "image/image.h"
 #include "scene/scene.h"
 #include "session/regions.h"
 
 namespace vkray {
+
+// ---- The numbers a caller gives ------------------------------------------------------------------
+// One entry for each number a face takes (a flag of the command line, a keyword argument of the
+// Python module), so that every face checks the same range and says the same thing; image_settings()
+// checks RenderOptions against the same entries for any other caller of the library.
+struct ArgumentLimit {
+  std::string_view name;  // as Python spells it; the command line's flag is --name, with '-' for '_'
+  uint32_t min, max;
+
+  bool contains(int64_t value) const { return value >= int64_t(min) && value <= int64_t(max); }
+  // "expected an integer from 1 to 16384, got 0", `got` as the caller wrote the value: what the
+  // command line prints after the flag's name ("--width: ...").
+  std::string expected(std::string_view got) const;
+  // UsageError("width: " + expected(got)).
+  UsageError error(std::string_view got) const;
+};
+
+inline constexpr ArgumentLimit kWidthArgument{"width", 1, kMaxImageSide};
+inline constexpr ArgumentLimit kHeightArgument{"height", 1, kMaxImageSide};
+inline constexpr ArgumentLimit kSppArgument{"spp", 1, kMaxSamplesPerPixel};
+inline constexpr ArgumentLimit kSeedArgument{"seed", 0, UINT32_MAX};
+inline constexpr ArgumentLimit kThreadsArgument{"threads", 1, kMaxThreads};  // not given: thread_count()'s default
+inline constexpr ArgumentLimit kTileTimeoutArgument{"tile_timeout", 1, 3600000};  // milliseconds
+inline constexpr ArgumentLimit kBandCountArgument{"count", 1, kMaxBands};       // vkray.bands(scene, count)
 
 // The device a session opens, and the shaders it compiles.
 struct SessionOptions {
@@ -45,7 +72,8 @@ struct RenderOptions {
   InlineScene inline_scene = InlineScene::automatic;
   std::chrono::milliseconds tile_timeout{60000};
   uint32_t tile_side = 0;
-  // CPU reference: threads (0: one per hardware thread). The image does not depend on it.
+  // CPU reference: threads (0: one per hardware thread; at most kMaxThreads). The image does not
+  // depend on it.
   unsigned threads = 0;
   // Called as the render proceeds with the unit ("pixels" on the GPU, "rows" on the CPU), the units
   // done and the units in all.
@@ -53,8 +81,9 @@ struct RenderOptions {
   // A render stops on an interrupt request (base/interrupt.h) and throws Cancelled.
 };
 
-// The scene's image settings with the options' overrides. Throws UsageError for an override out of
-// the range a scene file may give (1 to 16384 pixels, 1 to 65536 samples).
+// The scene's image settings with the options' overrides. Every render resolves them first, so this
+// is also where the options' numbers are checked: throws UsageError for an override, a thread count
+// or a tile timeout outside its ArgumentLimit (an override's is the range a scene file may give).
 ImageSettings image_settings(const Scene& scene, const RenderOptions& options);
 
 struct RenderStats {
