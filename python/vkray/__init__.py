@@ -14,19 +14,22 @@ top row first, exactly what ``vkray render -o x.pfm`` writes.
 
 ``vkray.Renderer`` keeps the device, the compiled shaders, the mesh files and the last scene on the
 device between renders, so that a loop that moves the camera or edits lights and materials uploads
-only what changed. Rendering releases the GIL; Ctrl-C stops a render within a fraction of a second
-and raises KeyboardInterrupt.
+only what changed. Rendering releases the GIL; Ctrl-C stops every render, on any thread, within a
+fraction of a second, each raising KeyboardInterrupt. Arguments are checked as the command line
+checks its options (UsageError); docs/python.md says how a program may end during a render, and how
+processes made by fork() render.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import operator
 import os
 import sys
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any, Optional, Union
+from typing import Any, NoReturn, Optional, Union
 
 try:
     import numpy as np
@@ -65,54 +68,125 @@ RenderOutput = Union[np.ndarray, dict[str, np.ndarray]]
 _DICT_NAME = "<scene dict>"
 
 
-def _json_value(value: Any) -> Any:
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, os.PathLike):
-        return os.fspath(value)
-    raise TypeError(f"a {type(value).__name__} is not a value a scene can hold")
+def _scene_data(scene: Mapping[str, Any], file: str) -> Any:
+    """The scene dict as plain JSON data, or a SceneError naming the key path of the first value JSON
+    cannot hold (NaN, infinity, a complex number, any other object), as the scene parser names a key."""
+
+    def fail(path: str, what: str) -> NoReturn:
+        raise SceneError(f"{file}: {path or 'top level'}: {what}")
+
+    def cannot_hold(path: str, value: Any) -> NoReturn:
+        fail(path, f"a Python {type(value).__name__} is not a value a scene can hold")
+
+    def text(path: str, value: str) -> str:
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError:
+            fail(path, f"{value!r} is not valid Unicode text")
+        return str(value)
+
+    def finite(path: str, value: float) -> float:
+        if not math.isfinite(value):
+            fail(path, f"{value} is not a value a scene can hold (JSON has no NaN or infinity)")
+        return float(value)
+
+    def plain(value: Any, path: str, depth: int) -> Any:
+        if isinstance(value, np.ndarray):
+            if value.dtype.kind == "f" and not np.isfinite(value).all():  # one test for the whole array
+                index = tuple(np.argwhere(~np.isfinite(value))[0])
+                finite(path + "".join(f"/{i}" for i in index), float(value[index]))
+            if value.dtype.kind in "biuf":
+                return value.tolist()
+            value = value.tolist()
+        elif isinstance(value, np.generic):
+            value = value.item()
+        elif isinstance(value, os.PathLike):
+            value = os.fsdecode(value)
+        if value is None or isinstance(value, bool):
+            return value
+        if isinstance(value, str):
+            return text(path, value)
+        if isinstance(value, int):
+            return int(value)
+        if isinstance(value, float):
+            return finite(path, value)
+        if isinstance(value, (Mapping, list, tuple)) and depth >= _vkray._MAX_JSON_DEPTH:
+            return {} if isinstance(value, Mapping) else []  # too deep: the scene parser refuses it, in its words
+        if isinstance(value, Mapping):
+            out = {}
+            for key, item in value.items():
+                if not isinstance(key, str):
+                    fail(path, f"a key is text, not a {type(key).__name__} ({key!r})")
+                out[text(path, key)] = plain(item, f"{path}/{key}", depth + 1)
+            return out
+        if isinstance(value, (list, tuple)):
+            return [plain(item, f"{path}/{i}", depth + 1) for i, item in enumerate(value)]
+        cannot_hold(path, value)
+
+    return plain(scene, "", 0)
 
 
 def _source(scene: Scene, base_dir: Optional[Union[str, "os.PathLike[str]"]]) -> Any:
     if isinstance(scene, (str, os.PathLike)):
         if base_dir is not None:
             raise UsageError("base_dir is for scene dicts: a scene file's paths resolve against its own folder")
-        return _vkray._SceneSource(os.fspath(scene))
+        return _vkray._SceneSource(_path("scene", scene))
     if isinstance(scene, Mapping):
-        folder = Path(base_dir) if base_dir is not None else Path.cwd()
-        try:
-            text = json.dumps(scene, default=_json_value, allow_nan=False)
-        except (TypeError, ValueError) as e:
-            raise SceneError(f"{folder / _DICT_NAME}: {e}") from None
-        return _vkray._SceneSource(os.fspath(folder / _DICT_NAME), text)
-    raise UsageError(f"a scene is a file name or a dict, not a {type(scene).__name__}")
+        folder = Path(_path("base_dir", base_dir)) if base_dir is not None else Path.cwd()
+        file = os.fspath(folder / _DICT_NAME)
+        return _vkray._SceneSource(file, json.dumps(_scene_data(scene, file), allow_nan=False))
+    raise UsageError(f"scene: expected a file name or a dict, got a {type(scene).__name__}")
+
+
+def _path(name: str, value: Any) -> str:
+    try:
+        return os.fsdecode(value)
+    except TypeError:
+        raise UsageError(f"{name}: expected a file name, got {value!r}") from None
+
+
+def _flag(name: str, value: Any) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise UsageError(f"{name}: expected True or False, got {value!r}")
+    return bool(value)
 
 
 def _pass_names(aovs: Union[str, Iterable[str]]) -> list[str]:
-    names = [aovs] if isinstance(aovs, str) else list(aovs)
-    return [n for name in names for n in name.split(",")] if names else []
+    if isinstance(aovs, str):
+        names = [aovs]
+    elif isinstance(aovs, Iterable) and not isinstance(aovs, (bytes, bytearray)):
+        names = list(aovs)
+    else:
+        names = [aovs]
+    if not all(isinstance(name, str) for name in names):
+        raise UsageError(f"aovs: expected names of passes ({', '.join(AOVS)}), got {aovs!r}")
+    return [n for name in names for n in name.split(",")]
 
 
 def _region_text(region: Optional[Region]) -> Optional[str]:
     if region is None or isinstance(region, str):
         return region
-    try:
-        # operator.index: whole numbers (numpy's too), never a float cut down to one.
-        x0, y0, x1, y1 = (operator.index(v) for v in region)
-    except (TypeError, ValueError):
-        raise UsageError(f"a region is (x0, y0, x1, y1) or 'I/N', not {region!r}") from None
-    if min(x0, y0, x1, y1) < 0:
+    bounds = None
+    if isinstance(region, (tuple, list)) or (isinstance(region, np.ndarray) and region.ndim == 1):
+        # operator.index: whole numbers (numpy's too), never a float cut down to one, nor a bool.
+        if len(region) == 4 and not any(isinstance(v, (bool, np.bool_)) for v in region):
+            try:
+                bounds = [operator.index(v) for v in region]
+            except TypeError:
+                pass
+    if bounds is None:
+        raise UsageError(f"a region is (x0, y0, x1, y1) or 'I/N', not {region!r}")
+    if min(bounds) < 0:
         raise UsageError(f"region {region!r}: pixel bounds are not negative")
-    return f"{x0},{y0},{x1},{y1}"
+    return ",".join(map(str, bounds))
 
 
 def _request(width: Optional[int], height: Optional[int], spp: Optional[int], seed: Optional[int],
              aovs: Union[str, Iterable[str]], region: Optional[Region], output: Any = None,
              exr_float: bool = False) -> Any:
+    # The numbers are checked against the library's limits, as the command line checks its flags.
     return _vkray._Request(width, height, spp, seed, _pass_names(aovs), _region_text(region),
-                           None if output is None else os.fspath(output), exr_float)
+                           None if output is None else _path("output", output), _flag("exr_float", exr_float))
 
 
 class Renderer:
@@ -135,8 +209,8 @@ class Renderer:
 
     def __init__(self, device: Optional[str] = None, *, validate: bool = False,
                  shader_dir: Optional[Union[str, "os.PathLike[str]"]] = None) -> None:
-        self._renderer = _vkray._Renderer(None if device is None else str(device), validate,
-                                          None if shader_dir is None else os.fspath(shader_dir))
+        self._renderer = _vkray._Renderer(None if device is None else str(device), _flag("validate", validate),
+                                          None if shader_dir is None else _path("shader_dir", shader_dir))
 
     def render(self, scene: Scene, *, width: Optional[int] = None, height: Optional[int] = None,
                spp: Optional[int] = None, seed: Optional[int] = None, aovs: Union[str, Iterable[str]] = (),
@@ -197,11 +271,11 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
         region: only these pixels: (x0, y0, x1, y1), bounds in the full image (half-open), or "I/N",
             band I of N bands of about equal work (``vkray.bands``). Each pixel is the same as in the
             full render; the arrays hold the region alone.
-        threads: for "cpu": threads to use; 0, one per hardware thread.
+        threads: for "cpu": threads to use, 1 to 256; 0, one per hardware thread.
 
     Raises:
         SceneError: the scene or a file it names cannot be used (the message names the file and key).
-        UsageError: an argument is out of range.
+        UsageError: an argument is out of range or of the wrong kind (the message names it).
         DeviceError: no such device, or the device failed.
         KeyboardInterrupt: Ctrl-C, within a fraction of a second.
     """
@@ -224,7 +298,7 @@ def parity(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
     first-hit passes, as ``vkray parity`` does. Returns the keys ``vkray parity --json`` prints;
     ``result["pass"]`` says whether they agree within the tolerance (``result["tolerance"]``)."""
     return json.loads(_vkray.parity(_source(scene, base_dir), width, height, spp, seed,
-                                    None if device is None else str(device), validate, threads))
+                                    None if device is None else str(device), _flag("validate", validate), threads))
 
 
 def bands(scene: Scene, count: int, *, width: Optional[int] = None, height: Optional[int] = None,
@@ -241,7 +315,7 @@ def merge(output: Union[str, "os.PathLike[str]"], parts: Iterable[Union[str, "os
     the image. Returns what was merged: parts, width, height, spp, seed, scene_digest,
     mixed_devices (parts of several devices agree within parity, not bit for bit) and
     passes_dropped (only an .exr output keeps first-hit passes)."""
-    return _vkray.merge(os.fspath(output), [os.fspath(p) for p in parts])
+    return _vkray.merge(_path("output", output), [_path("parts", p) for p in parts])
 
 
 def devices() -> list[dict[str, Any]]:
