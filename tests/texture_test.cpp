@@ -84,6 +84,8 @@ TEST(TextureTest, DecodesSrgbToLinearHalves) {
 // The files are written with libpng's full API so that each test states exactly what its file holds.
 
 // One pixel's worth of samples (and the file around them), in the order the colour type stores them.
+// Each case below names only the fields it sets; the others keep their defaults, as intended.
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 struct PngSpec {
   int bit_depth = 8;
   int colour_type = PNG_COLOR_TYPE_RGB;
