@@ -32,6 +32,10 @@
 namespace vkray::cli {
 namespace {
 
+// A benchmark's image is at least 8 pixels on a side (a workgroup); the rest as a render's.
+constexpr ArgumentLimit kBenchWidthArgument{"width", 8, kMaxImageSide};
+constexpr ArgumentLimit kBenchHeightArgument{"height", 8, kMaxImageSide};
+
 struct BenchArgs {
   std::vector<std::string> scenes{"cornell", "bunny", "dragon", "dragon-field"};  // in scenes/
   uint32_t width = 1024, height = 1024;
@@ -252,8 +256,8 @@ Command add_bench_command(CLI::App& app) {
                "fixed scenes, alternately in one run. Prints a table (or --json); never fails on the numbers.");
   command->add_option("--scenes", args->scenes, "Scene names in scenes/ (default: cornell bunny dragon dragon-field)")
       ->delimiter(',');
-  command->add_option("--width", args->width, "Image width")->check(CLI::Range(8u, kMaxImageSide));
-  command->add_option("--height", args->height, "Image height")->check(CLI::Range(8u, kMaxImageSide));
+  command->add_option("--width", args->width, "Image width")->check(within(kBenchWidthArgument));
+  command->add_option("--height", args->height, "Image height")->check(within(kBenchHeightArgument));
   command->add_option("--repeat", args->repeat, "Rounds per scene; the median is reported")->check(CLI::Range(1, 100));
   add_cpu_flags(*command, args->cpu,
                 "Threads for the CPU reference, Embree and both BVH builds (default: one per hardware thread)");

@@ -322,8 +322,8 @@ Command add_check_command(CLI::App& app) {
   add_device_flags(*command, args->device);
   add_gpu_flags(*command, args->gpu, /*inline_scene=*/false);
   add_cpu_flags(*command, args->cpu, "CPU reference threads (default: one per hardware thread)");
-  command->add_option("--width", args->width, "Image width of every case (default 256)")->check(CLI::Range(1u, kMaxImageSide));
-  command->add_option("--height", args->height, "Image height of every case (default 256)")->check(CLI::Range(1u, kMaxImageSide));
+  command->add_option("--width", args->width, "Image width of every case (default 256)")->check(within(kWidthArgument));
+  command->add_option("--height", args->height, "Image height of every case (default 256)")->check(within(kHeightArgument));
   command->add_option("--case", args->cases, "Run only this scene's cases (the file's name without .json); repeatable");
   command->add_option("--junit", args->junit, "Also write the results as JUnit XML, for CI systems");
   command->add_option("--failures", args->failures, "Folder for the heatmaps of failing cases (default vkray-check-failures)");

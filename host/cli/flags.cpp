@@ -15,8 +15,18 @@ namespace {
 
 constexpr const char* kLimitCheck = "limit";
 
-// The library's limit (session/options.h) as a check of the flag's text, with the library's message,
-// negative numbers included. What is not an integer at all is the decimal rule's (apply_value_rules).
+// Whether the option has a within() check, which says what is wrong with a negative number.
+bool has_limit(CLI::Option& option) {
+  try {
+    option.get_validator(kLimitCheck);
+    return true;
+  } catch (const CLI::OptionNotFound&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 CLI::Validator within(const ArgumentLimit& limit) {
   return CLI::Validator(
       [limit](std::string& text) -> std::string {
@@ -29,18 +39,6 @@ CLI::Validator within(const ArgumentLimit& limit) {
       },
       "UINT in [" + std::to_string(limit.min) + " - " + std::to_string(limit.max) + "]", kLimitCheck);
 }
-
-// Whether the option has a within() check, which says what is wrong with a negative number.
-bool has_limit(CLI::Option& option) {
-  try {
-    option.get_validator(kLimitCheck);
-    return true;
-  } catch (const CLI::OptionNotFound&) {
-    return false;
-  }
-}
-
-}  // namespace
 
 void add_scene_flags(CLI::App& command, SceneFlags& flags) {
   command.add_option("scene", flags.scene, "Scene file (default: the Cornell box, scenes/cornell.json)");

@@ -35,6 +35,11 @@ struct CpuFlags {
   unsigned threads = 0;
 };
 
+// The library's limit (session/options.h) as a check of a flag's text, with the library's message,
+// negative numbers included ("--width: expected an integer from 1 to 16384, got -5"). What is not an
+// integer at all is the decimal rule's (apply_value_rules).
+CLI::Validator within(const ArgumentLimit& limit);
+
 void add_scene_flags(CLI::App& command, SceneFlags& flags);
 void add_region_flag(CLI::App& command, SceneFlags& flags);
 // `validate`: whether the command offers --validate (`vkray bench` measures without the layer).
