@@ -373,6 +373,9 @@ def test_sigterm_stops_the_job_and_writes_nothing(scenes, tmp_path):
     (["{scenes}/cornell.json", "-o", "x.pfm", "--height", "8", "--regions", "9"], 2, "1 to 8"),
     (["{scenes}/cornell.json", "-o", "x.exr", "--aov", "depth,shadows"], 2, 'unknown pass "shadows"'),
     (["{scenes}/cornell.json", "-o", "x.pfm", "--seed", "-1"], 2, "--seed: -1 is not from 0"),
+    # Past the library's limits: the words `vkray render` uses for its flags.
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--width", "20000"], 2, "--width: expected an integer from 1 to 16384, got 20000"),
+    (["{scenes}/cornell.json", "-o", "x.pfm", "--spp", "70000"], 2, "--spp: expected an integer from 1 to 65536, got 70000"),
     (["{scenes}/cornell.json", "-o", "x.pfm", "--spp", "many"], 2, "--spp: 'many' is not a whole number"),
     (["{scenes}/cornell.json", "-o", "x.pfm", "--scheduler", "tcp://127.0.0.1:1", "--worker-timeout", "2"], 3,
      "cannot reach the scheduler at tcp://127.0.0.1:1"),

@@ -266,6 +266,12 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     # The library's own checks of an output, so that the farm refuses what `vkray render -o` refuses,
     # with the same message and exit code.
     vkray._vkray._check_output(output, aovs, args.exr_float, False)
+    # The numbers against the library's table of limits, which `vkray render` checks its flags with:
+    # the same range and words, "--width: expected an integer from 1 to 16384, got 20000".
+    try:
+        vkray._request(args.width, args.height, args.spp, args.seed, (), None)
+    except vkray.UsageError as e:
+        raise _Usage(f"--{e}") from None
     suffix = _PART_SUFFIX[output.suffix.lower()]
     settings = {"width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed, "aovs": args.aov,
                 "exr_float": args.exr_float}
