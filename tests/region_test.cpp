@@ -418,7 +418,8 @@ TEST(MergeTest, APartWrittenAgainAfterItsRecordIsRefused) {
            {pfm, "part0.pfm: its pixels are not the ones its record part0.pfm.json was written with"},
            {exr, "part0.exr: its pixels are not the ones its record (attribute \"vkray.part\") was written with"}}) {
     const std::filesystem::path output = dir / ("m" + files[0].extension().string());
-    const std::string message = error_of([&] { merge_part_files(output, files); });
+    const std::vector<std::filesystem::path>& parts = files;  // a lambda cannot capture a structured binding in clang 14
+    const std::string message = error_of([&] { merge_part_files(output, parts); });
     EXPECT_NE(message.find(says), std::string::npos) << message;
     EXPECT_FALSE(std::filesystem::exists(output));
   }
