@@ -1,302 +1,45 @@
 // vkray._vkray: the Python face on the library (python/vkray/__init__.py is the package around it).
-// It maps Python's arguments onto the library's options, checked against the library's limits as
-// the command line checks its flags, and the library's results onto numpy arrays, and each kind of
-// error (base/errors.h, session/failure.h) onto one exception class; everything else is the
-// library's. Long calls run on a thread of their own with the GIL released, while the calling thread
-// polls for signals; Ctrl-C reaches a render on any thread, and the end of the interpreter or a
-// fork() finds no render of this module half-done.
+// It binds the library's calls, maps Python's arguments onto its options (python/arguments.h) and its
+// results onto numpy arrays, and each kind of error onto one exception class (python/exceptions.h);
+// everything else is the library's. Every call runs as python/calls.h says: off the GIL, stopped by
+// Ctrl-C on any thread, and never half-done when the interpreter ends or the process forks.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
-#include <pthread.h>
-#include <signal.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <chrono>
 #include <cstring>
-#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include "base/errors.h"
-#include "base/interrupt.h"
 #include "base/json_document.h"
-#include "base/threads.h"
 #include "base/timing.h"
+#include "compare/parity.h"
+#include "compare/parity_report.h"
 #include "image/aovs.h"
 #include "image/exr.h"
 #include "image/image_file.h"
 #include "image/merge.h"
+#include "python/arguments.h"
+#include "python/calls.h"
+#include "python/exceptions.h"
 #include "session/cpu_render.h"
-#include "session/failure.h"
 #include "session/options.h"
-#include "compare/parity.h"
-#include "compare/parity_report.h"
 #include "session/parts.h"
 #include "session/paths.h"
 #include "session/regions.h"
 #include "session/session.h"
 #include "session/version.h"
-#include "load/scene_loader.h"
 
 namespace py = pybind11;
 
 namespace vkray::python {
 namespace {
-
-// The exception classes, made in PYBIND11_MODULE.
-struct Exceptions {
-  py::object error, scene_error, usage_error, device_error, internal_error;
-};
-Exceptions& exceptions() {
-  static Exceptions* e = new Exceptions();  // never destroyed: outlives the interpreter's teardown
-  return *e;
-}
-
-// Sets the Python exception for `error` (a Cancelled as KeyboardInterrupt).
-void set_failure(const std::exception_ptr& error) {
-  const Failure failure = describe_failure(error);
-  py::object type;
-  switch (failure.exit_code) {
-    case kExitBadInput: type = exceptions().scene_error; break;
-    case kExitUsage: type = exceptions().usage_error; break;
-    case kExitDevice: type = exceptions().device_error; break;
-    case kExitInterrupted: PyErr_SetNone(PyExc_KeyboardInterrupt); return;
-    default: type = exceptions().internal_error; break;
-  }
-  PyErr_SetString(type.ptr(), failure.message.c_str());
-}
-
-[[noreturn]] void raise_failure(const std::exception_ptr& error) {
-  set_failure(error);
-  throw py::error_already_set();
-}
-
-// ---- The end of the interpreter --------------------------------------------------------------------
-// Work runs on threads of its own while its caller waits without the GIL. Taking the GIL back is where
-// the end of the interpreter strikes: once it finalizes, CPython ends (pthread_exit) any other thread
-// that asks for the GIL, and that forced unwind through this module's C++ frames calls std::terminate
-// (SIGABRT); a render still running would meanwhile use the driver while the process tears it down.
-// So at exit (atexit: after the non-daemon threads were joined, before finalization) the module stops
-// every piece of work in flight and waits for it, and from then on a thread other than the one ending
-// the interpreter that would take the GIL back, or start work, is parked for good instead, as CPython
-// 3.14 itself does with such threads. The process then ends around it.
-struct InterpreterEnd {
-  std::mutex mutex;
-  bool ending = false;
-  std::thread::id thread;  // the thread ending the interpreter, which goes on
-};
-InterpreterEnd& interpreter_end() {
-  static PerProcess<InterpreterEnd> end;
-  [[maybe_unused]] static const int remade = ::pthread_atfork(nullptr, nullptr, [] { end.remake(); });
-  return end.get();
-}
-
-// The work in flight (base/interrupt.h) of the call from Python this thread is making: from its first
-// step to its last, so that Ctrl-C between two steps (loading, then rendering) still stops the call.
-thread_local std::shared_ptr<WorkInFlight> call_in_flight;
-
-// The end's lock, held; or, once the interpreter is ending, for any thread but the one ending it,
-// never: the thread is parked for good, its call no longer in flight.
-std::unique_lock<std::mutex> lock_unless_ending() {
-  InterpreterEnd& end = interpreter_end();
-  std::unique_lock lock(end.mutex);
-  if (!end.ending || std::this_thread::get_id() == end.thread) return lock;
-  lock.unlock();
-  call_in_flight.reset();  // end_interpreter() waits for it
-  for (;;) ::pause();
-}
-
-// The GIL given up for the scope and taken back at its end, unless the interpreter is ending.
-class WithoutGil {
- public:
-  WithoutGil() : state_(PyEval_SaveThread()) {}
-  ~WithoutGil() {
-    const auto lock = lock_unless_ending();  // held until the GIL is back: the end cannot come between
-    PyEval_RestoreThread(state_);
-  }
-  WithoutGil(const WithoutGil&) = delete;
-  WithoutGil& operator=(const WithoutGil&) = delete;
-
- private:
-  PyThreadState* state_;
-};
-
-// Marks the call in flight for its lifetime, unless it is made from within one on this thread (a
-// warning's handler that renders), which it joins. Waits without the GIL while a stop request ends
-// the work in flight; parks the thread once the interpreter is ending.
-class CallInFlight {
- public:
-  CallInFlight() {
-    if (call_in_flight) return;
-    owner_ = true;
-    WithoutGil released;  // its end parks the thread, once the call is registered for end_interpreter() to stop
-    call_in_flight = std::make_shared<WorkInFlight>();
-  }
-  ~CallInFlight() {
-    if (owner_) call_in_flight.reset();
-  }
-  CallInFlight(const CallInFlight&) = delete;
-  CallInFlight& operator=(const CallInFlight&) = delete;
-
- private:
-  bool owner_ = false;
-};
-
-// Called by atexit on the thread that ends the interpreter, with the GIL.
-void end_interpreter() {
-  WithoutGil released;  // for a thread that waits to take it back and park
-  {
-    InterpreterEnd& end = interpreter_end();
-    const std::lock_guard lock(end.mutex);
-    end.ending = true;
-    end.thread = std::this_thread::get_id();
-  }
-  stop_work_in_flight();
-}
-
-// ---- Ctrl-C on any thread ---------------------------------------------------------------------------
-// Python runs signal handlers on the main thread only, so a render on another thread would never hear
-// of Ctrl-C. While SIGINT means KeyboardInterrupt (Python's default handler), the module wraps
-// Python's C-level handler in one that also asks the library to stop: every render in flight stops,
-// each raising KeyboardInterrupt, whatever the main thread is doing. signal.signal() removes the
-// wrapper as it installs its own handler; each render looks again as it starts.
-std::atomic<void (*)(int)> python_sigint_handler{nullptr};
-
-extern "C" void on_sigint(int signal) {
-  const int saved = errno;
-  request_interrupt();  // async-signal-safe
-  errno = saved;
-  if (void (*python)(int) = python_sigint_handler.load()) python(signal);
-}
-
-// With the GIL (which serializes it with signal.signal()).
-void follow_ctrl_c() {
-  static const auto* const signal_module = new py::module_(py::module_::import("signal"));
-  static const auto* const default_handler = new py::object(signal_module->attr("default_int_handler"));
-  struct sigaction now {};
-  if (::sigaction(SIGINT, nullptr, &now) != 0) return;
-  const bool wrapped = !(now.sa_flags & SA_SIGINFO) && now.sa_handler == on_sigint;
-  const bool keyboard_interrupt = signal_module->attr("getsignal")(int(SIGINT)).is(*default_handler);
-  if (keyboard_interrupt && !wrapped && !(now.sa_flags & SA_SIGINFO) && now.sa_handler != SIG_DFL && now.sa_handler != SIG_IGN) {
-    python_sigint_handler.store(now.sa_handler);
-    struct sigaction wrapper = now;
-    wrapper.sa_handler = on_sigint;
-    ::sigaction(SIGINT, &wrapper, nullptr);
-  } else if (!keyboard_interrupt && wrapped) {  // another handler set without signal.signal()
-    now.sa_handler = python_sigint_handler.load();
-    ::sigaction(SIGINT, &now, nullptr);
-  }
-}
-
-// Runs `work` on a thread of its own with the GIL released, in flight as part of the call; the
-// calling thread runs Python's signal handlers every 50 ms (on the main thread; elsewhere there are
-// none to run). A handler's exception (KeyboardInterrupt) asks the library to stop, waits for it (the
-// library stops within a fraction of a second) and is raised; a stop that came from elsewhere (Ctrl-C
-// while the main thread does something else) raises KeyboardInterrupt.
-template <typename Work>
-auto run_interruptibly(Work&& work) -> decltype(work()) {
-  follow_ctrl_c();
-  const CallInFlight call;
-  std::future<decltype(work())> done = std::async(std::launch::async, [flight = call_in_flight, &work]() mutable {
-    const std::shared_ptr<WorkInFlight> in_flight = std::move(flight);  // until the work ends, not the future
-    return work();
-  });
-  while (true) {
-    {
-      WithoutGil released;
-      if (done.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready) break;
-    }
-    if (PyErr_CheckSignals() != 0) {
-      py::error_already_set raised;  // KeyboardInterrupt, or what a signal handler raised
-      request_interrupt();
-      {
-        WithoutGil released;
-        done.wait();
-      }
-      throw raised;
-    }
-  }
-  try {
-    return done.get();
-  } catch (const Cancelled&) {
-    // Ctrl-C: on the main thread, Python's own KeyboardInterrupt, once, rather than ours and then its.
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    raise_failure(std::current_exception());
-  } catch (...) {
-    raise_failure(std::current_exception());
-  }
-}
-
-// ---- Arguments --------------------------------------------------------------------------------------
-// Numbers as the command line checks its flags (session/options.h's limits, the same messages): None
-// is "not given"; an int (numpy's too, but not a bool) within the limit is taken; anything else is a
-// UsageError naming the argument.
-std::optional<uint32_t> number(const py::handle& value, const ArgumentLimit& limit) {
-  static const auto* const numpy_bool = new py::object(py::module_::import("numpy").attr("bool_"));
-  if (value.is_none()) return std::nullopt;
-  if (PyBool_Check(value.ptr()) || py::isinstance(value, *numpy_bool) || !PyIndex_Check(value.ptr()))
-    throw limit.error(std::string(py::repr(value)));
-  const auto whole = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
-  if (!whole) throw py::error_already_set();
-  int overflow = 0;
-  const long long n = PyLong_AsLongLongAndOverflow(whole.ptr(), &overflow);
-  if (overflow != 0 || !limit.contains(n)) throw limit.error(std::string(py::str(whole)));
-  return uint32_t(n);
-}
-
-// A thread count: 0 (the default) or None is one per hardware thread, as the library's 0.
-unsigned thread_count_argument(const py::handle& value) {
-  if (PyLong_Check(value.ptr()) && !PyBool_Check(value.ptr()) && py::int_(0).equal(value)) return 0;
-  return number(value, kThreadsArgument).value_or(0);
-}
-
-// A scene as the package hands it over: a file to load, or the text of a scene dict with the file
-// name its relative paths resolve against.
-struct SceneSource {
-  std::filesystem::path file;
-  std::optional<std::string> text;
-};
-
-std::shared_ptr<const Scene> load(const SceneSource& source, MeshCache* meshes) {
-  return std::make_shared<const Scene>(source.text ? parse_scene(*source.text, source.file, meshes) : load_scene(source.file, meshes));
-}
-
-// What a render is asked for from Python: the overrides, the passes, a region ("X0,Y0,X1,Y1" or
-// "I/N"), and for a render to a file, the file and its precision.
-struct Request {
-  std::optional<uint32_t> width, height, spp, seed;
-  std::vector<std::string> aovs;
-  std::optional<std::string> region;
-  std::optional<std::filesystem::path> output;
-  bool exr_float = false;
-};
-
-Request make_request(const py::object& width, const py::object& height, const py::object& spp, const py::object& seed,
-                     std::vector<std::string> aovs, std::optional<std::string> region, std::optional<std::filesystem::path> output,
-                     bool exr_float) {
-  return {number(width, kWidthArgument), number(height, kHeightArgument), number(spp, kSppArgument), number(seed, kSeedArgument),
-          std::move(aovs), std::move(region), std::move(output), exr_float};
-}
-
-RenderOptions render_options(std::optional<uint32_t> width, std::optional<uint32_t> height, std::optional<uint32_t> spp,
-                             std::optional<uint32_t> seed, bool aovs) {
-  RenderOptions options;
-  options.width = width;
-  options.height = height;
-  options.samples_per_pixel = spp;
-  options.seed = seed;
-  options.aovs = aovs;
-  return options;
-}
 
 // Copies of the render as numpy arrays: a float32 (height, width, 3) array, or with `passes` a
 // dict of it ("color") and the passes asked for.
@@ -333,32 +76,6 @@ py::object to_numpy(const RenderResult& result, const std::vector<Aov>& passes) 
     }
   }
   return py::object(out);
-}
-
-RenderOptions options_of(const Request& request, bool aovs) {
-  RenderOptions options = render_options(request.width, request.height, request.spp, request.seed, aovs);
-  if (request.region) options.region = parse_region(*request.region);
-  return options;
-}
-
-// The file's content, checked before any work: passes and 32-bit floats only in an .exr, a region
-// only as a part (.exr or .pfm).
-ExrContent output_content(const Request& request, const std::vector<Aov>& passes) {
-  ExrContent content;
-  content.passes = passes;
-  content.full_float = request.exr_float;
-  if (!request.output) {
-    if (request.exr_float) throw UsageError("exr_float is for a render to an .exr file");
-    return content;
-  }
-  check_render_output(*request.output, content, request.region.has_value());
-  return content;
-}
-
-std::vector<Aov> parse_passes(const std::vector<std::string>& names) {
-  std::string list;
-  for (const auto& name : names) list += (list.empty() ? "" : ",") + name;
-  return list.empty() ? std::vector<Aov>{} : parse_aov_list(list);
 }
 
 // vkray._vkray._check_output: what a render to `output` would raise before any work.
@@ -458,9 +175,9 @@ class Renderer {
   }
 
   void close() {
-    if (forked()) return abandon();
+    if (opened_in_.forked()) return abandon();
     const CallInFlight call;  // before the lock: a call in flight may be waiting for it
-    const auto lock = lock_without_gil();
+    const auto lock = lock_without_gil(mutex_);
     release();
   }
 
@@ -471,8 +188,6 @@ class Renderer {
   py::object last_stats() const { return last_stats_; }
 
  private:
-  bool forked() const { return ::getpid() != opened_in_; }
-
   // In a child made by fork(), the device is the parent's: using it would wait for ever, and
   // destroying it would wait for driver threads that did not come along. It is left as it is.
   void abandon() {
@@ -480,30 +195,17 @@ class Renderer {
     static_cast<void>(session_.release());
   }
 
-  // The renderer's lock, waited for without the GIL: the thread that holds it needs the GIL to
-  // check for signals. A thread that holds it may be parked at the end of the interpreter, so a
-  // waiter looks for that end between tries.
-  std::unique_lock<std::timed_mutex> lock_without_gil() {
-    std::unique_lock lock(mutex_, std::defer_lock);
-    WithoutGil released;
-    while (!lock.try_lock_for(std::chrono::milliseconds(50))) lock_unless_ending();
-    return lock;
-  }
-
   // The lock, once the renderer is known to be usable in this process and open.
   std::unique_lock<std::timed_mutex> usable_without_gil() {
-    if (forked())
-      throw UsageError("this vkray.Renderer was opened in process " + std::to_string(opened_in_) +
-                       ", and a process made by fork() cannot use its device: open a Renderer in this process, or start "
-                       "processes with multiprocessing's 'spawn' method");
-    auto lock = lock_without_gil();
+    opened_in_.check_not_forked();
+    auto lock = lock_without_gil(mutex_);
     if (!session_) throw UsageError("the renderer is closed");
     return lock;
   }
 
   // Releases the device, without the GIL: closing may wait for a tile an interrupt left running.
   void release() {
-    if (forked()) return abandon();
+    if (opened_in_.forked()) return abandon();
     last_.reset();
     if (!session_) return;
     std::unique_ptr<Session> session = std::move(session_);
@@ -512,7 +214,7 @@ class Renderer {
     session->close();
   }
 
-  const pid_t opened_in_ = ::getpid();
+  const OpenedInProcess opened_in_;
   std::timed_mutex mutex_;
   std::unique_ptr<Session> session_;
   MeshCache meshes_;
@@ -623,35 +325,8 @@ PYBIND11_MODULE(_vkray, m) {
   using namespace vkray::python;
   namespace vp = vkray::python;
   m.doc() = "vkray's C++ library; use the vkray package, which wraps it.";
-  auto& e = exceptions();
-  const auto make = [&](const char* name, py::object base, const char* doc) {
-    py::object type = py::reinterpret_steal<py::object>(
-        PyErr_NewExceptionWithDoc((std::string("vkray.") + name).c_str(), doc, base.ptr(), nullptr));
-    if (!type) throw py::error_already_set();
-    m.attr(name) = type;
-    return type;
-  };
-  e.error = make("Error", py::reinterpret_borrow<py::object>(PyExc_Exception), "The base of every error vkray raises.");
-  e.scene_error = make("SceneError", e.error,
-                       "A scene, a mesh, a shader or an output file cannot be used, or an input is past a limit "
-                       "(what exits 1 in the command line); the message names the file and the key or line.");
-  e.usage_error = make("UsageError", e.error, "An argument is out of range (what exits 2 in the command line).");
-  e.device_error = make("DeviceError", e.error,
-                        "Vulkan or the device failed: no such device, a failed call, a validation message, a limit of "
-                        "the device (what exits 3 in the command line).");
-  e.internal_error = make("InternalError", e.error, "An invariant of vkray's own does not hold: a bug in vkray.");
-  // What the library throws outside run_interruptibly() (an argument checked on the calling thread, a
-  // device closed), as it would be raised from a render.
-  py::register_exception_translator([](std::exception_ptr error) {
-    try {
-      if (error) std::rethrow_exception(error);
-    } catch (const py::builtin_exception&) {
-      throw;  // pybind11's own, for its own translator
-    } catch (const std::exception&) {
-      set_failure(error);
-    }
-  });
-  py::module_::import("atexit").attr("register")(py::cpp_function(&end_interpreter));
+  add_exceptions(m);
+  stop_calls_at_exit();
 
   py::class_<vp::SceneSource>(m, "_SceneSource")
       .def(py::init([](std::filesystem::path file, std::optional<std::string> text) { return vp::SceneSource{std::move(file), std::move(text)}; }),
@@ -683,6 +358,7 @@ PYBIND11_MODULE(_vkray, m) {
   m.def("parity", &vp::parity, py::arg("source"), py::arg("width"), py::arg("height"), py::arg("spp"), py::arg("seed"),
         py::arg("device"), py::arg("validate"), py::arg("threads"));
   m.def("devices", &vp::devices);
+  m.def("_calls_in_flight", &vp::calls_in_flight, "How many calls into the library are in flight in this process.");
   m.def("_shader_dir", [] { return vkray::default_shader_dir(); }, "Where the shaders are compiled from by default.");
   m.attr("_MAX_JSON_DEPTH") = vkray::kMaxJsonDepth;
   m.attr("__version__") = vkray::version_string();
