@@ -1,6 +1,8 @@
 // OpenEXR files (through the OpenEXR library): the image as R, G, B, and the first-hit passes as
 // named layers, the channel names other tools expect (docs/rendering.md): albedo.R/G/B,
-// normal.X/Y/Z, position.X/Y/Z, depth.Z, object.id.
+// normal.X/Y/Z, position.X/Y/Z, depth.Z, object.id. write_exr is in exr_write.cpp, read_exr in
+// exr_read.cpp (after exr_header.h has checked the header against the file); the channel names and
+// the hash of the pixels as stored, which both use, in exr_channels.h.
 #pragma once
 
 #include <filesystem>
