@@ -83,10 +83,20 @@ float intersect_sphere(Ray ray, vec3 center, float radius, float t_min, float t_
 }
 
 // Barycentric coordinates (u, v) of a point in the triangle's plane: p = v0 + u (v1 - v0) + v (v2 - v0).
+// They do not change when the triangle is scaled, so it is brought to a size of about 1 first: the
+// denominator is an edge length to the fourth power, which for edges of 1e-10 is below the smallest
+// normal float (and 1 / it infinite). A triangle too thin for floats to tell from a line gives
+// (0, 0), the first vertex, rather than NaN.
 vec2 triangle_barycentrics(vec3 p, vec3 v0, vec3 v1, vec3 v2) {
   vec3 e1 = v1 - v0, e2 = v2 - v0, d = p - v0;
+  vec3 largest = max(abs(e1), abs(e2));
+  float scale = 1.0 / max(largest.x, max(largest.y, largest.z));
+  e1 *= scale;
+  e2 *= scale;
+  d *= scale;
   float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), d1 = dot(d, e1), d2 = dot(d, e2);
-  float inv = 1.0 / (d11 * d22 - d12 * d12);
+  float denominator = d11 * d22 - d12 * d12;
+  float inv = denominator > 0.0 ? 1.0 / denominator : 0.0;
   return vec2((d22 * d1 - d12 * d2) * inv, (d11 * d2 - d12 * d1) * inv);
 }
 

@@ -57,6 +57,8 @@ void main() {
   // that tests its condition first runs the whole body once more, masked, after the last iteration
   // (here a second camera ray's traversal and shading for every pixel; docs/design.md, "What the
   // time goes to"). sample_end > sample_begin.
+  // The mean of the samples, each weighed by 1 / spp as it comes (not the sum, divided at the end,
+  // which a bright pixel of many samples could take past the largest float).
   vec3 sum = vec3(0.0);
   uint rays = 0u;
   if (tile.sample_begin > 0u) {  // an earlier dispatch's running sum (TileConstants::sample_begin)
@@ -74,7 +76,7 @@ void main() {
     rays += 1u;
     do {
       if (path_step(path, stream, rays)) {
-        sum += path.radiance;
+        sum += path.radiance * frame.inv_samples_per_pixel;
         probe_loop_limit(rays);
         if (++k < tile.sample_end) {
           path = start_path(camera_sample(pixel, pixel_index, k, stream));
@@ -87,14 +89,13 @@ void main() {
       uint stream;
       Ray ray = camera_sample(pixel, pixel_index, k, stream);
       rays += 1u;
-      sum += direct_radiance(ray, stream, rays);
+      sum += direct_radiance(ray, stream, rays) * frame.inv_samples_per_pixel;
       probe_loop_limit(rays);
     } while (++k < tile.sample_end);
   }
   if (k < tile.sample_end) rays |= VKRAY_LOOPS_CUT_SHORT;
   // Alpha carries the number of rays traced for this pixel (bit pattern of a uint) for the rays/s
   // figure, and VKRAY_LOOPS_CUT_SHORT.
-  vec3 stored = tile.sample_end == frame.samples_per_pixel ? sum * frame.inv_samples_per_pixel : sum;
-  radiance[index] = vec4(stored, uintBitsToFloat(rays));
+  radiance[index] = vec4(sum, uintBitsToFloat(rays));
   if (FIRST_HIT_PASSES) store_first_hits(index);
 }

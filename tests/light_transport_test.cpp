@@ -235,7 +235,9 @@ Scene shipped(const char* name) { return load_scene(std::filesystem::path(VKRAY_
 
 class TwoPercentDarker : public BrokenShaderParityTest {
  protected:
-  TwoPercentDarker() : BrokenShaderParityTest("trace.comp", "sum += path.radiance;", "sum += path.radiance * 0.98;") {}
+  TwoPercentDarker()
+      : BrokenShaderParityTest("trace.comp", "sum += path.radiance * frame.inv_samples_per_pixel;",
+                               "sum += path.radiance * frame.inv_samples_per_pixel * 0.98;") {}
 };
 TEST_F(TwoPercentDarker, IsCaught) { expect_caught(shipped("cornell-path.json"), {64, 64, 16}); }
 

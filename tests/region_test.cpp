@@ -1,5 +1,6 @@
 // Regions of a render, parts and their merge, on the host: --region's forms, bands of equal work,
 // the CPU reference's regions against its whole image, the scene digest, and `vkray merge`'s rules.
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include "image/part.h"
 #include "scene/digest.h"
 #include "session/cpu_render.h"
+#include "session/parts.h"
 #include "session/regions.h"
 #include "support/error_of.h"
 #include "support/temp_dir.h"
@@ -119,6 +121,31 @@ TEST(RegionTest, BandsDoNotDependOnTheSeed) {
   const Scene scene = load_scene(kScenes / "cornell-path.json");
   const std::vector<PixelRegion> bands = work_bands(scene, {64, 64, 1, 0}, 8);
   for (const uint32_t seed : {1u, 7u, 123456u}) EXPECT_EQ(work_bands(scene, {64, 64, 1, seed}, 8), bands) << seed;
+}
+
+// ---- what a face hands over -------------------------------------------------------------------------
+
+TEST(WriteRenderTest, APixelThatIsNotFiniteIsNeverWritten) {
+  // Both renderers keep every value in the float range, so a NaN or an infinity is a fault of the
+  // shaders or the driver: the render fails naming the pixel, and nothing is written.
+  const Scene scene = sky_and_ground();
+  RenderOptions options;
+  options.threads = 2;
+  options.region = PixelRegion{8, 4, 24, 20};
+  for (const float bad : {std::nanf(""), INFINITY, -INFINITY}) {
+    RenderResult result = render_on_cpu(scene, options);
+    result.image.at(3, 2).g = bad;
+    result.image.at(9, 9).b = bad;
+    for (const char* name : {"out.png", "out.pfm", "out.exr"}) {
+      TempDir dir;
+      RenderResult shown = result;
+      shown.part = std::string(name) != "out.png";
+      const std::string message = error_of([&] { write_render(dir / name, scene, shown, {}, "test"); });
+      EXPECT_NE(message.find("2 pixels are not finite, the first at (11, 6)"), std::string::npos) << message;
+      EXPECT_TRUE(std::filesystem::is_empty(dir.path())) << name;
+    }
+  }
+  EXPECT_NO_THROW(check_finite(render_on_cpu(scene, options)));  // a finite render passes
 }
 
 // ---- the CPU reference's regions ---------------------------------------------------------------

@@ -19,14 +19,14 @@ Scene lit_by(const std::string& rest) {
                          "integrator": {"type": "path"}, )" + rest + "}", "test.json");
 }
 
-TEST(ScenePackingTest, TheBrightestRadianceIsBroughtToTwoToTheMinusForty) {
+TEST(ScenePackingTest, TheBrightestRadianceIsBroughtToTwoToTheTwenty) {
   for (const float brightest : {3.4e38f, 3e38f, 18.387f, 1.0f, 1e-25f, 1.17e-38f, 1e-39f, 1.4e-45f}) {
     Scene scene = lit_by(R"("background": [0, 0, 0])");
     scene.background = glm::vec3(brightest * 0.5f, brightest, 0.0f);
     const int k = radiance_exponent(scene);
     const float scaled = std::ldexp(brightest, k);
-    EXPECT_GE(scaled, std::ldexp(1.0f, -41)) << brightest;
-    EXPECT_LT(scaled, std::ldexp(1.0f, -40)) << brightest;
+    EXPECT_GE(scaled, std::ldexp(1.0f, 19)) << brightest;
+    EXPECT_LT(scaled, std::ldexp(1.0f, 20)) << brightest;
   }
   EXPECT_EQ(radiance_exponent(lit_by(R"("background": [0, 0, 0])")), 0);  // nothing shines
 }
@@ -47,7 +47,7 @@ TEST(ScenePackingTest, ScaledRadianceComesBackBitForBit) {
 }
 
 TEST(ScenePackingTest, EveryRadianceIsScaledAlike) {
-  const Scene scene = lit_by(R"("background": [3e38, 1, 0], "ambient": [0.5, 0, 0],
+  const Scene scene = lit_by(R"("background": [3e28, 1, 0], "ambient": [0.5, 0, 0],
       "materials": {"e": {"albedo": [0.5, 0.5, 0.5], "emission": [2, 3, 4]}},
       "lights": [{"type": "point", "position": [0, 1, 0], "intensity": [5, 6, 7]}],
       "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1, "material": "e"}])");
@@ -57,7 +57,7 @@ TEST(ScenePackingTest, EveryRadianceIsScaledAlike) {
   EXPECT_EQ(packed.materials[VKRAY_MATERIAL_EMISSION].y, std::ldexp(3.0f, k));
   EXPECT_EQ(packed.lights[VKRAY_LIGHT_INTENSITY].z, std::ldexp(7.0f, k));
   const FrameUniforms frame = pack_frame(scene, 1, packed.frame, scene.image);
-  EXPECT_EQ(frame.background.x, std::ldexp(3e38f, k));
+  EXPECT_EQ(frame.background.x, std::ldexp(3e28f, k));
   EXPECT_EQ(frame.ambient.x, std::ldexp(0.5f, k));
 }
 

@@ -226,6 +226,21 @@ TEST(SceneTest, ValuesPastWhatTheGpuCarriesAreRefused) {
                                              "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1, "material": "e"},
                                                          {"type": "sphere", "center": [0, 0, 5], "radius": 1e-21, "material": "f"}])"),
                               "test.json"));
+  // A scene so small that the squared distances the shader divides by are below the smallest
+  // normal float; the smallest it takes renders (checks/scale-1e-9.json).
+  expect_error(R"({"camera": {"position": [0, 0, -4e-22], "direction": [0, 0, 1], "focal_length": 1},
+                  "materials": {"m": {"albedo": [1, 1, 1]}},
+                  "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1e-22, "material": "m"}]})",
+               "the scene reaches only 4e-22 from the origin", "at least 1e-9");
+  EXPECT_NO_THROW(parse_scene(R"({"camera": {"position": [0, 0, 0], "direction": [0, 0, 1], "focal_length": 1}})", "test.json"));
+  // Radiance no one scale of floats holds: the brightest more than 1e30 times the dimmest.
+  expect_error(with_camera(R"("background": [3e38, 3e38, 3e38],
+                              "lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, 0, 0]}])"),
+               "/lights/0/intensity, 1, is more than 1e30 times dimmer", "(/background, 3e+38)");
+  expect_error(with_camera(R"("background": [1e-39, 0, 0], "materials": {"hot": {"albedo": [1, 1, 1], "emission": [0, 2e-9, 0]}})"),
+               "/background, 1e-39, is more than 1e30 times dimmer", "(material \"hot\"'s emission, 2e-09)");
+  EXPECT_NO_THROW(parse_scene(with_camera(R"("background": [3e29, 3e29, 3e29],
+                                             "lights": [{"type": "point", "position": [0, 1, 0], "intensity": [1, 0, 0]}])"), "test.json"));
   EXPECT_NO_THROW(parse_scene(with_camera(R"("materials": {"e": {"albedo": [1, 1, 1], "emission": [1e-25, 1e-25, 1e-25]}},
                                              "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1e-8, "material": "e"}])"),
                               "test.json"));

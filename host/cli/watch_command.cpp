@@ -18,6 +18,7 @@
 #include "image/image.h"
 #include "image/image_file.h"
 #include "session/failure.h"
+#include "session/parts.h"
 #include "session/paths.h"
 #include "session/session.h"
 #include "load/scene_loader.h"
@@ -164,6 +165,7 @@ std::string Watch::render(bool errors_reported) {
   try {
     const RenderResult result = session_->render(*on_device_, options_);
     const double render_ms = ms_since(start);
+    check_finite(result);  // an edited shader's NaN is reported, and the last good image kept
     write_image(result.image, output_);
     return "render " + format_ms(render_ms) + " -> " + output_.string();
   } catch (const Cancelled&) {

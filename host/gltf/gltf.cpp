@@ -520,7 +520,11 @@ uint32_t GltfReader::material(int index, const std::string& where) {
       const tinygltf::Value& v = strength->second.Get("emissiveStrength");
       const double s = v.IsNumber() ? v.GetNumberAsDouble() : 1.0;
       if (!(s >= 0.0 && s <= 1e6)) fail(name + ".extensions.KHR_materials_emissive_strength", "emissiveStrength outside [0, 1e6]");
-      m.emission *= float(s);
+      const glm::dvec3 emission = glm::dvec3(m.emission) * s;
+      if (!(std::max({emission.r, emission.g, emission.b}) <= double(FLT_MAX)))
+        fail(name + ".extensions.KHR_materials_emissive_strength",
+             "emissiveFactor times emissiveStrength passes the largest 32-bit float (3.4e38)");
+      m.emission = glm::vec3(emission);
     }
     int set = 0;
     if (pbr.baseColorTexture.index >= 0) {

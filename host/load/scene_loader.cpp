@@ -10,7 +10,7 @@
 #include "base/input_file.h"
 #include "base/json_document.h"
 #include "load/scene_parser.h"
-#include "scene/emitters.h"
+#include "scene/float_range.h"
 
 namespace vkray {
 namespace {
@@ -41,7 +41,7 @@ void recentre_texture_coordinates(Scene& scene) {
 // and the checks that need the whole scene.
 void finish_scene(Scene& scene) {
   recentre_texture_coordinates(scene);
-  check_area_lights(scene);
+  check_float_range(scene);
 }
 
 

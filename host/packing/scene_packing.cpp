@@ -273,7 +273,7 @@ int radiance_exponent(const Scene& scene) {
   if (!(brightest > 0.0f)) return 0;
   int exponent = 0;
   std::frexp(brightest, &exponent);  // brightest = m 2^exponent, m in [0.5, 1)
-  return -40 - exponent;
+  return 20 - exponent;
 }
 
 glm::vec3 unscale_radiance(glm::vec3 scaled, int radiance_exponent) {

@@ -23,11 +23,12 @@ struct LightingFrame {
 };
 
 // The exponent k that brings the scene's brightest radiance (an emission, the background, the
-// ambient term, a light's intensity) to [2^-41, 2^-40) when multiplied by 2^k; 0 when all are 0.
-// Far below 1, so that the products a path makes (a point light's 1 / r^2 near a surface, a
-// sample's weight, thousands of samples summed) stay below FLT_MAX even where the brightest light is
-// near it; far above FLT_MIN, so that lights 10^25 times dimmer than the brightest are still normal
-// floats, not flushed to zero. Powers of two scale floats exactly.
+// ambient term, a light's intensity) to [2^19, 2^20) when multiplied by 2^k; 0 when all are 0.
+// Headroom above of 2^108 (3e32) for the factors a sample picks up on its way (a point light's
+// 1 / r^2, at least 1e-28 with the scene at least 1e-9 across; the area-light estimator's area /
+// r^2; glass's eta^2); room below of 2^145 (4e43) before the floats a GPU may flush to zero, for the
+// dimmest light (at most 1e30 times dimmer than the brightest, scene/emitters.h) times the factors
+// that dim it. Powers of two scale floats exactly.
 int radiance_exponent(const Scene& scene);
 
 // The shader's radiance back in the scene's units: `scaled` times 2^-radiance_exponent, exactly,

@@ -1,10 +1,7 @@
 #include "scene/emitters.h"
 
-#include <cfloat>
 #include <numbers>
-#include <sstream>
 
-#include "base/errors.h"
 #include "shared/scene_layout.h"
 
 namespace vkray {
@@ -63,22 +60,6 @@ EmitterTable build_emitter_table(const Scene& scene) {
   for (const uint32_t i : small) table.entries[i].probability = 1.0f;
   for (const uint32_t i : large) table.entries[i].probability = 1.0f;
   return table;
-}
-
-void check_area_lights(const Scene& scene) {
-  const EmitterTable table = build_emitter_table(scene);
-  for (const EmitterTable::Entry& e : table.entries) {
-    const bool sphere = e.primitive >= scene.triangles.size();
-    const uint32_t material = sphere ? scene.spheres[e.primitive - scene.triangles.size()].material : scene.triangles[e.primitive].material;
-    if (table.density[material] <= double(FLT_MAX)) continue;
-    const uint32_t object = sphere ? scene.spheres[e.primitive - scene.triangles.size()].object : scene.triangles[e.primitive].object;
-    std::ostringstream area;
-    area << primitive_area(scene, e.primitive);
-    throw SceneError(scene.file.string() + ": /objects/" + std::to_string(object) + ": an area light (material \"" +
-                     printable(scene.materials[material].name) + "\") of area " + area.str() +
-                     ": light sampling picks its points with a density of at least 1 / area, past the largest 32-bit "
-                     "float (3.4e38) the GPU computes with; make it larger, or its material not emit");
-  }
 }
 
 }  // namespace vkray

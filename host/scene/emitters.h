@@ -29,11 +29,6 @@ struct EmitterTable {
 // never be picked.
 EmitterTable build_emitter_table(const Scene& scene);
 
-// Throws SceneError, naming the object, for an area light the GPU cannot sample: one whose density
-// (at least 1 / its area) passes the largest 32-bit float. The loader checks every scene here, so
-// that both renderers refuse it before any work.
-void check_area_lights(const Scene& scene);
-
 // The area of primitive p (scene numbering), in double.
 double primitive_area(const Scene& scene, uint32_t p);
 

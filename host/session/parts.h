@@ -28,9 +28,16 @@ void check_render_output(const std::filesystem::path& file, const ExrContent& co
 // kCpuReferenceDevice.
 PartRecord part_record(const Scene& scene, const RenderResult& result, const std::string& device);
 
+// Throws InternalError, naming how many and the first, when pixels of `result` are not finite: both
+// renderers hold every value within the float range (docs/limits.md, "Floats on the GPU"), so one
+// that is not is a fault of the shaders or the driver, never an image to deliver. Every face checks
+// what it hands over here (write_render does).
+void check_finite(const RenderResult& result);
+
 // Writes `result` to `file` (.png, .pfm or .exr; `content`: the passes and precision of an .exr); a
 // region of the image as a part (write_part: .exr or .pfm, else UsageError; a part and its record
-// replace an earlier pair together or not at all). Throws OutputError, LimitError.
+// replace an earlier pair together or not at all). Throws OutputError, LimitError, and check_finite's
+// InternalError before anything is written.
 void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const ExrContent& content,
                   const std::string& device);
 

@@ -79,7 +79,7 @@ VKRAY_SHARED_BEGIN
 // ---- Per-frame constants (std140 uniform block) ----------------------------------------------
 // The camera follows the scene contract: d = normalize(x*right + y*up + focal_px*forward).
 // Radiance here (background, ambient), in the materials' emission and in the lights' intensity is
-// the scene's times a power of two that brings the brightest of them near 2^-40 (gpu::LightingFrame):
+// the scene's times a power of two that brings the brightest of them near 2^20 (gpu::LightingFrame):
 // light transport is linear in them, so the shader's image is the scene's times that power exactly,
 // which the host divides out, and no float the shader computes overflows or flushes to zero where
 // the double-precision CPU reference's does not (docs/limits.md, "Floats on the GPU").
@@ -153,8 +153,9 @@ struct TileConstants {
   // cheap and costly pixels, so no thread finishes long before the others (gpu::row_stride).
   uint row_stride;
   // The dispatch traces samples [sample_begin, sample_end) of each pixel, continuing the running sum
-  // an earlier dispatch of the tile left in the output (the same float additions in the same order
-  // as one loop over all samples); the one that ends at samples_per_pixel stores the mean.
+  // of samples weighed by 1 / samples_per_pixel that an earlier dispatch of the tile left in the
+  // output (the same float additions in the same order as one loop over all samples): the mean, once
+  // the dispatch that ends at samples_per_pixel is done.
   uint sample_begin;
   uint sample_end;
   // Where the tile's pixels start in the output, which holds a tile or two, not the image (any

@@ -1,0 +1,97 @@
+#include "scene/float_range.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "base/errors.h"
+#include "base/extension.h"
+#include "scene/emitters.h"
+
+namespace vkray {
+namespace {
+
+std::string brief(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+bool from_gltf_file(const Scene& scene) {
+  const std::string extension = lower_extension(scene.file);
+  return extension == ".gltf" || extension == ".glb";
+}
+
+// Where a primitive comes from, for a message: its place in a scene file's "objects", or, in a
+// glTF file rendered on its own, the material it has.
+std::string where_is(const Scene& scene, uint32_t object, const Material& material) {
+  const std::string named = "material \"" + printable(material.name) + "\"";
+  return from_gltf_file(scene) ? named : "/objects/" + std::to_string(object) + " (" + named + ")";
+}
+
+void check_extent(const Scene& scene) {
+  if (scene.triangles.empty() && scene.spheres.empty()) return;  // nothing to square a distance to
+  const float extent = scene.extent();
+  if (extent >= kMinExtent) return;
+  throw SceneError(scene.file.string() + ": the scene reaches only " + brief(extent) +
+                   " from the origin (its largest coordinate, camera and lights included): the GPU's 32-bit floats "
+                   "square distances a hundred-thousandth of that, below the smallest normal float; vkray renders "
+                   "scenes that reach at least 1e-9: scale it up");
+}
+
+struct Radiance {
+  std::string key;  // what the scene calls it
+  float brightest = 0.0f;  // its brightest channel
+};
+
+float brightest(const glm::vec3& c) { return std::max({c.r, c.g, c.b}); }
+
+void check_radiance_range(const Scene& scene) {
+  std::vector<Radiance> all;
+  const bool json = !from_gltf_file(scene);
+  all.push_back({"/background", brightest(scene.background)});
+  all.push_back({"/ambient", brightest(scene.ambient)});
+  for (const Material& m : scene.materials)
+    all.push_back({"material \"" + printable(m.name) + "\"'s emission", brightest(m.emission)});
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    all.push_back({(json ? "/lights/" : "light ") + std::to_string(i) + (json ? "/intensity" : "'s intensity"),
+                   brightest(scene.lights[i].intensity)});
+  const Radiance* bright = nullptr;
+  const Radiance* dim = nullptr;
+  for (const Radiance& r : all) {
+    if (!(r.brightest > 0.0f)) continue;
+    if (!bright || r.brightest > bright->brightest) bright = &r;
+    if (!dim || r.brightest < dim->brightest) dim = &r;
+  }
+  if (!bright || double(bright->brightest) <= kMaxRadianceRatio * double(dim->brightest)) return;
+  throw SceneError(scene.file.string() + ": " + dim->key + ", " + brief(dim->brightest) +
+                   ", is more than 1e30 times dimmer than the scene's brightest radiance (" + bright->key + ", " +
+                   brief(bright->brightest) +
+                   "): the GPU's 32-bit floats cannot carry both; make the dim one 0 or brighter");
+}
+
+void check_area_lights(const Scene& scene) {
+  const EmitterTable table = build_emitter_table(scene);
+  for (const EmitterTable::Entry& e : table.entries) {
+    const bool sphere = e.primitive >= scene.triangles.size();
+    const uint32_t material = sphere ? scene.spheres[e.primitive - scene.triangles.size()].material : scene.triangles[e.primitive].material;
+    if (table.density[material] <= double(FLT_MAX)) continue;
+    const uint32_t object = sphere ? scene.spheres[e.primitive - scene.triangles.size()].object : scene.triangles[e.primitive].object;
+    throw SceneError(scene.file.string() + ": " + where_is(scene, object, scene.materials[material]) +
+                     ": an area light of area " + brief(primitive_area(scene, e.primitive)) +
+                     ": light sampling picks its points with a density of at least 1 / area, past the largest 32-bit "
+                     "float (3.4e38) the GPU computes with; make it larger, or its material not emit");
+  }
+}
+
+}  // namespace
+
+void check_float_range(const Scene& scene) {
+  check_extent(scene);
+  check_radiance_range(scene);
+  check_area_lights(scene);
+}
+
+}  // namespace vkray
