@@ -1,6 +1,10 @@
 #include "image/image_file.h"
 
+#include <cerrno>
+#include <cstring>
 #include <string>
+
+#include <unistd.h>
 
 #include "base/errors.h"
 #include "base/extension.h"
@@ -26,6 +30,9 @@ void check_output_folder(const std::filesystem::path& file) {
   const auto dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) throw OutputError(file.string() + ": folder " + dir.string() + " does not exist");
+  // Found now, not after the render: the file is made in this folder (a temporary, then renamed).
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw OutputError(file.string() + ": folder " + dir.string() + " cannot be written to (" + std::strerror(errno) + ")");
 }
 
 bool is_supported_image_path(const std::filesystem::path& file) { return image_file_type(file).has_value(); }

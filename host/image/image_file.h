@@ -34,7 +34,8 @@ void write_render_image(const std::filesystem::path& file, const Image& image, c
 void check_render_image(const std::filesystem::path& file, const ExrContent& content);
 
 // Throws OutputError, before any work is done, when `file` cannot be an image vkray writes: an
-// unknown extension, a folder that does not exist (or is a file), or a folder in the file's place.
+// unknown extension, a folder that does not exist (or is a file) or cannot be written to, or a
+// folder in the file's place.
 // Every face checks an output here first, so that each refuses it with the same message and exit code.
 void check_output_image(const std::filesystem::path& file);
 // For a file of any type (a report, a JUnit file, a folder to make): its folder must exist.
