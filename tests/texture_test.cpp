@@ -2,9 +2,11 @@
 // colour, the sRGB decode, the CPU reference's filtering and wrap modes, textures from an OBJ file's
 // .mtl, and how they are packed for the shader.
 #include <cstring>
+#include <fstream>
 #include <memory>
 #include <optional>
 
+#include <Imath/half.h>
 #include <gtest/gtest.h>
 #include <png.h>
 #include <turbojpeg.h>
@@ -219,6 +221,37 @@ TEST(PictureEncodingTest, ColourSpaceChunksAreIgnored) {
   EXPECT_EQ(decoded(png_file({.samples = {200, 100, 50}, .iccp_chunk = true})), colour);
   EXPECT_EQ(decoded(png_file({.bit_depth = 16, .colour_type = PNG_COLOR_TYPE_GRAY, .samples = {128 * 257}, .iccp_chunk = true})), grey);
   EXPECT_EQ(decoded(png_file({.samples = {200, 100, 50}, .file_gamma = 1.0}), false), reference(200, 100, 50, 255, false));
+}
+
+TEST(PictureEncodingTest, ImageFilesReadAsTexturesDo) {
+  // read_png (parts, tests, tools) decodes a PNG as a texture's is decoded: the samples as stored,
+  // whatever their depth or the file's colour-space chunks, each value the texture's texel before
+  // its rounding to a half float.
+  test::TempDir dir;
+  const auto read = [&](const std::string& bytes) {
+    std::ofstream(dir / "p.png", std::ios::binary) << bytes;
+    return read_png(dir / "p.png").at(1, 1);
+  };
+  const glm::vec3 colour(decode_srgb8(200), decode_srgb8(100), decode_srgb8(50)), grey(decode_srgb8(128));
+  EXPECT_EQ(read(png_file({8, PNG_COLOR_TYPE_RGB, {200, 100, 50}})), colour);
+  EXPECT_EQ(read(png_file({16, PNG_COLOR_TYPE_RGB, {200 * 257, 100 * 257, 50 * 257}})), colour);
+  EXPECT_EQ(read(png_file({.samples = {200, 100, 50}, .file_gamma = 1.0})), colour);
+  EXPECT_EQ(read(png_file({.bit_depth = 16, .samples = {200 * 257, 100 * 257, 50 * 257}, .file_gamma = 1.0})), colour);
+  EXPECT_EQ(read(png_file({.samples = {200, 100, 50}, .iccp_chunk = true})), colour);
+  EXPECT_EQ(read(png_file({8, PNG_COLOR_TYPE_GRAY, {128}})), grey);
+  EXPECT_EQ(read(png_file({16, PNG_COLOR_TYPE_GRAY_ALPHA, {128 * 257, 64 * 257}})), grey);  // alpha dropped
+  EXPECT_EQ(read(png_file({8, PNG_COLOR_TYPE_PALETTE, {1}, {{0, 0, 0}, {200, 100, 50}}})), colour);
+  // 16 bits keep their precision, and are the texture's light.
+  const std::string between = png_file({16, PNG_COLOR_TYPE_RGB, {128 * 257 + 128, 100 * 257, 50 * 257}});
+  const glm::vec3 value = read(between);
+  EXPECT_GT(value.r, grey.r);
+  EXPECT_LT(value.r, decode_srgb8(129));
+  const glm::vec4 texel = decoded(between);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(float(Imath::half(value[c])), texel[c]) << c;
+  // An image's limit is kMaxImageSide on a side (a texture's is stricter), checked before any pixel.
+  std::ofstream(dir / "wide.png", std::ios::binary) << test::png_header_only(16385, 1);
+  EXPECT_NE(error_of([&] { read_png(dir / "wide.png"); }).find("wide.png: a PNG of 16385 x 1 pixels (vkray reads up to 16384 on a side)"),
+            std::string::npos);
 }
 
 // A scene with one 2 x 2 texture of four colours, for the lookups below.

@@ -6,21 +6,38 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <new>
+#include <string>
 #include <vector>
 
 #include <png.h>
 #include <turbojpeg.h>
 
 #include "base/errors.h"
+#include "image/image.h"
 
 namespace vkray {
 namespace {
 
-[[noreturn]] void fail(const std::string& name, const std::string& why) { throw SceneError(name + ": " + why); }
+// What a picture is decoded for: a texture, a scene's input (SceneError, the picture limits above),
+// or an image file (image.h's read_png: InputError, kMaxImageSide on a side, no other limit).
+enum class Use { texture, image_file };
+
+[[noreturn]] void fail(Use use, const std::string& name, const std::string& why) {
+  if (use == Use::image_file) throw InputError(name + ": " + why);
+  throw SceneError(name + ": " + why);
+}
 
 // Refuses a size past the limits before the pixels are allocated.
-void check_size(const std::string& name, uint64_t width, uint64_t height) {
-  if (width == 0 || height == 0) fail(name, "the picture has no pixels (" + std::to_string(width) + " x " + std::to_string(height) + ")");
+void check_size(Use use, const std::string& name, uint64_t width, uint64_t height) {
+  if (width == 0 || height == 0)
+    fail(use, name, "the picture has no pixels (" + std::to_string(width) + " x " + std::to_string(height) + ")");
+  if (use == Use::image_file) {
+    if (width > kMaxImageSide || height > kMaxImageSide)
+      fail(use, name, "a PNG of " + std::to_string(width) + " x " + std::to_string(height) + " pixels (vkray reads up to " +
+                          std::to_string(kMaxImageSide) + " on a side)");
+    return;
+  }
   if (width > kMaxPictureSide || height > kMaxPictureSide || width * height > kMaxPicturePixels)
     throw LimitError(name + ": a picture of " + std::to_string(width) + " x " + std::to_string(height) +
                      " pixels; vkray decodes at most " + std::to_string(kMaxPictureSide) + " on a side and " +
@@ -31,22 +48,16 @@ void check_size(const std::string& name, uint64_t width, uint64_t height) {
 // it takes a 16-bit file's samples as linear light unless told otherwise and re-encodes them as sRGB
 // (a mid grey rendered more than twice as bright as in 8 bits), and it applies a gAMA chunk to 8-bit
 // samples too. Here no gamma transform is asked for, and the colour-space chunks are not even read.
+// The bytes come from memory (a texture's file, read whole) or from an open file as libpng asks for
+// them (an image file, which may be far larger than a texture's).
 //
 // libpng reports errors by longjmp: the structs are freed by a member's destructor (which runs when
 // the constructor throws, too), and the functions that call setjmp create no C++ object that a
 // longjmp would skip.
 class PngReader {
  public:
-  PngReader(std::string_view bytes, const std::string& name) : bytes_(bytes) {
-    png_.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, this, on_error, on_warning);
-    if (png_.png) png_.info = png_create_info_struct(png_.png);
-    if (!png_.png || !png_.info) throw LimitError(name + ": libpng could not start (out of memory)");
-    if (!read_header()) fail(name, std::string("not a readable PNG file: ") + message_);
-    width = png_get_image_width(png_.png, png_.info);
-    height = png_get_image_height(png_.png, png_.info);
-    bit_depth = png_get_bit_depth(png_.png, png_.info);
-    check_size(name, width, height);
-  }
+  PngReader(std::string_view bytes, const std::string& name, Use use) : use_(use), bytes_(bytes) { start(name); }
+  PngReader(std::FILE* file, const std::string& name, Use use) : use_(use), file_(file) { start(name); }
   PngReader(const PngReader&) = delete;
   PngReader& operator=(const PngReader&) = delete;
 
@@ -56,13 +67,24 @@ class PngReader {
     const size_t row_bytes = size_t(width) * 4 * (bit_depth == 16 ? 2 : 1);
     std::vector<png_bytep> rows(height);
     for (size_t y = 0; y < height; ++y) rows[y] = static_cast<png_bytep>(out) + y * row_bytes;
-    if (!read_pixels(rows.data(), row_bytes)) fail(name, std::string("a damaged PNG file: ") + message_);
+    if (!read_pixels(rows.data(), row_bytes)) fail(use_, name, std::string("a damaged PNG file: ") + message_);
   }
 
   uint32_t width = 0, height = 0;
   int bit_depth = 0;
 
  private:
+  void start(const std::string& name) {
+    png_.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, this, on_error, on_warning);
+    if (png_.png) png_.info = png_create_info_struct(png_.png);
+    if (!png_.png || !png_.info) throw LimitError(name + ": libpng could not start (out of memory)");
+    if (!read_header()) fail(use_, name, std::string("not a readable PNG file: ") + message_);
+    width = png_get_image_width(png_.png, png_.info);
+    height = png_get_image_height(png_.png, png_.info);
+    bit_depth = png_get_bit_depth(png_.png, png_.info);
+    check_size(use_, name, width, height);
+  }
+
   static void on_error(png_structp png, png_const_charp text) {
     auto* self = static_cast<PngReader*>(png_get_error_ptr(png));
     std::snprintf(self->message_, sizeof self->message_, "%s", text);
@@ -72,6 +94,11 @@ class PngReader {
   static void on_warning(png_structp, png_const_charp) {}
   static void on_read(png_structp png, png_bytep out, size_t length) {
     auto* self = static_cast<PngReader*>(png_get_io_ptr(png));
+    if (self->file_) {
+      if (std::fread(out, 1, length, self->file_) != length)
+        png_error(png, std::ferror(self->file_) ? "the file could not be read" : "the file ends early");
+      return;
+    }
     if (length > self->bytes_.size() - self->at_) png_error(png, "the file ends early");
     std::memcpy(out, self->bytes_.data() + self->at_, length);
     self->at_ += length;
@@ -111,7 +138,9 @@ class PngReader {
   };
 
   Structs png_;  // freed also when the constructor throws
-  std::string_view bytes_;
+  Use use_;
+  std::string_view bytes_;  // the file's bytes, or
+  std::FILE* file_ = nullptr;  // the file
   size_t at_ = 0;
   char message_[200] = "";
 };
@@ -125,9 +154,9 @@ class JpegReader {
     if (!handle) throw LimitError(name + ": TurboJPEG could not start: " + tjGetErrorStr2(nullptr));
     int subsampling = 0, colorspace = 0;
     if (tjDecompressHeader3(handle.get(), data, size, &width, &height, &subsampling, &colorspace) != 0)
-      fail(name, std::string("not a readable JPEG file: ") + tjGetErrorStr2(handle.get()));
-    if (colorspace == TJCS_CMYK || colorspace == TJCS_YCCK) fail(name, "a CMYK JPEG file; textures must be RGB or greyscale");
-    check_size(name, uint64_t(std::max(width, 0)), uint64_t(std::max(height, 0)));
+      fail(Use::texture, name, std::string("not a readable JPEG file: ") + tjGetErrorStr2(handle.get()));
+    if (colorspace == TJCS_CMYK || colorspace == TJCS_YCCK) fail(Use::texture, name, "a CMYK JPEG file; textures must be RGB or greyscale");
+    check_size(Use::texture, name, uint64_t(std::max(width, 0)), uint64_t(std::max(height, 0)));
   }
   std::unique_ptr<void, int (*)(tjhandle)> handle;
   const unsigned char* data;
@@ -135,8 +164,7 @@ class JpegReader {
   int width = 0, height = 0;
 };
 
-Picture decode_png(std::string_view bytes, const std::string& name) {
-  PngReader reader(bytes, name);
+Picture decode_png(PngReader& reader, const std::string& name) {
   Picture picture{reader.width, reader.height, {}, {}};
   const size_t samples = size_t(reader.width) * reader.height * 4;
   if (reader.bit_depth == 16) {
@@ -156,7 +184,7 @@ Picture decode_jpeg(std::string_view bytes, const std::string& name) {
   // TJFLAG_LIMITSCANS: a progressive file of thousands of tiny scans is refused, not decoded for minutes.
   if (tjDecompress2(reader.handle.get(), reader.data, reader.size, picture.rgba.data(), width, 0, height, TJPF_RGBA,
                     TJFLAG_ACCURATEDCT | TJFLAG_LIMITSCANS) != 0)
-    fail(name, std::string("a damaged JPEG file: ") + tjGetErrorStr2(reader.handle.get()));
+    fail(Use::texture, name, std::string("a damaged JPEG file: ") + tjGetErrorStr2(reader.handle.get()));
   return picture;
 }
 
@@ -167,20 +195,32 @@ bool is_jpeg(std::string_view bytes) { return bytes.size() >= 3 && bytes.substr(
 
 PictureSize picture_size(std::string_view bytes, const std::string& name) {
   if (is_png(bytes)) {
-    const PngReader reader(bytes, name);
+    const PngReader reader(bytes, name, Use::texture);
     return {reader.width, reader.height};
   }
   if (is_jpeg(bytes)) {
     const JpegReader reader(bytes, name);
     return {uint32_t(reader.width), uint32_t(reader.height)};
   }
-  fail(name, bytes.empty() ? "the picture is empty" : "not a PNG or JPEG file (vkray's textures are PNG or JPEG)");
+  fail(Use::texture, name, bytes.empty() ? "the picture is empty" : "not a PNG or JPEG file (vkray's textures are PNG or JPEG)");
 }
 
 Picture decode_picture(std::string_view bytes, const std::string& name) {
-  if (is_png(bytes)) return decode_png(bytes, name);
+  if (is_png(bytes)) {
+    PngReader reader(bytes, name, Use::texture);
+    return decode_png(reader, name);
+  }
   if (is_jpeg(bytes)) return decode_jpeg(bytes, name);
-  fail(name, bytes.empty() ? "the picture is empty" : "not a PNG or JPEG file (vkray's textures are PNG or JPEG)");
+  fail(Use::texture, name, bytes.empty() ? "the picture is empty" : "not a PNG or JPEG file (vkray's textures are PNG or JPEG)");
+}
+
+Picture decode_png_image(std::FILE* file, const std::string& name) {
+  PngReader reader(file, name, Use::image_file);
+  try {
+    return decode_png(reader, name);
+  } catch (const std::bad_alloc&) {
+    throw out_of_host_memory(name, reader.width, reader.height);
+  }
 }
 
 }  // namespace vkray

@@ -1,9 +1,11 @@
-// PNG and JPEG files decoded to RGBA samples: the pictures textures are made of. libpng and
-// libjpeg-turbo (TurboJPEG) do the decoding; a picture's size is read from its header and checked
-// against vkray's limits before any pixel memory is allocated.
+// PNG and JPEG files decoded to RGBA samples: the pictures textures are made of, and the PNG image
+// files read_png (image.h) reads, so that a PNG's samples mean the same wherever vkray reads it.
+// libpng and libjpeg-turbo (TurboJPEG) do the decoding; a picture's size is read from its header and
+// checked against vkray's limits before any pixel memory is allocated.
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -44,5 +46,12 @@ PictureSize picture_size(std::string_view bytes, const std::string& name);
 // refused). Greyscale becomes grey RGB; a missing alpha is full scale. Throws SceneError
 // "<name>: <why>": an unknown format, a damaged file, a size past the limits above.
 Picture decode_picture(std::string_view bytes, const std::string& name);
+
+// A PNG image file (read_png, image.h), decoded as decode_picture decodes a texture's PNG but read
+// from `file` as libpng asks for its bytes (an image may be far larger than a texture) and held to
+// an image's limit, kMaxImageSide on a side (image.h), instead of a picture's. Throws InputError
+// "<name>: <why>" (not a PNG file, a damaged one, a size past the limit), LimitError when its pixels
+// do not fit in host memory.
+Picture decode_png_image(std::FILE* file, const std::string& name);
 
 }  // namespace vkray

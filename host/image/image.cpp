@@ -27,6 +27,7 @@
 #include "base/check.h"
 #include "base/errors.h"
 #include "base/interrupt.h"
+#include "image/decode.h"
 
 namespace vkray {
 namespace {
@@ -284,30 +285,36 @@ Image read_pfm(const std::filesystem::path& file) {
   return image;
 }
 
-Image read_png(const std::filesystem::path& file) {
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&png, file.string().c_str()))
-    throw InputError(file.string() + ": " + png.message);
-  if (png.width > kMaxImageSide || png.height > kMaxImageSide) {
-    png_image_free(&png);
-    throw InputError(file.string() + ": a PNG of " + std::to_string(png.width) + " x " + std::to_string(png.height) +
-                     " pixels (vkray reads up to " + std::to_string(kMaxImageSide) + " on a side)");
-  }
-  png.format = PNG_FORMAT_RGB;
-  std::vector<uint8_t> bytes;
-  Image image;
-  try {
-    bytes.resize(PNG_IMAGE_SIZE(png));
-    image = Image(png.width, png.height);
-  } catch (const std::bad_alloc&) {
-    png_image_free(&png);
-    throw out_of_host_memory(file, png.width, png.height);
-  }
-  if (!png_image_finish_read(&png, nullptr, bytes.data(), 0, nullptr))
-    throw InputError(file.string() + ": " + png.message);
+namespace {
+
+// A picture's colour samples (its alpha, if any, dropped) from sRGB to linear, through a table of
+// every value a sample of its depth can hold: v / max_value decoded once. An 8-bit v and a 16-bit
+// 257 v are the same quotient, rounded once, so they are the same light; 8-bit values are exactly
+// decode_srgb8's, the inverse of write_png's encode_srgb8.
+template <typename Sample>
+void decode_colour(const std::vector<Sample>& rgba, uint32_t max_value, Image& image) {
+  std::vector<float> linear(size_t(max_value) + 1);
+  for (uint32_t v = 0; v <= max_value; ++v) linear[v] = decode_srgb(float(v) / float(max_value));
   for (size_t i = 0; i < image.pixels.size(); ++i)
-    image.pixels[i] = {decode_srgb8(bytes[i * 3]), decode_srgb8(bytes[i * 3 + 1]), decode_srgb8(bytes[i * 3 + 2])};
+    image.pixels[i] = {linear[rgba[4 * i]], linear[rgba[4 * i + 1]], linear[rgba[4 * i + 2]]};
+}
+
+struct FileCloser {
+  void operator()(FILE* file) const { std::fclose(file); }
+};
+
+}  // namespace
+
+Image read_png(const std::filesystem::path& file) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(file, error)) throw InputError(file.string() + ": not found, or not a regular file");
+  const std::unique_ptr<FILE, FileCloser> in(std::fopen(file.c_str(), "rb"));
+  if (!in) throw InputError(file.string() + ": cannot open: " + std::strerror(errno));
+  // The decoder textures use: the samples as stored, no colour-space chunk applied.
+  const Picture picture = decode_png_image(in.get(), file.string());
+  Image image = allocate_image(file, picture.width, picture.height);
+  if (picture.sixteen_bit()) decode_colour(picture.rgba16, 65535, image);
+  else decode_colour(picture.rgba, 255, image);
   return image;
 }
 

@@ -45,10 +45,13 @@ void write_pfm(const Image& image, const std::filesystem::path& file);
 // The PFM's bytes into `out`, which the caller commits (with a file that must change with it).
 void write_pfm(const Image& image, AtomicFile& out);
 
-// Readers of parts, tests and tools. read_png returns decoded (linear) values. A header's size is
-// checked against the file's (a PFM's exactly) and against kMaxImageSide before anything is
-// allocated for it. Throw InputError naming the file; LimitError ("out of host memory") when an
-// image the file does hold does not fit in memory.
+// Readers of parts, tests and tools. A header's size is checked against the file's (a PFM's exactly)
+// and against kMaxImageSide before anything is allocated for it. Throw InputError naming the file;
+// LimitError ("out of host memory") when an image the file does hold does not fit in memory.
+// read_png returns linear values, its samples decoded from sRGB as a texture's are (image/decode.h):
+// any bit depth or colour type, an 8-bit v and a 16-bit 257 v alike, alpha dropped, and no
+// colour-space chunk (gAMA, cHRM, iCCP, sRGB) applied. For a file write_png wrote, each value is
+// decode_srgb8 of the byte stored, so that encode_srgb8 gives that byte back.
 Image read_pfm(const std::filesystem::path& file);
 Image read_png(const std::filesystem::path& file);
 
