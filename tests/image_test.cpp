@@ -1,7 +1,10 @@
 // Image encoding and files: the contract's sRGB rule, PFM layout, atomic writes (of one file, and of
 // files that change together).
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -140,31 +143,47 @@ std::string text_of(const std::filesystem::path& file) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+std::vector<std::string> names_in(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// link(2) on a file system without hard links (FAT, some network and FUSE file systems).
+int no_hard_links(const char*, const char*) {
+  errno = EPERM;
+  return -1;
+}
+
 TEST_F(ImageFileTest, FilesCommittedTogetherAreAllReplacedOrNone) {
   // An image and its record change together: when the second cannot be renamed into place (here a
-  // folder stands in its way), the first is put back as it was, or removed if it was not there.
-  std::ofstream(dir_ / "image") << "old image";
-  std::filesystem::create_directories(dir_ / "record" / "inside");
-  for (const char* first : {"image", "new-image"}) {
-    AtomicFile image(dir_ / first), record(dir_ / "record");
+  // folder stands in its way), the first is put back as it was, or removed if it was not there. The
+  // old image is kept meanwhile under a hard link, or where the file system has none, moved aside.
+  for (const AtomicFile::LinkFunction link : {AtomicFile::LinkFunction(::link), AtomicFile::LinkFunction(no_hard_links)}) {
+    SCOPED_TRACE(link == ::link ? "with hard links" : "without hard links");
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_ / "record" / "inside");
+    std::ofstream(dir_ / "image") << "old image";
+    for (const char* first : {"image", "new-image"}) {
+      AtomicFile image(dir_ / first), record(dir_ / "record");
+      std::fputs("new image", image.get());
+      std::fputs("new record", record.get());
+      EXPECT_THROW(AtomicFile::commit_together({&image, &record}, link), OutputError) << first;
+    }
+    EXPECT_EQ(text_of(dir_ / "image"), "old image");
+    EXPECT_EQ(names_in(dir_), (std::vector<std::string>{"image", "record"}));  // no temporary file, no second name left
+    // When both can be, both are.
+    std::filesystem::remove_all(dir_ / "record");
+    std::ofstream(dir_ / "record") << "old record";
+    AtomicFile image(dir_ / "image"), record(dir_ / "record");
     std::fputs("new image", image.get());
     std::fputs("new record", record.get());
-    EXPECT_THROW(AtomicFile::commit_together({&image, &record}), OutputError) << first;
+    AtomicFile::commit_together({&image, &record}, link);
+    EXPECT_EQ(text_of(dir_ / "image"), "new image");
+    EXPECT_EQ(text_of(dir_ / "record"), "new record");
+    EXPECT_EQ(names_in(dir_), (std::vector<std::string>{"image", "record"}));
   }
-  EXPECT_EQ(text_of(dir_ / "image"), "old image");
-  EXPECT_FALSE(std::filesystem::exists(dir_ / "new-image"));
-  std::vector<std::string> names;
-  for (const auto& entry : std::filesystem::directory_iterator(dir_)) names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{"image", "record"}));  // no temporary file, no second name left
-  // When both can be, both are.
-  std::filesystem::remove_all(dir_ / "record");
-  AtomicFile image(dir_ / "image"), record(dir_ / "record");
-  std::fputs("new image", image.get());
-  std::fputs("new record", record.get());
-  AtomicFile::commit_together({&image, &record});
-  EXPECT_EQ(text_of(dir_ / "image"), "new image");
-  EXPECT_EQ(text_of(dir_ / "record"), "new record");
 }
 
 }  // namespace

@@ -56,55 +56,94 @@ namespace {
 
 // What a target held before a rename replaced it, so that the rename can be undone.
 struct Previous {
-  enum { absent, kept, unknown } state = unknown;
-  std::filesystem::path kept_as;  // a hard link to the old file, when kept
+  enum { absent, kept, moved_aside, unknown } state = unknown;
+  std::filesystem::path kept_as;  // the old file's second name, when kept or moved aside
 };
 
-Previous keep_previous(const std::filesystem::path& target, const std::filesystem::path& temp) {
+// Keeps what `target` holds under a second name beside it (its temporary file's, plus ".old": as
+// unique as that): a hard link, which leaves the target in place; or, on a file system without hard
+// links (FAT, some network and FUSE file systems), the old file itself, renamed aside for the moment
+// of the renames. A folder in the target's place is left where it is: no rename replaces it.
+// Throws OutputError when an old file can be kept neither way, before anything was replaced.
+Previous keep_previous(const std::filesystem::path& target, const std::filesystem::path& temp, AtomicFile::LinkFunction link) {
   Previous previous;
-  std::filesystem::path link = temp;
-  link += ".old";  // unique: the temporary name is
-  if (::link(target.c_str(), link.c_str()) == 0) {
+  previous.kept_as = temp;
+  previous.kept_as += ".old";
+  struct stat status {};
+  if (::lstat(target.c_str(), &status) != 0 && errno == ENOENT) {
+    previous.state = Previous::absent;
+  } else if (S_ISDIR(status.st_mode)) {
+    previous.state = Previous::unknown;
+  } else if (link(target.c_str(), previous.kept_as.c_str()) == 0) {
     previous.state = Previous::kept;
-    previous.kept_as = link;
   } else if (errno == ENOENT) {
     previous.state = Previous::absent;
-  }  // else a file system without hard links: the old file cannot be put back
+  } else if (::rename(target.c_str(), previous.kept_as.c_str()) == 0) {
+    previous.state = Previous::moved_aside;
+  } else if (errno == ENOENT) {
+    previous.state = Previous::absent;
+  } else {
+    throw OutputError(target.string() + ": cannot keep the old file while the files that change with it are renamed into place: " +
+                      std::strerror(errno));
+  }
   return previous;
 }
 
-void put_back(const std::filesystem::path& target, const Previous& previous) {
-  std::error_code ignored;
-  if (previous.state == Previous::kept) std::filesystem::rename(previous.kept_as, target, ignored);
-  if (previous.state == Previous::absent) std::filesystem::remove(target, ignored);
+// Puts back what the first `count` renames replaced, the last first. Returns what could not be put
+// back ("; the old FILE is kept as NAME" for each), for the error's message: an old file whose rename
+// back fails stays under its second name.
+std::string put_back(const std::vector<std::filesystem::path>& targets, std::vector<Previous>& previous, size_t count) {
+  std::string stranded;
+  for (size_t i = count; i-- > 0;) {
+    Previous& p = previous[i];
+    std::error_code ec;
+    if (p.state == Previous::absent) std::filesystem::remove(targets[i], ec);
+    if (p.state != Previous::kept && p.state != Previous::moved_aside) continue;
+    std::filesystem::rename(p.kept_as, targets[i], ec);
+    if (ec) stranded += "; the old " + targets[i].string() + " is kept as " + p.kept_as.string();
+    p.state = Previous::unknown;  // put back, or left where it is
+  }
+  return stranded;
 }
 
-// Removes the second names of the old files (once put back, a name is gone already).
+// Removes the second names of the old files that were not put back: links, or (after a rename over
+// the target) the old files themselves.
 void forget(const std::vector<Previous>& previous) {
   std::error_code ignored;
   for (const Previous& p : previous)
-    if (p.state == Previous::kept) std::filesystem::remove(p.kept_as, ignored);
+    if (p.state == Previous::kept || p.state == Previous::moved_aside) std::filesystem::remove(p.kept_as, ignored);
 }
 
 }  // namespace
 
-void AtomicFile::commit_together(std::initializer_list<AtomicFile*> files) {
+void AtomicFile::commit_together(std::initializer_list<AtomicFile*> files) { commit_together(files, ::link); }
+
+void AtomicFile::commit_together(std::initializer_list<AtomicFile*> files, LinkFunction link) {
   // Every write is checked first: a full disk or a size limit leaves every target as it was.
   for (AtomicFile* file : files) file->finish();
+  std::vector<std::filesystem::path> targets;
+  for (AtomicFile* file : files) targets.push_back(file->target_);
   std::vector<Previous> previous(files.size());
   const bool undoable = files.size() > 1;
   // Not after an interrupt request: a command stopped by Ctrl-C writes nothing.
   commit_unless_interrupted(files.begin()[0]->temp_, [&] {
-    size_t renamed = 0;
-    for (; renamed < files.size(); ++renamed) {
+    for (size_t renamed = 0; renamed < files.size(); ++renamed) {
       AtomicFile& file = *files.begin()[renamed];
-      if (undoable) previous[renamed] = keep_previous(file.target_, file.temp_);
+      try {
+        if (undoable) previous[renamed] = keep_previous(file.target_, file.temp_, link);
+      } catch (const OutputError& e) {
+        const std::string stranded = put_back(targets, previous, renamed);
+        forget(previous);
+        throw OutputError(e.what() + stranded);
+      }
       std::error_code ec;
       std::filesystem::rename(file.temp_, file.target_, ec);
       if (!ec) continue;
-      for (size_t i = renamed; i-- > 0;) put_back(files.begin()[i]->target_, previous[i]);
+      // The earlier targets as they were, and this one too if its old file was moved aside.
+      const size_t changed = renamed + (previous[renamed].state == Previous::moved_aside ? 1 : 0);
+      const std::string stranded = put_back(targets, previous, changed);
       forget(previous);
-      throw OutputError(file.target_.string() + ": cannot rename into place: " + ec.message());
+      throw OutputError(file.target_.string() + ": cannot rename into place: " + ec.message() + stranded);
     }
     forget(previous);
   });

@@ -23,10 +23,16 @@ class AtomicFile {
 
   // Renames every file into place, or none: files that belong together (an image and its record).
   // Every write is checked before the first rename, the renames happen under one interrupt check,
-  // and when a rename fails the files the earlier ones replaced are put back (kept meanwhile under
-  // a second name, a hard link). Throws OutputError naming the file whose write or rename failed,
-  // Cancelled.
+  // and when a rename fails the files the earlier ones replaced are put back. Each is kept meanwhile
+  // under a second name beside it: a hard link, or on a file system without hard links the old file
+  // itself, renamed aside until the renames are done (a reader at that moment finds no file there).
+  // Throws OutputError naming the file whose write or rename failed, or whose old file could be kept
+  // neither way (then nothing is replaced); Cancelled.
   static void commit_together(std::initializer_list<AtomicFile*> files);
+  // The same, keeping an old file by `link` (link(2)'s signature): a test passes one that fails as
+  // a file system without hard links does.
+  using LinkFunction = int (*)(const char* from, const char* to);
+  static void commit_together(std::initializer_list<AtomicFile*> files, LinkFunction link);
 
  private:
   // Closes the file and gives it its mode. Throws OutputError when a write failed.
