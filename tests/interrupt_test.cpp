@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -18,6 +19,7 @@
 
 #include "base/errors.h"
 #include "base/interrupt.h"
+#include "base/per_process.h"
 #include "bvh/bvh.h"
 #include "cpu/reference.h"
 #include "image/image.h"
@@ -181,6 +183,30 @@ TEST_F(InterruptTest, AForkedChildDoesNotRemoveTheParentsTemporaryFiles) {
   EXPECT_TRUE(std::filesystem::exists(pattern));
   unregister_temporary_file(pattern);
   ::close(fd);
+}
+
+// What a parent's thread could hold in the object: a count, a destructor that must not run in a child.
+struct Held {
+  int count = 0;
+  ~Held() { std::abort(); }  // never destroyed, in the parent or in a child
+};
+
+TEST(PerProcessTest, AForkedChildMakesItsOwnObjectAndLeavesTheParentsAsItIs) {
+  static PerProcess<Held> held;  // its user registers nothing for fork()
+  Held* const parents = &held.get();
+  parents->count = 7;
+  held.remake();  // in the process that made it: nothing changes
+  EXPECT_EQ(&held.get(), parents);
+  EXPECT_EQ(in_forked_child([&] {
+              if (&held.get() == parents) return 1;  // a new object, at another address
+              if (held.get().count != 0) return 2;   // made afresh
+              if (parents->count != 7) return 3;     // the parent's, as it was
+              held.get().count = 5;
+              return 0;
+            }),
+            0);
+  EXPECT_EQ(&held.get(), parents);
+  EXPECT_EQ(parents->count, 7);
 }
 
 }  // namespace

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "base/errors.h"
-#include "base/threads.h"
+#include "base/per_process.h"
 
 namespace vkray {
 namespace {
@@ -29,32 +29,28 @@ struct TemporaryFiles {
   std::vector<std::filesystem::path> files;
   bool closed = false;  // set by remove_temporary_files(): the process is about to end
 };
-PerProcess<TemporaryFiles>& temporary_files_slot() {
+TemporaryFiles& temporary_files() {
   static PerProcess<TemporaryFiles> files;  // a forced exit may use it late
-  return files;
+  return files.get();
 }
-TemporaryFiles& temporary_files() { return temporary_files_slot().get(); }
 
 struct Flight {
   std::mutex mutex;
   std::condition_variable ended;  // notified when the count falls to 0
   size_t count = 0;
 };
-PerProcess<Flight>& flight_slot() {
+Flight& flight() {
   static PerProcess<Flight> flight;
-  return flight;
+  return flight.get();
 }
-Flight& flight() { return flight_slot().get(); }
 
-// A forked child has one thread, the one that called fork(): the parent's work in flight, its
-// request and its temporary files (which the child must not remove) stay the parent's, and the
-// parent's descriptor would share its counter.
+// A forked child has one thread, the one that called fork(): the parent's request stays the parent's,
+// and the parent's descriptor would share its counter. (Its work in flight and its temporary files,
+// which the child must not remove, stay the parent's too: PerProcess.)
 void in_forked_child() noexcept {
   requested.store(false, std::memory_order_relaxed);
   ::close(event_fd);
   event_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
-  temporary_files_slot().remake();
-  flight_slot().remake();
 }
 [[maybe_unused]] const int fork_handler = ::pthread_atfork(nullptr, nullptr, in_forked_child);
 

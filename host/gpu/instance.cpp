@@ -1,7 +1,5 @@
 #include "gpu/instance.h"
 
-#include <pthread.h>
-
 #include <algorithm>
 #include <mutex>
 #include <string>
@@ -9,7 +7,7 @@
 #include <vector>
 
 #include "base/errors.h"
-#include "base/threads.h"
+#include "base/per_process.h"
 
 namespace vkray::gpu {
 namespace {
@@ -53,7 +51,6 @@ struct Instances {
 };
 Instances& instances() {
   static PerProcess<Instances> all;
-  [[maybe_unused]] static const int remade = ::pthread_atfork(nullptr, nullptr, [] { all.remake(); });
   return all.get();
 }
 
