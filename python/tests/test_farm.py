@@ -25,7 +25,8 @@ import pytest
 
 import vkray
 import vkray.farm as farm_module
-from conftest import SCENES, run
+from vkray._farm_outputs import _commit
+from conftest import ROOT, SCENES, run
 
 # Every test renders the Cornell box with paths: cheap, and noisy, so that any wrong sample shows.
 RENDER = ["--width", "64", "--height", "48", "--spp", "8"]
@@ -422,7 +423,6 @@ def test_a_python_without_dask_is_told_what_to_install_for_it(scenes, tmp_path):
 def test_outputs_are_renamed_into_place_all_or_none(tmp_path):
     # The farm's last step: frame 0 is renamed into place, frame 1 cannot be (its folder is gone), and
     # frame 0's earlier file is back as it was.
-    from vkray.farm import _commit
     parts = tmp_path / "parts"
     parts.mkdir()
     (parts / "merged0").write_text("new 0")
@@ -436,6 +436,24 @@ def test_outputs_are_renamed_into_place_all_or_none(tmp_path):
     (parts / "merged0").write_text("new 0")
     _commit([parts / "merged0", parts / "merged1"], [tmp_path / "out.0000.pfm", tmp_path / "out.0001.pfm"], parts)
     assert [(tmp_path / f"out.000{i}.pfm").read_text() for i in (0, 1)] == ["new 0", "new 1"]
+
+
+def test_the_installed_package_holds_every_module_of_the_farm(tmp_path, scenes):
+    # `cmake --install` lays out every .py of python/vkray, and the farm runs from there: it reads
+    # its options only after importing all of its modules.
+    build, cmake, site = (os.environ.get(k) for k in ("VKRAY_BUILD_DIR", "CMAKE_COMMAND", "VKRAY_PYTHON_INSTALL_DIR"))
+    if not (build and cmake and site):
+        pytest.fail("VKRAY_BUILD_DIR, CMAKE_COMMAND and VKRAY_PYTHON_INSTALL_DIR are set by ctest")
+    prefix = tmp_path / "prefix"
+    subprocess.run([cmake, "--install", build, "--prefix", str(prefix)], check=True, capture_output=True, timeout=120)
+    package = prefix / site / "vkray"
+    sources = sorted(p.name for p in (ROOT / "python" / "vkray").glob("*.py"))
+    assert "_farm_parts.py" in sources
+    assert [name for name in sources if not (package / name).is_file()] == []
+    job = run(sys.executable, "-m", "vkray.farm", str(scenes / "cornell.json"), "-o", "x.pfm", "--width", "20000", check=False,
+              cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(prefix / site)))
+    assert job.returncode == 2, job.stderr
+    assert "vkray.farm: error: --width: expected an integer from 1 to 16384, got 20000" in job.stderr, job.stderr
 
 
 def test_bands_and_merge_from_python(scenes, tmp_path):

@@ -1,0 +1,18 @@
+"""The farm's own kinds of failure, beside vkray's (SceneError, UsageError, DeviceError): each is one
+class of the command line's exit codes, which ``vkray.farm.main`` maps them to."""
+
+
+class _Usage(Exception):
+    """An option's value the farm refuses: usage (2), as `vkray render` refuses a flag's."""
+
+
+class _CannotWrite(Exception):
+    """An output, or a part in the folder beside it, cannot be written: bad input (1)."""
+
+
+class _MissingDask(Exception):
+    """Dask's distributed is not importable by the Python that runs the farm: bad input (1)."""
+
+
+class _ClusterError(Exception):
+    """The cluster cannot do the job: no workers, none with a GPU, all of them lost (3)."""
