@@ -221,7 +221,7 @@ TEST(CliTest, ParityCatchesAPerturbedShader) {
   const auto entry = dir / "shaders" / "trace.comp";
   std::ifstream in(entry);
   std::string text((std::istreambuf_iterator<char>(in)), {});
-  const std::string from = "sum * frame.inv_samples_per_pixel";
+  const std::string from = "direct_radiance(ray, stream, rays) * frame.inv_samples_per_pixel";
   ASSERT_NE(text.find(from), std::string::npos);
   text.replace(text.find(from), from.size(), from + " * 1.02");
   std::ofstream(entry) << text;
