@@ -3,6 +3,7 @@ merge`), to the Python module and to the farm ends in the same class, exit code 
 usage, 3 device (docs/commands.md, "Exit codes"), and SceneError, UsageError or DeviceError in
 Python, with the same words."""
 
+import dataclasses
 import os
 import signal
 import subprocess
@@ -21,8 +22,25 @@ EXCEPTION = {1: vkray.SceneError, 2: vkray.UsageError, 3: vkray.DeviceError}
 SMALL = {"width": 16, "height": 16, "spp": 1}
 
 
+@dataclasses.dataclass(frozen=True)
+class Faces:
+    """What differs by face: the command lines (`vkray render` and the farm) are given text, the
+    Python module objects. A value, or the words each face's message holds."""
+    command_line: str
+    python: object
+
+
+def on(face: str, value):
+    """`value` as `face` ("command line" or "python") is given it, or says it."""
+    return getattr(value, face.replace(" ", "_")) if isinstance(value, Faces) else value
+
+
 def flags(settings: dict) -> list:
-    return [f for key, value in settings.items() for f in (f"--{key}", str(value))]
+    return [f for key, value in settings.items() for f in (f"--{key}", str(on("command line", value)))]
+
+
+def keywords(settings: dict) -> dict:
+    return {key: on("python", value) for key, value in settings.items()}
 
 
 def farm(*args: str, cwd: Path, env=None) -> subprocess.CompletedProcess:
@@ -38,14 +56,33 @@ def farm(*args: str, cwd: Path, env=None) -> subprocess.CompletedProcess:
     return subprocess.CompletedProcess(job.args, job.returncode, out, err)
 
 
-# (what is wrong, the scene, the output, settings, exit code, words every face's message holds)
+def not_decimal(flag: str, text: str, limit: str) -> tuple:
+    """A number written as the command line does not read one, given as that text to every face: the
+    command lines say their decimal rule, Python that text is not an integer."""
+    return ({flag: Faces(text, text)}, 2, Faces(f'--{flag}: expected a decimal integer, got "{text}"',
+                                                f"{flag}: expected an integer from {limit}, got {text!r}"))
+
+
+# (what is wrong, the scene, the output, settings, exit code, words every face's message holds),
+# a setting or the words as a Faces where they differ by face.
 MISTAKES = [
     ("scene file missing", "missing.json", "out.pfm", {}, 1, "missing.json"),
     ("output under a file", "{cornell}", "{cornell}/out.pfm", {}, 1, "cornell.json does not exist"),
     ("output of an unknown type", "{cornell}", "out.txt", {}, 1, "unknown image type"),
     ("output is a folder", "{cornell}", "folder.pfm", {}, 1, "folder.pfm: is a folder"),
-    ("width past the limit", "{cornell}", "out.pfm", {"width": 20000}, 2, "expected an integer from 1 to 16384, got 20000"),
-    ("samples past the limit", "{cornell}", "out.pfm", {"spp": 70000}, 2, "expected an integer from 1 to 65536, got 70000"),
+    ("width past the limit", "{cornell}", "out.pfm", {"width": 20000}, 2, "width: expected an integer from 1 to 16384, got 20000"),
+    ("width below the limit", "{cornell}", "out.pfm", {"width": 0}, 2, "width: expected an integer from 1 to 16384, got 0"),
+    ("negative height", "{cornell}", "out.pfm", {"height": -5}, 2, "height: expected an integer from 1 to 16384, got -5"),
+    ("samples past the limit", "{cornell}", "out.pfm", {"spp": 70000}, 2, "spp: expected an integer from 1 to 65536, got 70000"),
+    ("negative seed", "{cornell}", "out.pfm", {"seed": -1}, 2, "seed: expected an integer from 0 to 4294967295, got -1"),
+    # Leading zeros are decimal: 020000 is twenty thousand (not octal), past the limit.
+    ("width with leading zeros", "{cornell}", "out.pfm", {"width": Faces("020000", 20000)}, 2,
+     "width: expected an integer from 1 to 16384, got 20000"),
+    ("width with underscores", "{cornell}", "out.pfm", *not_decimal("width", "1_000", "1 to 16384")),
+    ("height with a plus sign", "{cornell}", "out.pfm", *not_decimal("height", "+5", "1 to 16384")),
+    ("samples with a space", "{cornell}", "out.pfm", *not_decimal("spp", " 5", "1 to 65536")),
+    ("seed in Arabic-Indic digits", "{cornell}", "out.pfm", *not_decimal("seed", "\u0663", "0 to 4294967295")),
+    ("width in letters", "{cornell}", "out.pfm", *not_decimal("width", "abc", "1 to 16384")),
     ("a bad scene value", "{bad}", "out.pfm", {}, 1, "/objects/0/radius: expected a number > 0"),
 ]
 
@@ -71,17 +108,17 @@ def test_a_mistake_is_the_same_class_on_every_face(workdir, vkray_command, what,
 
     cli = run(vkray_command, "render", scene, "-o", output, "-q", *flags({**SMALL, **settings}), check=False, cwd=cwd)
     assert cli.returncode == code, cli.stderr
-    assert says in cli.stderr, cli.stderr
+    assert on("command line", says) in cli.stderr, cli.stderr
 
     os.chdir(cwd)
     with pytest.raises(EXCEPTION[code], match=None) as raised:
         with vkray.Renderer() as renderer:
-            renderer.render_to_file(scene, output, **{**SMALL, **settings})
-    assert says in str(raised.value), raised.value
+            renderer.render_to_file(scene, output, **keywords({**SMALL, **settings}))
+    assert on("python", says) in str(raised.value), raised.value
 
     job = farm(scene, "-o", output, *flags({**SMALL, **settings}), cwd=cwd)
     assert job.returncode == code, job.stderr
-    assert says in job.stderr, job.stderr
+    assert on("command line", says) in job.stderr, job.stderr
 
     assert sorted(p.name for p in cwd.iterdir()) == before, "a face left a file behind"
 

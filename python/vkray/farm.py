@@ -35,6 +35,8 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
+import re
 import shutil
 import signal
 import sys
@@ -54,17 +56,11 @@ from ._farm_worker import _render_part  # noqa: F401  (the task, also as vkray.f
 
 # ---- the command line -----------------------------------------------------------------------------
 
-def _whole(low: int, high: int = 2**32 - 1):
-    """An argparse type: a whole number from `low` to `high`."""
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-        if not low <= value <= high:
-            raise argparse.ArgumentTypeError(f"{value} is not from {low} to {high}")
-        return value
-    return parse
+# The options whose value is an integer, read as `vkray render` reads its flags (_decimal).
+_INTEGER_OPTIONS = ("--width", "--height", "--spp", "--seed", "--regions", "--workers")
+# Those that the library's table of limits holds, by the name `vkray._request` gives them.
+_LIMITED = ("width", "height", "spp", "seed")
+_MAX_WORKERS = 256
 
 
 def _number(what: str, low: float, high: float):
@@ -91,11 +87,11 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("scene", help="scene file (.json, .gltf, .glb), read by every worker at its absolute path")
     p.add_argument("-o", "--output", required=True, metavar="OUT", help="the whole image: .exr, .pfm or .png; with --frames, "
                    "frame N goes to OUT with .NNNN before the suffix")
-    p.add_argument("--regions", type=_whole(1), default=None, metavar="N",
+    p.add_argument("--regions", metavar="N",
                    help="bands per frame (default: twice the GPUs the workers declare, at least 2, at most the rows)")
     p.add_argument("--frames", nargs="+", default=[], metavar="SCENE", help="more scenes, rendered as frames 1, 2, ...")
     p.add_argument("--scheduler", metavar="ADDRESS", help="address of a Dask scheduler (tcp://host:8786); default: a LocalCluster here")
-    p.add_argument("--workers", type=_whole(1, 256), default=1, metavar="K",
+    p.add_argument("--workers", default="1", metavar="K",
                    help="LocalCluster worker processes (default 1). Each opens the device VKRAY_DEVICE names, or the "
                         "best one: more than one shares that GPU, which helps only a device that one process "
                         "leaves idle")
@@ -108,14 +104,95 @@ def _parser() -> argparse.ArgumentParser:
                         "workers, and the first result of each is used (default 4)")
     p.add_argument("--slow-floor", type=_seconds, default=10.0, metavar="SECONDS",
                    help="the least time that makes a worker slow, whatever the median (default 10)")
-    p.add_argument("--width", type=_whole(1), metavar="W", help="image width in pixels (default: the scene's)")
-    p.add_argument("--height", type=_whole(1), metavar="H", help="image height in pixels (default: the scene's)")
-    p.add_argument("--spp", type=_whole(1), metavar="N", help="samples per pixel (default: the scene's)")
-    p.add_argument("--seed", type=_whole(0), metavar="S", help="sample streams (default: the scene's)")
+    p.add_argument("--width", metavar="W", help="image width in pixels (default: the scene's)")
+    p.add_argument("--height", metavar="H", help="image height in pixels (default: the scene's)")
+    p.add_argument("--spp", metavar="N", help="samples per pixel (default: the scene's)")
+    p.add_argument("--seed", metavar="S", help="sample streams (default: the scene's)")
     p.add_argument("--aov", default="", metavar="LIST", help="first-hit passes for an .exr output, comma-separated")
     p.add_argument("--exr-float", action="store_true", help="32-bit float channels in an .exr output")
     p.add_argument("-q", "--quiet", action="store_true", help="print only errors")
     return p
+
+
+def _glued(argv: Sequence[str]) -> list[str]:
+    """`argv` with each integer option joined to the word after it ("--width=-x"): argparse takes a
+    word that begins with '-' for an option of its own, `vkray render` takes it as the value."""
+    out, i = [], 0
+    while i < len(argv):
+        if argv[i] == "--":
+            return out + list(argv[i:])
+        glue = argv[i] in _INTEGER_OPTIONS and i + 1 < len(argv)
+        out.append(f"{argv[i]}={argv[i + 1]}" if glue else argv[i])
+        i += 2 if glue else 1
+    return out
+
+
+def _printable(text: str, max_length: int = 60) -> str:
+    """Text from the command line fit to print on one line, as vkray's messages quote a value
+    (printable() in host/base/errors.h): control characters and bytes that are not UTF-8 become '?',
+    and text past `max_length` bytes is cut with "..."."""
+    data = os.fsencode(text)  # the bytes as given, those that are not UTF-8 included
+    out, i = bytearray(), 0
+    while i < len(data) and i < max_length:
+        byte = data[i]
+        # The length of a well-formed UTF-8 sequence starting here (RFC 3629), or 0.
+        length = (1 if byte < 0x80 else 2 if 0xc2 <= byte <= 0xdf else 3 if 0xe0 <= byte <= 0xef
+                  else 4 if 0xf0 <= byte <= 0xf4 else 0)
+        if any(i + k >= len(data) or data[i + k] & 0xc0 != 0x80 for k in range(1, length)):
+            length = 0
+        control = byte < 0x20 or byte == 0x7f or (byte == 0xc2 and length == 2 and data[i + 1] < 0xa0)
+        if length == 0 or control or i + length > max_length:
+            out += b"?"
+        else:
+            out += data[i:i + length]
+        i += length or 1
+    return out.decode("utf-8", "replace") + ("..." if len(data) > max_length else "")
+
+
+def _decimal(option: str, text: str) -> tuple[int, str]:
+    """An integer option's value as `vkray render` reads its flags (host/cli/flags.cpp): decimal
+    digits, leading zeros read as decimal ("0100" is 100), or '-' and digits, which is out of every
+    option's range. Returns (the value to hold against the option's range, the value as the range's
+    message shows it): a negative value stands as -1 and shows as written ("-05"); one of more than
+    ten digits, past every range, stands as 10**10 (int() refuses to read past 4300 digits)."""
+    negative = text.startswith("-")
+    digits = text[negative:]
+    if not re.fullmatch("[0-9]+", digits):
+        raise _Usage(f'{option}: expected a decimal integer, got "{_printable(text)}"')
+    significant = digits.lstrip("0") or "0"
+    if negative:
+        return -1, text
+    return (10**10 if len(significant) > 10 else int(significant)), significant
+
+
+def _limited(name: str, text: Optional[str]) -> Optional[int]:
+    """--width, --height, --spp or --seed (`name`): the decimal rule, then the library's table of
+    limits, which `vkray render` checks its flags with, in its words and with the value as the
+    command line shows it: "--width: expected an integer from 1 to 16384, got 0"."""
+    if text is None:
+        return None
+    value, shown = _decimal(f"--{name}", text)
+    try:
+        vkray._request(**{**dict.fromkeys(_LIMITED), name: value}, aovs=(), region=None)
+    except vkray.UsageError as e:
+        words, got, _ = str(e).rpartition(", got ")
+        raise _Usage(f"--{words}{got}{_printable(shown)}" if got else f"--{e}") from None
+    return value
+
+
+def _arguments(argv: Optional[Sequence[str]]) -> argparse.Namespace:
+    """The command line, its integers read and checked as `vkray render` reads and checks its flags,
+    before anything else: --width, --height, --spp and --seed against the library's table of limits,
+    --workers against the farm's own. --regions, whose range is the rows of a frame, is checked once
+    the scenes are read (`regions_shown` is how its message shows it)."""
+    args = _parser().parse_args(_glued(sys.argv[1:] if argv is None else argv))
+    for name in _LIMITED:
+        setattr(args, name, _limited(name, getattr(args, name)))
+    args.workers, shown = _decimal("--workers", args.workers)
+    if not 1 <= args.workers <= _MAX_WORKERS:
+        raise _Usage(f"--workers: expected an integer from 1 to {_MAX_WORKERS}, got {_printable(shown)}")
+    args.regions, args.regions_shown = (None, None) if args.regions is None else _decimal("--regions", args.regions)
+    return args
 
 
 def _log(quiet: bool, line: str) -> None:
@@ -126,28 +203,22 @@ def _log(quiet: bool, line: str) -> None:
 # ---- the job --------------------------------------------------------------------------------------
 
 def run(argv: Optional[Sequence[str]] = None) -> int:
-    args = _parser().parse_args(argv)
+    args = _arguments(argv)
     _require_dask()
     output = Path(args.output)
     aovs = args.aov.split(",") if args.aov else []
     # The library's own checks of an output, so that the farm refuses what `vkray render -o` refuses,
     # with the same message and exit code.
     vkray._vkray._check_output(output, aovs, args.exr_float, False)
-    # The numbers against the library's table of limits, which `vkray render` checks its flags with:
-    # the same range and words, "--width: expected an integer from 1 to 16384, got 20000".
-    try:
-        vkray._request(args.width, args.height, args.spp, args.seed, (), None)
-    except vkray.UsageError as e:
-        raise _Usage(f"--{e}") from None
     suffix = _PART_SUFFIX[output.suffix.lower()]
     settings = {"width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed, "aovs": args.aov,
                 "exr_float": args.exr_float}
     # Every scene read here first, so that a bad one fails before any worker starts.
     scenes = [str(Path(s).resolve()) for s in [args.scene, *args.frames]]
     rows = min(vkray.bands(scene, 1, width=args.width, height=args.height)[0][3] for scene in scenes)
-    if args.regions is not None and args.regions > rows:
-        raise _Usage(f"--regions {args.regions}: a frame renders {rows} rows, and a band has at least one row, "
-                     f"so 1 to {rows}")
+    if args.regions is not None and not 1 <= args.regions <= rows:
+        raise _Usage(f"--regions {_printable(args.regions_shown)}: a frame renders {rows} rows, and a band has at "
+                     f"least one row, so 1 to {rows}")
 
     targets = [_frame_output(output, frame, len(scenes)) for frame in range(len(scenes))]
     for target in targets:
