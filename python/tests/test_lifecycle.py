@@ -22,21 +22,38 @@ TIMEOUT = 120  # a hang fails the test; no assertion is made about speed
 
 def run_program(body: str, scene) -> subprocess.CompletedProcess:
     program = textwrap.dedent(f"""
-        import sys, threading, time, vkray
+        import sys, threading, time, types, vkray
         SCENE = {str(scene)!r}
+        # A teardown that takes a while, as a finalizer doing I/O does: the end of the interpreter then
+        # lasts longer than the module's 50 ms polls of a render, so every thread whose render is in
+        # flight comes back for the GIL while it ends, whatever the timing.
+        class SlowTeardown:
+            def __del__(self, sleep=time.sleep):
+                sleep(0.2)
+        sys.modules["slow_teardown"] = types.ModuleType("slow_teardown")
+        sys.modules["slow_teardown"].finalizer = SlowTeardown()  # destroyed as the modules are
         vkray.render(SCENE, width=16, height=16)  # the device opened and the shaders compiled once
         def render_long():
             vkray.render(SCENE, {LONG})
         def render_long_cpu():
             vkray.render(SCENE, {LONG}, renderer="cpu", threads=2)
+        renders = 0
         def start_rendering(target=render_long, daemon=True):
-            started = threading.Event()
+            # Returns once the thread's render is in flight (or over), as the module counts them.
+            global renders
+            renders += 1
+            ended = threading.Event()
             def work():
-                started.set()
-                target()
+                try:
+                    target()
+                finally:
+                    ended.set()
             threading.Thread(target=work, daemon=daemon).start()
-            started.wait()
-            time.sleep(0.5)  # well inside the render
+            deadline = time.monotonic() + 60
+            while vkray._vkray._calls_in_flight() < renders and not ended.is_set():
+                if time.monotonic() > deadline:
+                    sys.exit("the render did not start")
+                time.sleep(0.005)
     """) + textwrap.dedent(body)
     return subprocess.run([sys.executable, "-c", program], capture_output=True, text=True, timeout=TIMEOUT)
 
