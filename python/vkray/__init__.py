@@ -277,7 +277,9 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
         SceneError: the scene or a file it names cannot be used (the message names the file and key).
         UsageError: an argument is out of range or of the wrong kind (the message names it).
         DeviceError: no such device, or the device failed.
-        KeyboardInterrupt: Ctrl-C, within a fraction of a second.
+        KeyboardInterrupt: Ctrl-C, within a fraction of a second; also when an exception a signal
+            handler raised on the main thread stopped the main thread's vkray call while this one
+            ran (the library has one request to stop per process: docs/python.md).
     """
     if renderer == "gpu":
         with Renderer(device) as r:
