@@ -1,12 +1,9 @@
 // How many threads vkray's CPU work uses when the user names no number (one per hardware thread),
-// and the most a user may name. (What a child made by fork(), which has one thread, makes afresh is
-// in base/per_process.h.)
+// and the most a user may name.
 #pragma once
 
 #include <algorithm>
 #include <thread>
-
-#include "base/per_process.h"
 
 namespace vkray {
 

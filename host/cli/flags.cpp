@@ -29,14 +29,7 @@ bool has_limit(CLI::Option& option) {
 
 CLI::Validator within(const ArgumentLimit& limit) {
   return CLI::Validator(
-      [limit](std::string& text) -> std::string {
-        const bool negative = text.starts_with('-');
-        const std::string_view digits = std::string_view(text).substr(negative ? 1 : 0);
-        if (digits.empty() || digits.find_first_not_of("0123456789") != std::string_view::npos) return "";
-        const std::string_view significant = digits.substr(std::min(digits.find_first_not_of('0'), digits.size()));
-        if (negative || significant.size() > 10) return limit.expected(text);  // past every limit, and an int64_t
-        return limit.contains(significant.empty() ? 0 : std::stoll(std::string(significant))) ? "" : limit.expected(text);
-      },
+      [limit](std::string& text) -> std::string { return limit.problem(text); },  // the library's reading, for every face
       "UINT in [" + std::to_string(limit.min) + " - " + std::to_string(limit.max) + "]", kLimitCheck);
 }
 

@@ -13,7 +13,7 @@
 
 #include "base/errors.h"
 #include "base/interrupt.h"
-#include "base/threads.h"
+#include "base/per_process.h"
 #include "python/exceptions.h"
 
 namespace py = pybind11;
@@ -33,7 +33,6 @@ struct InterpreterEnd {
 };
 InterpreterEnd& interpreter_end() {
   static PerProcess<InterpreterEnd> end;
-  [[maybe_unused]] static const int remade = ::pthread_atfork(nullptr, nullptr, [] { end.remake(); });
   return end.get();
 }
 

@@ -358,6 +358,18 @@ PYBIND11_MODULE(_vkray, m) {
   m.def("parity", &vp::parity, py::arg("source"), py::arg("width"), py::arg("height"), py::arg("spp"), py::arg("seed"),
         py::arg("device"), py::arg("validate"), py::arg("threads"));
   m.def("devices", &vp::devices);
+  m.def("_read_integer",
+        [](const std::string& name, const std::string& text, uint32_t min, uint32_t max) {
+          return vkray::ArgumentLimit{name, min, max}.read(text);
+        },
+        py::arg("name"), py::arg("text"), py::arg("min"), py::arg("max"),
+        "An integer given as text, read as the command line reads its flags (session/options.h); raises "
+        "UsageError \"NAME: expected ...\" in the command line's words.");
+  py::dict limits;
+  for (const vkray::ArgumentLimit& limit : {vkray::kWidthArgument, vkray::kHeightArgument, vkray::kSppArgument, vkray::kSeedArgument,
+                                            vkray::kThreadsArgument, vkray::kTileTimeoutArgument, vkray::kBandCountArgument})
+    limits[py::str(std::string(limit.name))] = py::make_tuple(limit.min, limit.max);
+  m.attr("_ARGUMENT_LIMITS") = limits;  // the library's table of limits, by name: (min, max)
   m.def("_calls_in_flight", &vp::calls_in_flight, "How many calls into the library are in flight in this process.");
   m.def("_shader_dir", [] { return vkray::default_shader_dir(); }, "Where the shaders are compiled from by default.");
   m.attr("_MAX_JSON_DEPTH") = vkray::kMaxJsonDepth;

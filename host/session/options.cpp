@@ -1,5 +1,7 @@
 #include "session/options.h"
 
+#include <algorithm>
+
 #include "base/errors.h"
 
 namespace vkray {
@@ -18,6 +20,23 @@ std::string ArgumentLimit::expected(std::string_view got) const {
 }
 
 UsageError ArgumentLimit::error(std::string_view got) const { return UsageError(std::string(name) + ": " + expected(got)); }
+
+std::string ArgumentLimit::problem(std::string_view text) const {
+  const bool negative = text.starts_with('-');
+  const std::string_view digits = text.substr(negative ? 1 : 0);
+  if (digits.empty() || digits.find_first_not_of("0123456789") != std::string_view::npos)
+    return "expected a decimal integer, got \"" + printable(text) + "\"";
+  const std::string_view significant = digits.substr(std::min(digits.find_first_not_of('0'), digits.size() - 1));
+  if (negative) return expected(text);                               // below every limit
+  if (significant.size() > 10) return expected(significant);         // past every limit, and an int64_t
+  return contains(std::stoll(std::string(significant))) ? "" : expected(significant);
+}
+
+uint32_t ArgumentLimit::read(std::string_view text) const {
+  if (const std::string why = problem(text); !why.empty()) throw UsageError(std::string(name) + ": " + why);
+  const std::string_view digits = text.substr(std::min(text.find_first_not_of('0'), text.size() - 1));
+  return uint32_t(std::stoull(std::string(digits)));
+}
 
 ImageSettings image_settings(const Scene& scene, const RenderOptions& options) {
   if (options.threads != 0 && !kThreadsArgument.contains(options.threads))

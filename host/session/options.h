@@ -33,6 +33,14 @@ struct ArgumentLimit {
   std::string expected(std::string_view got) const;
   // UsageError("width: " + expected(got)).
   UsageError error(std::string_view got) const;
+
+  // A value given as text, read as the command line reads its integers: decimal digits only,
+  // leading zeros read as decimal ("0100" is 100), a leading '-' out of range. What is wrong with it
+  // in the words the command line prints after the flag's name ("expected a decimal integer, got
+  // \"1_000\"", or expected()); empty when it is right.
+  std::string problem(std::string_view text) const;
+  // The value `text` names; UsageError("width: " + problem(text)) when problem() is not empty.
+  uint32_t read(std::string_view text) const;
 };
 
 inline constexpr ArgumentLimit kWidthArgument{"width", 1, kMaxImageSide};

@@ -35,8 +35,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import os
-import re
 import shutil
 import signal
 import sys
@@ -56,7 +54,7 @@ from ._farm_worker import _render_part  # noqa: F401  (the task, also as vkray.f
 
 # ---- the command line -----------------------------------------------------------------------------
 
-# The options whose value is an integer, read as `vkray render` reads its flags (_decimal).
+# The options whose value is an integer, read as `vkray render` reads its flags (_integer).
 _INTEGER_OPTIONS = ("--width", "--height", "--spp", "--seed", "--regions", "--workers")
 # Those that the library's table of limits holds, by the name `vkray._request` gives them.
 _LIMITED = ("width", "height", "spp", "seed")
@@ -127,71 +125,34 @@ def _glued(argv: Sequence[str]) -> list[str]:
     return out
 
 
-def _printable(text: str, max_length: int = 60) -> str:
-    """Text from the command line fit to print on one line, as vkray's messages quote a value
-    (printable() in host/base/errors.h): control characters and bytes that are not UTF-8 become '?',
-    and text past `max_length` bytes is cut with "..."."""
-    data = os.fsencode(text)  # the bytes as given, those that are not UTF-8 included
-    out, i = bytearray(), 0
-    while i < len(data) and i < max_length:
-        byte = data[i]
-        # The length of a well-formed UTF-8 sequence starting here (RFC 3629), or 0.
-        length = (1 if byte < 0x80 else 2 if 0xc2 <= byte <= 0xdf else 3 if 0xe0 <= byte <= 0xef
-                  else 4 if 0xf0 <= byte <= 0xf4 else 0)
-        if any(i + k >= len(data) or data[i + k] & 0xc0 != 0x80 for k in range(1, length)):
-            length = 0
-        control = byte < 0x20 or byte == 0x7f or (byte == 0xc2 and length == 2 and data[i + 1] < 0xa0)
-        if length == 0 or control or i + length > max_length:
-            out += b"?"
-        else:
-            out += data[i:i + length]
-        i += length or 1
-    return out.decode("utf-8", "replace") + ("..." if len(data) > max_length else "")
-
-
-def _decimal(option: str, text: str) -> tuple[int, str]:
-    """An integer option's value as `vkray render` reads its flags (host/cli/flags.cpp): decimal
-    digits, leading zeros read as decimal ("0100" is 100), or '-' and digits, which is out of every
-    option's range. Returns (the value to hold against the option's range, the value as the range's
-    message shows it): a negative value stands as -1 and shows as written ("-05"); one of more than
-    ten digits, past every range, stands as 10**10 (int() refuses to read past 4300 digits)."""
-    negative = text.startswith("-")
-    digits = text[negative:]
-    if not re.fullmatch("[0-9]+", digits):
-        raise _Usage(f'{option}: expected a decimal integer, got "{_printable(text)}"')
-    significant = digits.lstrip("0") or "0"
-    if negative:
-        return -1, text
-    return (10**10 if len(significant) > 10 else int(significant)), significant
+def _integer(option: str, text: str, low: int, high: int) -> int:
+    """An integer option's value, read by the library as `vkray render` reads its flags
+    (ArgumentLimit::read, session/options.h): decimal digits, leading zeros read as decimal, from
+    `low` to `high`, refused in the command line's words ("--width: expected an integer from 1 to
+    16384, got 0")."""
+    try:
+        return vkray._vkray._read_integer(option, text, low, high)
+    except vkray.UsageError as e:
+        raise _Usage(str(e)) from None
 
 
 def _limited(name: str, text: Optional[str]) -> Optional[int]:
-    """--width, --height, --spp or --seed (`name`): the decimal rule, then the library's table of
-    limits, which `vkray render` checks its flags with, in its words and with the value as the
-    command line shows it: "--width: expected an integer from 1 to 16384, got 0"."""
-    if text is None:
-        return None
-    value, shown = _decimal(f"--{name}", text)
-    try:
-        vkray._request(**{**dict.fromkeys(_LIMITED), name: value}, aovs=(), region=None)
-    except vkray.UsageError as e:
-        words, got, _ = str(e).rpartition(", got ")
-        raise _Usage(f"--{words}{got}{_printable(shown)}" if got else f"--{e}") from None
-    return value
+    """--width, --height, --spp or --seed (`name`), against the library's table of limits, which
+    `vkray render` checks its flags with."""
+    return None if text is None else _integer(f"--{name}", text, *vkray._vkray._ARGUMENT_LIMITS[name])
 
 
 def _arguments(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     """The command line, its integers read and checked as `vkray render` reads and checks its flags,
     before anything else: --width, --height, --spp and --seed against the library's table of limits,
     --workers against the farm's own. --regions, whose range is the rows of a frame, is checked once
-    the scenes are read (`regions_shown` is how its message shows it)."""
+    the scenes are read."""
     args = _parser().parse_args(_glued(sys.argv[1:] if argv is None else argv))
     for name in _LIMITED:
         setattr(args, name, _limited(name, getattr(args, name)))
-    args.workers, shown = _decimal("--workers", args.workers)
-    if not 1 <= args.workers <= _MAX_WORKERS:
-        raise _Usage(f"--workers: expected an integer from 1 to {_MAX_WORKERS}, got {_printable(shown)}")
-    args.regions, args.regions_shown = (None, None) if args.regions is None else _decimal("--regions", args.regions)
+    args.workers = _integer("--workers", args.workers, 1, _MAX_WORKERS)
+    # Its range is the rows of a frame, known once the scenes are read (run()).
+    args.regions = None if args.regions is None else _integer("--regions", args.regions, 0, 2**32 - 1)
     return args
 
 
@@ -217,7 +178,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     scenes = [str(Path(s).resolve()) for s in [args.scene, *args.frames]]
     rows = min(vkray.bands(scene, 1, width=args.width, height=args.height)[0][3] for scene in scenes)
     if args.regions is not None and not 1 <= args.regions <= rows:
-        raise _Usage(f"--regions {_printable(args.regions_shown)}: a frame renders {rows} rows, and a band has at "
+        raise _Usage(f"--regions {args.regions}: a frame renders {rows} rows, and a band has at "
                      f"least one row, so 1 to {rows}")
 
     targets = [_frame_output(output, frame, len(scenes)) for frame in range(len(scenes))]
