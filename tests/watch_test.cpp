@@ -99,7 +99,7 @@ class WatchTest : public ::testing::Test {
   std::unique_ptr<ChildProcess> child_;
 };
 
-const std::string kScale = "sum * frame.inv_samples_per_pixel";
+const std::string kScale = "vec4(sum";  // the stored mean: "vec4(sum * k, ..." scales the image
 
 TEST_F(WatchTest, ValidShaderEditChangesTheImage) {
   start();
