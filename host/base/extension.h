@@ -14,4 +14,10 @@ inline std::string lower_extension(const std::filesystem::path& file) {
   return ext;
 }
 
+// Whether a file name is a glTF file's (.gltf or .glb, any case).
+inline bool is_gltf_path(const std::filesystem::path& file) {
+  const std::string ext = lower_extension(file);
+  return ext == ".gltf" || ext == ".glb";
+}
+
 }  // namespace vkray

@@ -12,7 +12,6 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "base/errors.h"
-#include "base/extension.h"
 #include "base/grow.h"
 #include "base/input_file.h"
 #include "base/interrupt.h"
@@ -759,11 +758,6 @@ GltfScene load_gltf(const std::filesystem::path& file, const GltfLimits& limits)
   const InputFile input = read_input_file(file, kMaxGltfFileBytes);
   if (!input.error.empty()) throw SceneError(file.string() + ": " + (input.error == "not found" ? "glTF file not found" : input.error));
   return parse_gltf(input.text, file, limits);
-}
-
-bool is_gltf_path(const std::filesystem::path& file) {
-  const std::string ext = lower_extension(file);
-  return ext == ".gltf" || ext == ".glb";
 }
 
 }  // namespace vkray

@@ -49,7 +49,4 @@ GltfScene load_gltf(const std::filesystem::path& file, const GltfLimits& limits 
 // The same from the file's bytes in memory; `file` names it in messages and locates relative URIs.
 GltfScene parse_gltf(std::string_view bytes, const std::filesystem::path& file, const GltfLimits& limits = {});
 
-// Whether a file name is a glTF file's (.gltf or .glb, any case).
-bool is_gltf_path(const std::filesystem::path& file);
-
 }  // namespace vkray

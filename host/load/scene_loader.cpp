@@ -7,6 +7,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "base/errors.h"
+#include "base/extension.h"
 #include "base/input_file.h"
 #include "base/json_document.h"
 #include "load/scene_parser.h"

@@ -19,16 +19,11 @@ std::string brief(double value) {
   return out.str();
 }
 
-bool from_gltf_file(const Scene& scene) {
-  const std::string extension = lower_extension(scene.file);
-  return extension == ".gltf" || extension == ".glb";
-}
-
 // Where a primitive comes from, for a message: its place in a scene file's "objects", or, in a
 // glTF file rendered on its own, the material it has.
 std::string where_is(const Scene& scene, uint32_t object, const Material& material) {
   const std::string named = "material \"" + printable(material.name) + "\"";
-  return from_gltf_file(scene) ? named : "/objects/" + std::to_string(object) + " (" + named + ")";
+  return is_gltf_path(scene.file) ? named : "/objects/" + std::to_string(object) + " (" + named + ")";
 }
 
 void check_extent(const Scene& scene) {
@@ -50,7 +45,7 @@ float brightest(const glm::vec3& c) { return std::max({c.r, c.g, c.b}); }
 
 void check_radiance_range(const Scene& scene) {
   std::vector<Radiance> all;
-  const bool json = !from_gltf_file(scene);
+  const bool json = !is_gltf_path(scene.file);
   all.push_back({"/background", brightest(scene.background)});
   all.push_back({"/ambient", brightest(scene.ambient)});
   for (const Material& m : scene.materials)
