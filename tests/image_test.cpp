@@ -160,7 +160,7 @@ TEST_F(ImageFileTest, FilesCommittedTogetherAreAllReplacedOrNone) {
   // An image and its record change together: when the second cannot be renamed into place (here a
   // folder stands in its way), the first is put back as it was, or removed if it was not there. The
   // old image is kept meanwhile under a hard link, or where the file system has none, moved aside.
-  for (const AtomicFile::LinkFunction link : {AtomicFile::LinkFunction(::link), AtomicFile::LinkFunction(no_hard_links)}) {
+  for (const LinkFunction link : {LinkFunction(::link), LinkFunction(no_hard_links)}) {
     SCOPED_TRACE(link == ::link ? "with hard links" : "without hard links");
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_ / "record" / "inside");
@@ -184,6 +184,74 @@ TEST_F(ImageFileTest, FilesCommittedTogetherAreAllReplacedOrNone) {
     EXPECT_EQ(text_of(dir_ / "record"), "new record");
     EXPECT_EQ(names_in(dir_), (std::vector<std::string>{"image", "record"}));
   }
+}
+
+// For the link functions below, which are plain function pointers: the targets that were there.
+std::vector<std::filesystem::path> g_there;
+int link_checking_targets(const char* from, const char* to) {
+  for (const auto& target : g_there) EXPECT_TRUE(std::filesystem::exists(target)) << target << " missing before a rename";
+  return ::link(from, to);
+}
+// Before the third rename, a non-empty folder takes the first target's place, so that the first
+// old file cannot be put back there.
+int link_then_block_the_first(const char* from, const char* to) {
+  if (std::string_view(from).ends_with("b")) {
+    std::filesystem::remove(g_there[0]);
+    std::filesystem::create_directories(g_there[0] / "inside");
+  }
+  return ::link(from, to);
+}
+
+TEST_F(ImageFileTest, TargetsRenamedTogetherAreThereAtEveryStep) {
+  // With hard links every target that was there is there before each rename (as its old file or its
+  // new one) and after the last; a failed rename puts the old ones back.
+  std::filesystem::create_directories(dir_ / "new");
+  for (const bool fails : {false, true}) {
+    SCOPED_TRACE(fails ? "the last rename fails" : "all renamed");
+    std::vector<Rename> renames;
+    g_there.clear();
+    for (const char* name : {"a", "b", "c"}) {
+      std::ofstream(dir_ / name) << "old " << name;
+      std::ofstream(dir_ / "new" / name) << "new " << name;
+      g_there.push_back(dir_ / name);
+      renames.push_back({dir_ / "new" / name, dir_ / name, dir_ / (std::string(name) + ".old")});
+    }
+    if (fails) renames[2].to = dir_ / "gone" / "c";
+    if (fails) {
+      EXPECT_THROW(rename_together(renames, link_checking_targets), OutputError);
+      EXPECT_EQ(text_of(dir_ / "a"), "old a");
+      EXPECT_EQ(text_of(dir_ / "b"), "old b");
+    } else {
+      rename_together(renames, link_checking_targets);
+      EXPECT_EQ(text_of(dir_ / "c"), "new c");
+    }
+    for (const auto& target : g_there) EXPECT_TRUE(std::filesystem::exists(target));
+    for (const char* name : {"a.old", "b.old", "c.old"}) EXPECT_FALSE(std::filesystem::exists(dir_ / name));
+  }
+}
+
+TEST_F(ImageFileTest, AnOldFileThatCannotBePutBackIsNamedAndKept) {
+  std::filesystem::create_directories(dir_ / "new");
+  std::vector<Rename> renames;
+  g_there.clear();
+  for (const char* name : {"a", "b"}) {
+    std::ofstream(dir_ / name) << "old " << name;
+    std::ofstream(dir_ / "new" / name) << "new " << name;
+    g_there.push_back(dir_ / name);
+    renames.push_back({dir_ / "new" / name, dir_ / name, dir_ / (std::string(name) + ".old")});
+  }
+  std::ofstream(dir_ / "new" / "c") << "new c";
+  renames.push_back({dir_ / "new" / "c", dir_ / "gone" / "c", dir_ / "c.old"});
+  try {
+    rename_together(renames, link_then_block_the_first);
+    ADD_FAILURE() << "no error";
+  } catch (const OutputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("the old " + (dir_ / "a").string() + " is kept as " + (dir_ / "a.old").string()), std::string::npos)
+        << message;
+  }
+  EXPECT_EQ(text_of(dir_ / "a.old"), "old a");
+  EXPECT_EQ(text_of(dir_ / "b"), "old b");
 }
 
 }  // namespace

@@ -60,15 +60,14 @@ struct Previous {
   std::filesystem::path kept_as;  // the old file's second name, when kept or moved aside
 };
 
-// Keeps what `target` holds under a second name beside it (its temporary file's, plus ".old": as
-// unique as that): a hard link, which leaves the target in place; or, on a file system without hard
-// links (FAT, some network and FUSE file systems), the old file itself, renamed aside for the moment
-// of the renames. A folder in the target's place is left where it is: no rename replaces it.
-// Throws OutputError when an old file can be kept neither way, before anything was replaced.
-Previous keep_previous(const std::filesystem::path& target, const std::filesystem::path& temp, AtomicFile::LinkFunction link) {
+// Keeps what `target` holds as `keep_as`: a hard link, which leaves the target in place; or, on a
+// file system without hard links (FAT, some network and FUSE file systems), the old file itself,
+// renamed there for the moment of the renames. A folder in the target's place is left where it is:
+// no rename replaces it. Throws OutputError when an old file can be kept neither way, before
+// anything was replaced.
+Previous keep_previous(const std::filesystem::path& target, const std::filesystem::path& keep_as, LinkFunction link) {
   Previous previous;
-  previous.kept_as = temp;
-  previous.kept_as += ".old";
+  previous.kept_as = keep_as;
   struct stat status {};
   if (::lstat(target.c_str(), &status) != 0 && errno == ENOENT) {
     previous.state = Previous::absent;
@@ -92,15 +91,15 @@ Previous keep_previous(const std::filesystem::path& target, const std::filesyste
 // Puts back what the first `count` renames replaced, the last first. Returns what could not be put
 // back ("; the old FILE is kept as NAME" for each), for the error's message: an old file whose rename
 // back fails stays under its second name.
-std::string put_back(const std::vector<std::filesystem::path>& targets, std::vector<Previous>& previous, size_t count) {
+std::string put_back(const std::vector<Rename>& renames, std::vector<Previous>& previous, size_t count) {
   std::string stranded;
   for (size_t i = count; i-- > 0;) {
     Previous& p = previous[i];
     std::error_code ec;
-    if (p.state == Previous::absent) std::filesystem::remove(targets[i], ec);
+    if (p.state == Previous::absent) std::filesystem::remove(renames[i].to, ec);
     if (p.state != Previous::kept && p.state != Previous::moved_aside) continue;
-    std::filesystem::rename(p.kept_as, targets[i], ec);
-    if (ec) stranded += "; the old " + targets[i].string() + " is kept as " + p.kept_as.string();
+    std::filesystem::rename(p.kept_as, renames[i].to, ec);
+    if (ec) stranded += "; the old " + renames[i].to.string() + " is kept as " + p.kept_as.string();
     p.state = Previous::unknown;  // put back, or left where it is
   }
   return stranded;
@@ -116,37 +115,41 @@ void forget(const std::vector<Previous>& previous) {
 
 }  // namespace
 
-void AtomicFile::commit_together(std::initializer_list<AtomicFile*> files) { commit_together(files, ::link); }
+void rename_together(const std::vector<Rename>& renames, LinkFunction link) {
+  std::vector<Previous> previous(renames.size());
+  const bool undoable = renames.size() > 1;  // a single rename that fails has replaced nothing
+  for (size_t renamed = 0; renamed < renames.size(); ++renamed) {
+    const Rename& r = renames[renamed];
+    try {
+      if (undoable) previous[renamed] = keep_previous(r.to, r.keep_as, link);
+    } catch (const OutputError& e) {
+      const std::string stranded = put_back(renames, previous, renamed);
+      forget(previous);
+      throw OutputError(e.what() + stranded);
+    }
+    std::error_code ec;
+    std::filesystem::rename(r.from, r.to, ec);
+    if (!ec) continue;
+    // The earlier targets as they were, and this one too if its old file was moved aside.
+    const size_t changed = renamed + (previous[renamed].state == Previous::moved_aside ? 1 : 0);
+    const std::string stranded = put_back(renames, previous, changed);
+    forget(previous);
+    throw OutputError(r.to.string() + ": cannot rename into place: " + ec.message() + stranded);
+  }
+  forget(previous);
+}
 
 void AtomicFile::commit_together(std::initializer_list<AtomicFile*> files, LinkFunction link) {
   // Every write is checked first: a full disk or a size limit leaves every target as it was.
   for (AtomicFile* file : files) file->finish();
-  std::vector<std::filesystem::path> targets;
-  for (AtomicFile* file : files) targets.push_back(file->target_);
-  std::vector<Previous> previous(files.size());
-  const bool undoable = files.size() > 1;
+  std::vector<Rename> renames;
+  for (AtomicFile* file : files) {
+    std::filesystem::path keep_as = file->temp_;
+    keep_as += ".old";  // as unique as the temporary file's own name
+    renames.push_back({file->temp_, file->target_, keep_as});
+  }
   // Not after an interrupt request: a command stopped by Ctrl-C writes nothing.
-  commit_unless_interrupted(files.begin()[0]->temp_, [&] {
-    for (size_t renamed = 0; renamed < files.size(); ++renamed) {
-      AtomicFile& file = *files.begin()[renamed];
-      try {
-        if (undoable) previous[renamed] = keep_previous(file.target_, file.temp_, link);
-      } catch (const OutputError& e) {
-        const std::string stranded = put_back(targets, previous, renamed);
-        forget(previous);
-        throw OutputError(e.what() + stranded);
-      }
-      std::error_code ec;
-      std::filesystem::rename(file.temp_, file.target_, ec);
-      if (!ec) continue;
-      // The earlier targets as they were, and this one too if its old file was moved aside.
-      const size_t changed = renamed + (previous[renamed].state == Previous::moved_aside ? 1 : 0);
-      const std::string stranded = put_back(targets, previous, changed);
-      forget(previous);
-      throw OutputError(file.target_.string() + ": cannot rename into place: " + ec.message() + stranded);
-    }
-    forget(previous);
-  });
+  commit_unless_interrupted(files.begin()[0]->temp_, [&] { rename_together(renames, link); });
   for (AtomicFile* file : files) {
     file->committed_ = true;
     unregister_temporary_file(file->temp_);  // the first one is already

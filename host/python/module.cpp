@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "base/atomic_file.h"
 #include "base/errors.h"
 #include "base/json_document.h"
 #include "base/timing.h"
@@ -365,6 +366,15 @@ PYBIND11_MODULE(_vkray, m) {
         py::arg("name"), py::arg("text"), py::arg("min"), py::arg("max"),
         "An integer given as text, read as the command line reads its flags (session/options.h); raises "
         "UsageError \"NAME: expected ...\" in the command line's words.");
+  m.def("_rename_together",
+        [](const std::vector<std::tuple<std::filesystem::path, std::filesystem::path, std::filesystem::path>>& renames) {
+          std::vector<vkray::Rename> all;
+          for (const auto& [from, to, keep_as] : renames) all.push_back({from, to, keep_as});
+          vkray::rename_together(all);
+        },
+        py::arg("renames"),
+        "Renames each (from, to, keep_as) all or none, as the library commits files that belong together "
+        "(base/atomic_file.h); raises SceneError.");
   py::dict limits;
   for (const vkray::ArgumentLimit& limit : {vkray::kWidthArgument, vkray::kHeightArgument, vkray::kSppArgument, vkray::kSeedArgument,
                                             vkray::kThreadsArgument, vkray::kTileTimeoutArgument, vkray::kBandCountArgument})
