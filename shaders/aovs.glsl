@@ -40,7 +40,7 @@ void store_first_hits(uint index) {
 // Called by the integrators where the camera ray hit surface `s` at x, t along the (unit) ray.
 void add_first_hit(Hit hit, vec3 x, Surface s) {
   first_hits.hits += 1u;
-  first_hits.albedo += s.material_type == VKRAY_MATERIAL_GLASS ? vec3(1.0) : s.albedo;
+  first_hits.albedo += (s.properties & VKRAY_BSDF_CLEAR) != 0u ? vec3(1.0) : s.albedo;
   first_hits.normal += s.shading_normal;
   first_hits.position += x;
   first_hits.depth += hit.t;

@@ -1,6 +1,7 @@
 // The direct model (the default integrator): what a camera ray sees, lit by the lights directly
 // (shade.glsl). Emitters seen are added; a mirror or glass surface passes the ray on, as a Whitted
-// ray tracer does, up to VKRAY_SPECULAR_BOUNCES times, until it meets a diffuse surface or nothing.
+// ray tracer does, up to VKRAY_SPECULAR_BOUNCES times, until it meets a surface that is not a delta
+// (diffuse or glossy) or nothing.
 #ifndef VKRAY_DIRECT_GLSL
 #define VKRAY_DIRECT_GLSL
 
@@ -11,7 +12,7 @@
 
 // The radiance along a camera ray; adds the rays it traces after the camera ray to `rays`.
 vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
-  if (!SCENE_HAS_EMITTERS && !SCENE_HAS_SPECULAR) {  // the lecture's model: one hit, shaded
+  if (!SCENE_HAS_EMITTERS && !SCENE_HAS_NON_DIFFUSE) {  // the lecture's model: one hit, shaded
     Hit hit = trace_closest(ray, frame.epsilon, FAR);
     if (hit.prim == NO_HIT) return frame.background.rgb;
     vec3 x = ray_at(ray, hit.t);
@@ -32,7 +33,7 @@ vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
     if (FIRST_HIT_PASSES && bounce == 0u) add_first_hit(hit, x, s);
     bool front = !(dot(s.geometric_normal, ray.dir) > 0.0);  // a grazing ray meets the front, as in shade()
     if (front) radiance += throughput * s.emission;
-    if (s.material_type == VKRAY_MATERIAL_DIFFUSE) {
+    if ((s.properties & VKRAY_BSDF_DELTA) == 0u) {
       radiance += throughput * shade(ray, x, s, stream, rays);
       break;
     }

@@ -41,13 +41,13 @@ LightPoint sample_area_light(inout uint stream) {
     light.position = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
     light.normal = normalize(cross(b.xyz - a.xyz, c.xyz - a.xyz));
   }
-  vec4 emission = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION);
-  vec4 density = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_LIGHT);
+  vec4 emission = texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_EMISSION);
+  vec4 density = texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_LIGHT);
   // The light is picked by its material's emission; a texture only scales what the point sends.
   light.pdf_area = density.x;
   light.radiance = emission.rgb;
   if (SCENE_HAS_TEXTURES) {
-    vec4 emission_texture = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION_TEXTURE);
+    vec4 emission_texture = texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_EMISSION_TEXTURE);
     bool sphere = SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u;  // spheres have no texture coordinates
     if (!sphere && has_texture(emission_texture)) light.radiance *= sample_texture(emission_texture, triangle_texcoord(prim, w.yz));
   }

@@ -1,7 +1,7 @@
 // The path integrator: the rendering equation by unidirectional path tracing, as Mitsuba 3's `path`.
-// At every diffuse vertex, next-event estimation: each point light, one area-light sample and one
-// sample of the background (when it is not black), the last two weighed against BSDF sampling by
-// the power heuristic; then the BSDF picks the next direction. A hit on an emitter (or a miss, on
+// At every vertex that is not a delta (diffuse or glossy), next-event estimation: each point light,
+// one area-light sample and one sample of the background (when it is not black), the last two
+// weighed against BSDF sampling by the power heuristic; then the BSDF picks the next direction. A hit on an emitter (or a miss, on
 // the background) adds its light weighed the same way, or whole after a mirror or glass.
 // Depth counts as Mitsuba's max_depth does; Russian roulette from rr_depth on.
 #ifndef VKRAY_PATH_GLSL
@@ -69,33 +69,31 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   vec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
   vec3 n = front ? s.shading_normal : -s.shading_normal;
   vec3 origin = x + frame.epsilon * n_geometric;  // on the side the ray came from
-  bool diffuse = !SCENE_HAS_SPECULAR || s.material_type == VKRAY_MATERIAL_DIFFUSE;
-  if (diffuse) {
-    // ---- Next-event estimation: f = albedo / pi, so each term is albedo * (incident / pi) ----------
-    vec3 irradiance = vec3(0.0);
-    add_point_lights(x, n, origin, irradiance, rays);
-    p.radiance += p.throughput * s.albedo * irradiance;
+  vec3 wo = -p.ray.dir;
+  if (!SCENE_HAS_NON_DIFFUSE || (s.properties & VKRAY_BSDF_DELTA) == 0u) {
+    // ---- Next-event estimation: f cos times the light over its density, weighed against BSDF sampling --
+    vec3 from_points = vec3(0.0);
+    add_point_lights(x, n, origin, s, wo, front, from_points, rays);
+    p.radiance += p.throughput * from_points;
     if (SCENE_HAS_EMITTERS) {
       AreaLightSample light = sample_area_light_from(x, n, origin, stream, rays);
       if (light.pdf > 0.0)
-        p.radiance += p.throughput * s.albedo * light.radiance *
-                      (light.cos_x / (PI * light.pdf) * power_heuristic(light.pdf, light.cos_x / PI));
+        p.radiance += p.throughput * eval_bsdf(s, wo, light.dir, n, front) * light.radiance *
+                      (power_heuristic(light.pdf, pdf_bsdf(s, wo, light.dir, n, front)) / light.pdf);
     }
     if (background_sampled) {
       vec3 w = uniform_sphere(vec2(next_random(stream), next_random(stream)));
-      float cos_x = dot(n, w);
-      if (cos_x > 0.0) {
+      if (dot(n, w) > 0.0) {
         rays += 1u;
-        if (!trace_any(Ray(origin, w), frame.epsilon, FAR)) {
-          float weight = power_heuristic(BACKGROUND_PDF, cos_x / PI);
-          p.radiance += p.throughput * s.albedo * frame.background.rgb * (cos_x / (PI * BACKGROUND_PDF) * weight);
-        }
+        if (!trace_any(Ray(origin, w), frame.epsilon, FAR))
+          p.radiance += p.throughput * eval_bsdf(s, wo, w, n, front) * frame.background.rgb *
+                        (power_heuristic(BACKGROUND_PDF, pdf_bsdf(s, wo, w, n, front)) / BACKGROUND_PDF);
       }
     }
   }
 
   // ---- The next direction ------------------------------------------------------------------------
-  BsdfSample b = sample_bsdf(s, -p.ray.dir, n, front, stream);
+  BsdfSample b = sample_bsdf(s, wo, n, front, stream);
   // A direction on the wrong side of the surface (an interpolated normal can point there) ends it.
   if ((dot(b.dir, n_geometric) > 0.0) == b.transmitted) return true;
   p.throughput *= b.weight;

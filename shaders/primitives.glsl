@@ -18,8 +18,9 @@ float intersect_primitive(Ray ray, RayShear shear, vec4 a, vec4 b, vec4 c, float
 struct Surface {
   vec3 geometric_normal;  // unit, not yet oriented toward the ray: the side it faces emits
   vec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal
-  vec3 albedo;            // or a mirror's reflectance, its texture applied
-  uint material_type;     // VKRAY_MATERIAL_*
+  vec3 albedo;            // the material's colour (shared/materials.h), its texture applied
+  uint material_type;     // VKRAY_MATERIAL_*: only bsdf.glsl asks it
+  uint properties;        // VKRAY_BSDF_*: what everything else asks
   vec3 emission;          // its texture applied
   float ior;
   float light_pdf_area;   // the density per unit area with which light sampling picks this point (emitters.glsl)
@@ -29,20 +30,25 @@ Surface hit_surface(Hit hit, vec3 position) {
   int base = int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE;
   vec4 a = texelFetch(primitives, base);
   uint flags = primitive_flags(a);
-  Surface s;
-  vec4 color = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_COLOR);
-  s.albedo = color.rgb;
-  s.material_type = floatBitsToUint(color.w);
-  s.emission = vec3(0.0);
-  s.ior = 1.0;
-  s.light_pdf_area = 0.0;
-  if (SCENE_HAS_EMITTERS || SCENE_HAS_SPECULAR) {
-    vec4 emission = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION);
-    vec4 density = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_LIGHT);
-    s.emission = emission.rgb;
-    s.ior = emission.w;
-    s.light_pdf_area = density.x;
+  int material = material_texel(primitive_material(flags));
+  // The material's value texels: each fetched only where the scene has a material that uses it.
+  MaterialValueTexels t;
+  t.color = texelFetch(materials, material + VKRAY_MATERIAL_COLOR);
+  t.emission = vec4(0.0, 0.0, 0.0, 1.0);
+  uint properties = material_properties_of(t.color);
+  float light_pdf_area = 0.0;
+  if (SCENE_HAS_EMITTERS || SCENE_HAS_NON_DIFFUSE) {
+    t.emission = texelFetch(materials, material + VKRAY_MATERIAL_EMISSION);
+    light_pdf_area = texelFetch(materials, material + VKRAY_MATERIAL_LIGHT).x;
   }
+  MaterialValues m = material_values(t);
+  Surface s;
+  s.albedo = m.color;
+  s.material_type = m.type;
+  s.properties = properties;
+  s.emission = m.emission;
+  s.ior = m.ior;
+  s.light_pdf_area = light_pdf_area;
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     s.geometric_normal = (position - a.xyz) / sphere_radius(texelFetch(primitives, base + 1));
     if ((flags & VKRAY_PRIM_INWARD) != 0u) s.geometric_normal = -s.geometric_normal;
@@ -55,8 +61,8 @@ Surface hit_surface(Hit hit, vec3 position) {
   bool smooth_normals = (flags & VKRAY_PRIM_SMOOTH) != 0u;
   vec4 albedo_texture = vec4(0.0), emission_texture = vec4(0.0);
   if (SCENE_HAS_TEXTURES) {
-    albedo_texture = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_ALBEDO_TEXTURE);
-    emission_texture = texelFetch(materials, material_texel(flags) + VKRAY_MATERIAL_EMISSION_TEXTURE);
+    albedo_texture = texelFetch(materials, material + VKRAY_MATERIAL_ALBEDO_TEXTURE);
+    emission_texture = texelFetch(materials, material + VKRAY_MATERIAL_EMISSION_TEXTURE);
   }
   bool textured = SCENE_HAS_TEXTURES && (has_texture(albedo_texture) || has_texture(emission_texture));
   if (!smooth_normals && !textured) return s;

@@ -1,12 +1,16 @@
-// Direct Lambertian shading from point lights plus an ambient term, exactly the scene contract:
+// Direct shading from point lights plus an ambient term; for a Lambertian surface exactly the scene
+// contract:
 //   L = albedo * (A + sum_lights V * I * (n . w) / (pi r^2) + one area-light sample)
 // with n the normal facing the incoming ray (the interpolated vertex normal for smooth meshes, the
 // geometric normal otherwise), w the unit vector to the light, r its distance, and V = 0 when the
 // light is at most epsilon above the plane of n at x (n . (light - x) <= epsilon) or a shadow ray
-// finds anything closer than the light. The path integrator (path.glsl) uses the same light terms.
+// finds anything closer than the light. Any other surface that is not a delta: the ambient term times
+// its colour, and its BSDF f(wo, w) (n . w) in place of albedo (n . w) / pi. The path integrator
+// (path.glsl) uses the same light terms.
 #ifndef VKRAY_SHADE_GLSL
 #define VKRAY_SHADE_GLSL
 
+#include "bsdf.glsl"
 #include "emitters.glsl"
 #include "primitives.glsl"
 #include "resources.glsl"
@@ -17,6 +21,7 @@
 // shadow_origin). Draws three numbers from the stream.
 struct AreaLightSample {
   vec3 radiance;  // 0 when the point is behind x's side, faces away, or is hidden
+  vec3 dir;       // unit, from x to the point
   float cos_x;    // at x, to the point
   float pdf;      // per unit solid angle at x
 };
@@ -27,7 +32,7 @@ AreaLightSample sample_area_light_from(vec3 x, vec3 n, vec3 shadow_origin, inout
   float r2 = dot(to_light, to_light);
   vec3 w = to_light * inversesqrt(r2);
   float cos_l = -dot(light.normal, w);
-  AreaLightSample s = AreaLightSample(vec3(0.0), dot(n, w), 0.0);
+  AreaLightSample s = AreaLightSample(vec3(0.0), w, dot(n, w), 0.0);
   if (!(s.cos_x > 0.0 && cos_l > 0.0)) return s;
   if (SHADOW_RAYS) {
     vec3 shadow_dir = light.position - shadow_origin;
@@ -41,9 +46,9 @@ AreaLightSample sample_area_light_from(vec3 x, vec3 n, vec3 shadow_origin, inout
   return s;
 }
 
-// Adds V I (n . w) / (pi r^2) for every point light to `irradiance` (n faces the incoming ray); adds
-// the shadow rays it casts to `rays`.
-void add_point_lights(vec3 x, vec3 n, vec3 shadow_origin, inout vec3 irradiance, inout uint rays) {
+// Adds V f(wo, w) (n . w) I / r^2 for every point light to `radiance`: the surface s at x, seen along
+// wo, n its normal facing the incoming ray; adds the shadow rays it casts to `rays`.
+void add_point_lights(vec3 x, vec3 n, vec3 shadow_origin, Surface s, vec3 wo, bool front, inout vec3 radiance, inout uint rays) {
   // A do-while without `continue`, as the sample loop in trace.comp: a loop that tests first costs
   // a masked pass more, and so does one with a `continue` (the compiler moves the test to the top
   // of the next pass, for every lane).
@@ -53,7 +58,6 @@ void add_point_lights(vec3 x, vec3 n, vec3 shadow_origin, inout vec3 irradiance,
     vec3 light_pos = texelFetch(lights, base + VKRAY_LIGHT_POSITION).xyz;
     vec3 to_light = light_pos - x;
     float r2 = dot(to_light, to_light);
-    float cos_theta = dot(n, to_light * inversesqrt(r2));
     // Lit only by a light more than epsilon above the plane of n at x (the contract's height rule:
     // a light on the surface, or at x itself, lights nothing there, whatever the rounding of x).
     bool lit = dot(n, to_light) > frame.epsilon;
@@ -64,27 +68,29 @@ void add_point_lights(vec3 x, vec3 n, vec3 shadow_origin, inout vec3 irradiance,
       // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
       lit = !trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon);
     }
-    if (lit) irradiance += texelFetch(lights, base + VKRAY_LIGHT_INTENSITY).rgb * (cos_theta / (PI * r2));
+    if (lit)
+      radiance += eval_bsdf(s, wo, to_light * inversesqrt(r2), n, front) * (texelFetch(lights, base + VKRAY_LIGHT_INTENSITY).rgb / r2);
   } while (++i < frame.light_count);
 }
 
-// Returns the radiance a diffuse surface at x reflects toward the ray's origin; draws from the
-// stream for an area light, and adds the shadow rays it casts to `rays`.
+// Returns the radiance a surface at x that is not a delta reflects toward the ray's origin; draws from
+// the stream for an area light, and adds the shadow rays it casts to `rays`.
 vec3 shade(Ray ray, vec3 x, Surface surface, inout uint stream, inout uint rays) {
   // Both normals face the incoming ray, decided by the geometric one.
-  bool flip = dot(surface.geometric_normal, ray.dir) > 0.0;
-  vec3 n_geometric = flip ? -surface.geometric_normal : surface.geometric_normal;
-  vec3 n = flip ? -surface.shading_normal : surface.shading_normal;
+  bool front = !(dot(surface.geometric_normal, ray.dir) > 0.0);
+  vec3 n_geometric = front ? surface.geometric_normal : -surface.geometric_normal;
+  vec3 n = front ? surface.shading_normal : -surface.shading_normal;
+  vec3 wo = -ray.dir;
 
   // Shadow rays start a little off the surface, on the side the ray came from.
   vec3 shadow_origin = x + frame.epsilon * n_geometric;
-  vec3 irradiance = frame.ambient.rgb;
-  add_point_lights(x, n, shadow_origin, irradiance, rays);
-  if (SCENE_HAS_EMITTERS) {  // its light over pi, as the contract's other terms: Le cos_x / (pi pdf)
+  vec3 radiance = surface.albedo * frame.ambient.rgb;
+  add_point_lights(x, n, shadow_origin, surface, wo, front, radiance, rays);
+  if (SCENE_HAS_EMITTERS) {  // one light sample: f cos Le / pdf
     AreaLightSample light = sample_area_light_from(x, n, shadow_origin, stream, rays);
-    if (light.pdf > 0.0) irradiance += light.radiance * (light.cos_x / (PI * light.pdf));
+    if (light.pdf > 0.0) radiance += eval_bsdf(surface, wo, light.dir, n, front) * (light.radiance / light.pdf);
   }
-  return surface.albedo * irradiance;
+  return radiance;
 }
 
 #endif

@@ -74,5 +74,54 @@ TEST(ScenePackingTest, AnAreaLightsDensityIsComputedInDouble) {
   EXPECT_NEAR(packed.materials[VKRAY_MATERIAL_LIGHT].x, 1.0 / area, 1e-5 / area);
 }
 
+// ---- The materials' table and texels (shared/materials.h) -----------------------------------------------
+
+TEST(ScenePackingTest, EveryMaterialTypeHasItsNameAndOneKindOfLobe) {
+  for (uint32_t t = 0; t < VKRAY_MATERIAL_TYPE_COUNT; ++t) {
+    const MaterialType type = MaterialType(t);
+    const std::string_view name = material_type_name(type);
+    EXPECT_NE(name, "unknown") << t;
+    EXPECT_EQ(material_type_named(name), type) << name;
+    // A delta BSDF has no other lobe; every other has a diffuse or a glossy one.
+    const uint32_t p = material_properties(t);
+    if (p & VKRAY_BSDF_DELTA)
+      EXPECT_EQ(p & (VKRAY_BSDF_DIFFUSE | VKRAY_BSDF_GLOSSY), 0u) << name;
+    else
+      EXPECT_NE(p & (VKRAY_BSDF_DIFFUSE | VKRAY_BSDF_GLOSSY), 0u) << name;
+  }
+  EXPECT_EQ(material_properties(VKRAY_MATERIAL_TYPE_COUNT), 0u);
+  EXPECT_FALSE(material_type_named("metal"));
+}
+
+TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
+  // Every value through the shared pack and unpack, as the shader unpacks what the host packed, and
+  // the properties in the texel the table's.
+  for (uint32_t t = 0; t < VKRAY_MATERIAL_TYPE_COUNT; ++t) {
+    MaterialValues m;
+    m.color = vec3(0.25f, 0.5f, 0.75f) + float(t);
+    m.type = t;
+    m.emission = vec3(3.0f, 5.0f, 7.0f);
+    m.ior = 1.33f + float(t);
+    const MaterialValueTexels texels = material_value_texels(m);
+    const MaterialValues back = material_values(texels);
+    EXPECT_EQ(back.color, m.color);
+    EXPECT_EQ(back.type, m.type);
+    EXPECT_EQ(back.emission, m.emission);
+    EXPECT_EQ(back.ior, m.ior);
+    EXPECT_EQ(material_properties_of(texels.color), material_properties(t));
+    static_assert(sizeof(MaterialValues) == 32, "a MaterialValues member is not checked here");
+  }
+}
+
+TEST(ScenePackingTest, APackedMaterialCarriesItsTypeAndProperties) {
+  const Scene scene = lit_by(R"("materials": {"d": {"albedo": [0.5, 0.5, 0.5]}, "g": {"type": "glass", "ior": 1.7}},
+      "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1, "material": "g"}])");
+  const PackedLighting packed = pack_lighting(scene, {0});
+  const vec4* glass = &packed.materials[size_t(material_texel(1))];
+  EXPECT_EQ(material_type_of(glass[VKRAY_MATERIAL_COLOR]), VKRAY_MATERIAL_GLASS);
+  EXPECT_EQ(material_properties_of(glass[VKRAY_MATERIAL_COLOR]), VKRAY_BSDF_DELTA | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR);
+  EXPECT_EQ(glass[VKRAY_MATERIAL_EMISSION].w, 1.7f);
+}
+
 }  // namespace
 }  // namespace vkray::gpu

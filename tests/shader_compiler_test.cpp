@@ -66,7 +66,7 @@ TEST(ShaderCompilerTest, CompilesTheTracerAndListsEveryIncludedFile) {
                          "shade.glsl",      "primitives.glsl",   "intersect.glsl",  "traversal.glsl",
                          "inline_scene.glsl", "warp.glsl",        "emitters.glsl",   "bsdf.glsl",
                          "direct.glsl",     "path.glsl",         "aovs.glsl",       "texture.glsl",
-                         "shared/first_hit_layout.h"};
+                         "shared/first_hit_layout.h", "shared/materials.h"};
   for (const char* file : files) {
     const auto expected = (dir / file).lexically_normal();
     EXPECT_NE(std::find(shader.sources.begin(), shader.sources.end(), expected), shader.sources.end()) << file;

@@ -25,9 +25,10 @@ ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scen
 
 ParityTolerance parity_tolerance(const Scene& scene) {
   ParityTolerance tolerance;
-  const bool glass = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.type == MaterialType::glass; });
+  // A BSDF that can transmit picks reflection or transmission at random, even in the direct model.
+  const bool chooses = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.has(VKRAY_BSDF_TRANSMISSION); });
   const bool emitters = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissive(); });
-  tolerance.stochastic = scene.integrator.type == Integrator::Type::path || glass || emitters || scene.camera.aperture_radius > 0;
+  tolerance.stochastic = scene.integrator.type == Integrator::Type::path || chooses || emitters || scene.camera.aperture_radius > 0;
   tolerance.textured = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.textured(); });
   return tolerance;
 }

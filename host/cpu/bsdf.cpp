@@ -1,11 +1,25 @@
 #include "cpu/bsdf.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "cpu/warp.h"
 #include "shared/sampling.h"
 
 namespace vkray::cpu {
+
+using glm::dvec3;
+
+Bsdf bsdf_of(const Material& material, const dvec3& color) {
+  Bsdf b;
+  b.type = material.type;
+  b.properties = material.properties();
+  b.color = color;
+  b.ior = material.ior;
+  return b;
+}
+
+// ---- Fresnel --------------------------------------------------------------------------------------------
 
 double fresnel_dielectric(double cos_i, double eta, double& cos_t) {
   // Snell: sin_t = sin_i / eta.
@@ -20,26 +34,50 @@ double fresnel_dielectric(double cos_i, double eta, double& cos_t) {
   return (rs * rs + rp * rp) / 2;
 }
 
-BsdfSample sample_bsdf(const Material& material, const glm::dvec3& albedo, const glm::dvec3& wo, const glm::dvec3& n, bool front, uint32_t& stream) {
+// ---- The three functions, by material ---------------------------------------------------------------------
+
+dvec3 eval_bsdf(const Bsdf& b, const dvec3&, const dvec3& wi, const dvec3& n, bool) {
+  switch (b.type) {
+    case MaterialType::diffuse:
+      return b.color * (std::max(0.0, glm::dot(wi, n)) / kPi);
+    case MaterialType::mirror:
+    case MaterialType::glass:
+      return dvec3(0.0);  // delta lobes: no direction but one
+  }
+  return dvec3(0.0);
+}
+
+double pdf_bsdf(const Bsdf& b, const dvec3&, const dvec3& wi, const dvec3& n, bool) {
+  switch (b.type) {
+    case MaterialType::diffuse:
+      return std::max(0.0, glm::dot(wi, n)) / kPi;
+    case MaterialType::mirror:
+    case MaterialType::glass:
+      return 0;
+  }
+  return 0;
+}
+
+BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool front, uint32_t& stream) {
   BsdfSample b;
-  switch (material.type) {
+  switch (bsdf.type) {
     case MaterialType::diffuse: {
       const double u1 = gpu::next_random(stream), u2 = gpu::next_random(stream);
-      const glm::dvec3 local = cosine_hemisphere(u1, u2);
+      const dvec3 local = cosine_hemisphere(u1, u2);
       b.dir = glm::normalize(to_world(local, n));  // as the shader does (bsdf.glsl says why)
       b.pdf = local.z / kPi;
-      b.weight = albedo;  // (albedo / pi) cos / (cos / pi)
+      b.weight = bsdf.color;  // (albedo / pi) cos / (cos / pi)
       return b;
     }
     case MaterialType::mirror:
       b.delta = true;
       b.dir = glm::normalize(2 * glm::dot(wo, n) * n - wo);
-      b.weight = albedo;
+      b.weight = bsdf.color;
       return b;
     case MaterialType::glass: {
       b.delta = true;
       const double cos_i = glm::dot(wo, n);
-      const double eta = front ? double(material.ior) : 1 / double(material.ior);
+      const double eta = front ? bsdf.ior : 1 / bsdf.ior;
       double cos_t;
       const double f = fresnel_dielectric(cos_i, eta, cos_t);
       if (gpu::next_random(stream) < f) {
@@ -50,7 +88,7 @@ BsdfSample sample_bsdf(const Material& material, const glm::dvec3& albedo, const
       b.dir = glm::normalize((cos_i / eta - cos_t) * n - wo / eta);
       b.transmitted = true;
       b.eta = eta;
-      b.weight = glm::dvec3(1 / (eta * eta));  // radiance is compressed into the narrower cone
+      b.weight = dvec3(1 / (eta * eta));  // radiance is compressed into the narrower cone
       return b;
     }
   }

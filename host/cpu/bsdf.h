@@ -1,5 +1,9 @@
-// The CPU reference's BSDFs, sampled: the same three materials as the shader's (shaders/bsdf.glsl),
-// drawing the same numbers from the sample's stream.
+// The CPU reference's BSDFs: the same materials as the shader's (shaders/bsdf.glsl), written again
+// in double, each with eval, pdf and sample, drawing the same numbers from the sample's stream.
+//
+// Every function takes wo, unit, back along the incoming ray; n, the unit shading normal turned to
+// the side the ray came from (so conductors and diffuse surfaces reflect on both sides); and front,
+// whether the ray met the side the geometric normal faces (a dielectric's outside).
 #pragma once
 
 #include <cstdint>
@@ -10,22 +14,37 @@
 
 namespace vkray::cpu {
 
+// A material's BSDF at one point: its values, its textures applied.
+struct Bsdf {
+  MaterialType type = MaterialType::diffuse;
+  uint32_t properties = 0;  // VKRAY_BSDF_* (shared/materials.h)
+  glm::dvec3 color{0.0};    // albedo or reflectance
+  double ior = 1.5;
+
+  bool has(uint32_t property) const { return (properties & property) != 0; }
+};
+
+// The BSDF of `material` where its colour, textures applied, is `color`.
+Bsdf bsdf_of(const Material& material, const glm::dvec3& color);
+
 struct BsdfSample {
   glm::dvec3 dir;             // unit, away from the surface
-  glm::dvec3 weight{1.0};     // f cos / pdf
+  glm::dvec3 weight{1.0};     // f |cos| / pdf; 0 when the sample failed (the path ends)
   double pdf = 0;             // solid-angle density; 0 for a delta BSDF
   bool delta = false;
   bool transmitted = false;   // into the other side
   double eta = 1;             // n_t / n_i of a refraction; 1 otherwise
 };
 
+// f(wo, wi) |n . wi|: what light arriving from wi sends toward wo, per unit of its radiance and solid
+// angle. 0 for delta BSDFs and for directions a lobe does not reach.
+glm::dvec3 eval_bsdf(const Bsdf& bsdf, const glm::dvec3& wo, const glm::dvec3& wi, const glm::dvec3& n, bool front);
+// The solid-angle density with which sample_bsdf picks wi; 0 for delta BSDFs.
+double pdf_bsdf(const Bsdf& bsdf, const glm::dvec3& wo, const glm::dvec3& wi, const glm::dvec3& n, bool front);
+// A direction drawn with density pdf_bsdf (or a delta lobe's), from `stream`.
+BsdfSample sample_bsdf(const Bsdf& bsdf, const glm::dvec3& wo, const glm::dvec3& n, bool front, uint32_t& stream);
+
 // Fresnel reflectance of a smooth dielectric: cos_i > 0 on the incident side, eta = n_t / n_i. Sets
 // cos_t, the cosine on the other side (0 past the critical angle, where it returns 1).
 double fresnel_dielectric(double cos_i, double eta, double& cos_t);
-
-// wo: unit, back along the incoming ray; n: the shading normal on wo's side; front: the ray met the
-// side the geometric normal faces (glass: from outside); albedo: the material's, its texture applied
-// (SurfacePoint::albedo). Draws from `stream`.
-BsdfSample sample_bsdf(const Material& material, const glm::dvec3& albedo, const glm::dvec3& wo, const glm::dvec3& n, bool front, uint32_t& stream);
-
 }  // namespace vkray::cpu

@@ -1,5 +1,6 @@
 // The direct model: L = albedo (A + sum of point lights + one area-light sample) at the first diffuse
-// surface, emitters seen added, mirrors and glass followed up to VKRAY_SPECULAR_BOUNCES times.
+// surface (a glossy one: its BSDF against the same lights, the ambient term times its colour), emitters
+// seen added, mirrors and glass followed up to VKRAY_SPECULAR_BOUNCES times.
 #include <limits>
 
 #include "cpu/bsdf.h"
@@ -10,19 +11,21 @@
 namespace vkray::cpu {
 namespace {
 
-// The radiance a diffuse surface reflects toward the ray; n, n_geometric face the incoming ray.
-dvec3 shade(const Tracer& tracer, const Lights& lights, const SurfacePoint& s, const dvec3& n, const dvec3& n_geometric,
-            SampleState& state, bool first) {
+// The radiance a surface that is not a delta reflects toward the ray: the ambient term times its
+// colour, and its BSDF against the point lights and one area-light sample. n, n_geometric face the
+// incoming ray. For a diffuse surface, the scene contract's albedo (A + sum of lights + area light).
+dvec3 shade(const Tracer& tracer, const Lights& lights, const SurfacePoint& s, const Bsdf& bsdf, const dvec3& wo, bool front,
+            const dvec3& n, const dvec3& n_geometric, SampleState& state, bool first) {
   const Scene& scene = tracer.scene();
   const dvec3 x = s.position;
-  dvec3 irradiance(scene.ambient);
+  dvec3 radiance = bsdf.color * dvec3(scene.ambient);
   const dvec3 shadow_origin = x + tracer.epsilon() * n_geometric;
-  lights.add_point_lights(x, n, shadow_origin, irradiance, first ? &state.signature : nullptr, state.rays);
+  lights.add_point_lights(x, n, shadow_origin, bsdf, wo, front, radiance, first ? &state.signature : nullptr, state.rays);
   if (lights.has_area_lights()) {
     const AreaLightSample light = lights.sample_area_light_from(x, n, shadow_origin, state.stream, state.rays);
-    if (light.pdf > 0) irradiance += light.radiance * (light.cos_x / (kPi * light.pdf));
+    if (light.pdf > 0) radiance += eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance / light.pdf;
   }
-  return s.albedo * irradiance;
+  return radiance;
 }
 
 }  // namespace
@@ -47,11 +50,12 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
     const dvec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
     const dvec3 n = front ? s.shading_normal : -s.shading_normal;
     if (front) radiance += throughput * s.emission;
-    if (!material.specular()) {
-      radiance += throughput * shade(tracer, lights, s, n, n_geometric, state, bounce == 0);
+    const Bsdf bsdf = bsdf_of(material, s.albedo);
+    if (!bsdf.has(VKRAY_BSDF_DELTA)) {
+      radiance += throughput * shade(tracer, lights, s, bsdf, -ray.dir, front, n, n_geometric, state, bounce == 0);
       break;
     }
-    const BsdfSample b = sample_bsdf(material, s.albedo, -ray.dir, n, front, state.stream);
+    const BsdfSample b = sample_bsdf(bsdf, -ray.dir, n, front, state.stream);
     if ((glm::dot(b.dir, n_geometric) > 0) == b.transmitted) break;  // the wrong side of the surface
     throughput *= b.weight;
     ray = {s.position + (b.transmitted ? -epsilon : epsilon) * n_geometric, b.dir};

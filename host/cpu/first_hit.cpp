@@ -10,7 +10,7 @@ void add_first_hit(const Tracer& tracer, const Hit& hit, const SurfacePoint& sur
   const Scene& scene = tracer.scene();
   const Material& material = scene.materials[surface.material];
   ++sums->hits;
-  sums->albedo += material.type == MaterialType::glass ? dvec3(1.0) : surface.albedo;
+  sums->albedo += material.has(VKRAY_BSDF_CLEAR) ? dvec3(1.0) : surface.albedo;
   sums->normal += surface.shading_normal;
   sums->position += surface.position;
   sums->depth += hit.t;  // along a unit direction

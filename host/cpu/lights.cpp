@@ -1,7 +1,6 @@
 #include "cpu/lights.h"
 
 #include <cmath>
-#include <numbers>
 
 #include "cpu/texture.h"
 #include "cpu/warp.h"
@@ -15,14 +14,13 @@ Lights::Lights(const Tracer& tracer, bool shadows)
   if (!table_.entries.empty()) inv_weight_ = 1 / table_.total_weight;
 }
 
-void Lights::add_point_lights(const dvec3& x, const dvec3& n, const dvec3& shadow_origin, dvec3& irradiance,
-                              uint64_t* signature, uint64_t& rays) const {
+void Lights::add_point_lights(const dvec3& x, const dvec3& n, const dvec3& shadow_origin, const Bsdf& bsdf, const dvec3& wo,
+                              bool front, dvec3& radiance, uint64_t* signature, uint64_t& rays) const {
   const Scene& scene = tracer_.scene();
   for (size_t l = 0; l < scene.lights.size(); ++l) {
     const dvec3 light(scene.lights[l].position);
     const dvec3 to_light = light - x;
     const double r2 = glm::dot(to_light, to_light);
-    const double cos_theta = glm::dot(n, to_light / std::sqrt(r2));
     // The light must stand more than epsilon above the plane of the normal: one on the surface
     // (or at x) lights nothing there.
     if (!(glm::dot(n, to_light) > epsilon_)) continue;
@@ -33,7 +31,7 @@ void Lights::add_point_lights(const dvec3& x, const dvec3& n, const dvec3& shado
       if (tracer_.occluded({shadow_origin, shadow / distance}, epsilon_, distance - epsilon_)) continue;
     }
     if (signature) mix(*signature, 0x8000000000000000ull | l);
-    irradiance += dvec3(scene.lights[l].intensity) * (cos_theta / (std::numbers::pi * r2));
+    radiance += eval_bsdf(bsdf, wo, to_light / std::sqrt(r2), n, front) * dvec3(scene.lights[l].intensity) / r2;
   }
 }
 
@@ -44,6 +42,7 @@ AreaLightSample Lights::sample_area_light_from(const dvec3& x, const dvec3& n, c
   const double r2 = glm::dot(to_light, to_light);
   const dvec3 w = to_light / std::sqrt(r2);
   AreaLightSample s;
+  s.dir = w;
   s.cos_x = glm::dot(n, w);
   const double cos_l = -glm::dot(light.normal, w);
   if (!(s.cos_x > 0 && cos_l > 0)) return s;

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "cpu/bsdf.h"
 #include "cpu/tracer.h"
 #include "scene/emitters.h"
 
@@ -25,6 +26,7 @@ struct LightPoint {
 // One area-light sample as a point x sees it.
 struct AreaLightSample {
   dvec3 radiance{0.0};  // 0 when the point is behind x's side, faces away, or is hidden
+  dvec3 dir{0.0};       // unit, from x to the point
   double cos_x = 0;     // at x, to the point
   double pdf = 0;       // per unit solid angle at x
 };
@@ -34,10 +36,11 @@ class Lights {
   // shadows false: every light counts as visible (benchmarks).
   Lights(const Tracer& tracer, bool shadows);
 
-  // Adds V I (n . w) / (pi r^2) of every point light to `irradiance`, n facing the incoming ray;
-  // counts shadow rays in `rays`; mixes each light that lights x into `signature` when given.
-  void add_point_lights(const dvec3& x, const dvec3& n, const dvec3& shadow_origin, dvec3& irradiance, uint64_t* signature,
-                        uint64_t& rays) const;
+  // Adds V f(wo, w) (n . w) I / r^2 of every point light to `radiance`, n facing the incoming ray
+  // (for a diffuse surface, albedo V I (n . w) / (pi r^2), the scene contract's term); counts shadow
+  // rays in `rays`; mixes each light that lights x into `signature` when given.
+  void add_point_lights(const dvec3& x, const dvec3& n, const dvec3& shadow_origin, const Bsdf& bsdf, const dvec3& wo, bool front,
+                        dvec3& radiance, uint64_t* signature, uint64_t& rays) const;
 
   bool has_area_lights() const { return !table_.entries.empty(); }
   // Draws three numbers: the light, then the point on it.

@@ -1,4 +1,4 @@
-// Path tracing, as the shader's path.glsl: next-event estimation at diffuse vertices (every point
+// Path tracing, as the shader's path.glsl: next-event estimation at every vertex that is not a delta (every point
 // light, one area-light sample, one background sample) weighed by the power heuristic against BSDF
 // sampling; Mitsuba's max_depth; Russian roulette from rr_depth.
 #include <algorithm>
@@ -53,32 +53,33 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     const dvec3 n = front ? s.shading_normal : -s.shading_normal;
     const dvec3 x = s.position;
     const dvec3 origin = x + epsilon * n_geometric;
-    if (!material.specular()) {
-      const dvec3 albedo = s.albedo;
-      dvec3 irradiance(0.0);
-      lights.add_point_lights(x, n, origin, irradiance, depth == 1 ? &state.signature : nullptr, state.rays);
-      radiance += throughput * albedo * irradiance;
+    const Bsdf bsdf = bsdf_of(material, s.albedo);
+    const dvec3 wo = -ray.dir;
+    if (!bsdf.has(VKRAY_BSDF_DELTA)) {
+      // Next-event estimation: each term f cos times the light over its density, weighed against BSDF sampling.
+      dvec3 from_points(0.0);
+      lights.add_point_lights(x, n, origin, bsdf, wo, front, from_points, depth == 1 ? &state.signature : nullptr, state.rays);
+      radiance += throughput * from_points;
       if (lights.has_area_lights()) {
         const AreaLightSample light = lights.sample_area_light_from(x, n, origin, state.stream, state.rays);
         if (light.pdf > 0)
-          radiance += throughput * albedo * light.radiance *
-                      (light.cos_x / (kPi * light.pdf) * power_heuristic(light.pdf, light.cos_x / kPi));
+          radiance += throughput * eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance *
+                      (power_heuristic(light.pdf, pdf_bsdf(bsdf, wo, light.dir, n, front)) / light.pdf);
       }
       if (background_sampled) {
         const double u1 = gpu::next_random(state.stream), u2 = gpu::next_random(state.stream);
         const dvec3 w = uniform_sphere(u1, u2);
-        const double cos_x = glm::dot(n, w);
-        if (cos_x > 0) {
+        if (glm::dot(n, w) > 0) {
           ++state.rays;
           if (!tracer.occluded({origin, w}, epsilon, kFar))
-            radiance += throughput * albedo * background *
-                        (cos_x / (kPi * kBackgroundPdf) * power_heuristic(kBackgroundPdf, cos_x / kPi));
+            radiance += throughput * eval_bsdf(bsdf, wo, w, n, front) * background *
+                        (power_heuristic(kBackgroundPdf, pdf_bsdf(bsdf, wo, w, n, front)) / kBackgroundPdf);
         }
       }
     }
 
     // The next direction.
-    const BsdfSample b = sample_bsdf(material, s.albedo, -ray.dir, n, front, state.stream);
+    const BsdfSample b = sample_bsdf(bsdf, wo, n, front, state.stream);
     if ((glm::dot(b.dir, n_geometric) > 0) == b.transmitted) break;  // the wrong side of the surface
     throughput *= b.weight;
     if (std::max({throughput.r, throughput.g, throughput.b}) == 0) break;

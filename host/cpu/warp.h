@@ -48,15 +48,28 @@ inline glm::dvec3 uniform_triangle(double u1, double u2) {
   return {b0, b1, 1 - b0 - b1};
 }
 
-// `local` turned so that its +z is the unit vector n: an orthonormal basis about n (Duff et al.
-// 2017), the one the shader builds.
-inline glm::dvec3 to_world(const glm::dvec3& local, const glm::dvec3& n) {
+// An orthonormal basis about the unit vector n (Duff et al. 2017), the one the shader builds: its
+// two tangents; (t, bt, n) is right-handed.
+struct Frame {
+  glm::dvec3 t, bt, n;
+};
+inline Frame frame_about(const glm::dvec3& n) {
   const double sign = n.z >= 0 ? 1.0 : -1.0;
   const double a = -1 / (sign + n.z);
   const double b = n.x * n.y * a;
-  const glm::dvec3 t(1 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-  const glm::dvec3 bt(b, sign + n.y * n.y * a, -n.y);
-  return local.x * t + local.y * bt + local.z * n;
+  return {{1 + sign * n.x * n.x * a, sign * b, -sign * n.x}, {b, sign + n.y * n.y * a, -n.y}, n};
+}
+
+// `local` turned so that its +z is the unit vector n.
+inline glm::dvec3 to_world(const glm::dvec3& local, const glm::dvec3& n) {
+  const Frame f = frame_about(n);
+  return local.x * f.t + local.y * f.bt + local.z * f.n;
+}
+
+// The world direction v in the frame about n: (t . v, bt . v, n . v).
+inline glm::dvec3 to_local(const glm::dvec3& v, const glm::dvec3& n) {
+  const Frame f = frame_about(n);
+  return {glm::dot(v, f.t), glm::dot(v, f.bt), glm::dot(v, f.n)};
 }
 
 }  // namespace vkray::cpu

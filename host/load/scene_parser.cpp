@@ -187,40 +187,55 @@ void SceneParser::parse_materials(const Value& v) {
     Material material;
     material.name = name;
     const std::string type = m.has("type") ? string(m["type"]) : "diffuse";
-    // A colour in [0, 1]: more would reflect more light than arrives. The direct model takes it with
-    // a warning (a light bounces at most a few times); paths would carry it without end, so that a
-    // closed room of such a surface has no finite radiance.
-    const auto reflectance = [&](const Value& c) {
-      const glm::vec3 rgb = color(c);
-      if (rgb.r > 1.0f || rgb.g > 1.0f || rgb.b > 1.0f) {
-        if (scene_.integrator.type == Integrator::Type::path)
-          fail(c, "a value above 1 reflects more light than arrives, which the path integrator would carry without end "
-                  "(radiance past any bound): at most 1");
-        warn(c, "a value above 1 reflects more light than arrives");
-      }
-      return rgb;
-    };
-    if (type == "diffuse") {
-      check_keys(m, {"type", "albedo", "emission"});
-      material.albedo = reflectance(require(m, "albedo"));
-    } else if (type == "mirror") {
-      check_keys(m, {"type", "reflectance", "emission"});
-      material.type = MaterialType::mirror;
-      material.albedo = reflectance(require(m, "reflectance"));
-    } else if (type == "glass") {
-      check_keys(m, {"type", "ior", "emission"});
-      material.type = MaterialType::glass;
-      if (m.has("ior")) {
-        material.ior = positive(m["ior"]);
-        if (!(material.ior <= kMaxIor)) fail(m["ior"], "expected an index of refraction up to 100, got " + brief(m["ior"].j));
-      }
-    } else {
-      fail(m["type"], "unknown material type \"" + printable(type) + "\" (expected \"diffuse\", \"mirror\" or \"glass\")");
+    const std::optional<MaterialType> known = material_type_named(type);
+    if (!known) fail(m["type"], "unknown material type \"" + printable(type) + "\" (expected " + material_type_list() + ")");
+    material.type = *known;
+    switch (material.type) {
+      case MaterialType::diffuse:
+        check_keys(m, {"type", "albedo", "emission"});
+        material.albedo = reflectance(require(m, "albedo"));
+        break;
+      case MaterialType::mirror:
+        check_keys(m, {"type", "reflectance", "emission"});
+        material.albedo = reflectance(require(m, "reflectance"));
+        break;
+      case MaterialType::glass:
+        check_keys(m, {"type", "ior", "emission"});
+        if (m.has("ior")) material.ior = index_of_refraction(m["ior"]);
+        break;
     }
     if (m.has("emission")) material.emission = color(m["emission"]);
     material_index_[name] = static_cast<uint32_t>(scene_.materials.size());
     scene_.materials.push_back(material);
   }
+}
+
+// A colour in [0, 1]: more would reflect more light than arrives. The direct model takes it with a
+// warning (a light bounces at most a few times); paths would carry it without end, so that a closed
+// room of such a surface has no finite radiance.
+glm::vec3 SceneParser::reflectance(const Value& c) {
+  const glm::vec3 rgb = color(c);
+  if (rgb.r > 1.0f || rgb.g > 1.0f || rgb.b > 1.0f) {
+    if (scene_.integrator.type == Integrator::Type::path)
+      fail(c, "a value above 1 reflects more light than arrives, which the path integrator would carry without end "
+              "(radiance past any bound): at most 1");
+    warn(c, "a value above 1 reflects more light than arrives");
+  }
+  return rgb;
+}
+
+float SceneParser::index_of_refraction(const Value& v) const {
+  const float ior = positive(v);
+  if (!(ior <= kMaxIor)) fail(v, "expected an index of refraction up to 100, got " + brief(v.j));
+  return ior;
+}
+
+std::string SceneParser::material_type_list() {
+  std::string list;
+  for (uint32_t t = 0; t < VKRAY_MATERIAL_TYPE_COUNT; ++t)
+    list += std::string(t == 0 ? "" : t + 1 == VKRAY_MATERIAL_TYPE_COUNT ? " or " : ", ") + "\"" +
+            std::string(material_type_name(MaterialType(t))) + "\"";
+  return list;
 }
 
 uint32_t SceneParser::material_ref(const Value& v) const {

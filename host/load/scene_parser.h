@@ -121,6 +121,9 @@ class SceneParser {
   void parse_camera(const Value& v);
   void parse_integrator(const Value& v);
   void parse_materials(const Value& v);
+  glm::vec3 reflectance(const Value& v);  // a colour in [0, 1] (above 1: refused for paths, a warning otherwise)
+  float index_of_refraction(const Value& v) const;
+  static std::string material_type_list();  // "\"diffuse\", \"mirror\", ... or \"...\""
   // Fails unless the JSON value is an integer from `min` to `max`.
   int64_t integer(const Value& v, int64_t min, int64_t max) const;
   // "flip_normals": true turns an object's normals around (for emission and glass).

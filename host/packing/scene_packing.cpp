@@ -297,8 +297,10 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
     glm::vec4* texels = &packed.materials[i * VKRAY_TEXELS_PER_MATERIAL];
-    texels[VKRAY_MATERIAL_COLOR] = glm::vec4(m.albedo, uintBitsToFloat(uint32_t(m.type)));
-    texels[VKRAY_MATERIAL_EMISSION] = glm::vec4(scale_radiance(m.emission, exponent), m.ior);
+    const MaterialValueTexels values = material_value_texels(
+        {m.albedo, uint32_t(m.type), scale_radiance(m.emission, exponent), m.ior});
+    texels[VKRAY_MATERIAL_COLOR] = values.color;
+    texels[VKRAY_MATERIAL_EMISSION] = values.emission;
     texels[VKRAY_MATERIAL_ALBEDO_TEXTURE] = header(m.albedo_texture);
     texels[VKRAY_MATERIAL_EMISSION_TEXTURE] = header(m.emission_texture);
     // In double on the host, then one rounding: no 1 / total power in float that could overflow.

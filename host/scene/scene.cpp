@@ -6,6 +6,22 @@
 
 namespace vkray {
 
+std::string_view material_type_name(MaterialType type) {
+#define VKRAY_MATERIAL_NAME(number, name, properties) \
+  if (uint32_t(type) == number) return #name;
+  VKRAY_MATERIAL_TYPES(VKRAY_MATERIAL_NAME)
+#undef VKRAY_MATERIAL_NAME
+  return "unknown";
+}
+
+std::optional<MaterialType> material_type_named(std::string_view name) {
+#define VKRAY_MATERIAL_NAMED(number, type_name, properties) \
+  if (name == #type_name) return MaterialType(number);
+  VKRAY_MATERIAL_TYPES(VKRAY_MATERIAL_NAMED)
+#undef VKRAY_MATERIAL_NAMED
+  return std::nullopt;
+}
+
 float Scene::extent() const {
   float e = 0.0f;
   auto grow = [&e](glm::vec3 p) { e = std::max({e, std::abs(p.x), std::abs(p.y), std::abs(p.z)}); };

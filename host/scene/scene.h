@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,6 +17,7 @@
 #include <glm/glm.hpp>
 
 #include "image/image.h"
+#include "shared/materials.h"
 #include "scene/texture.h"
 
 namespace vkray {
@@ -60,8 +62,17 @@ struct Camera {
   float focus_distance = 1.0f;
 };
 
-// The values are the shader's (VKRAY_MATERIAL_* in shaders/shared/scene_layout.h).
-enum class MaterialType : uint32_t { diffuse = 0, mirror = 1, glass = 2 };
+// The material types, numbered as the shader numbers them: made from the table in
+// shaders/shared/materials.h, which also gives each its properties.
+enum class MaterialType : uint32_t {
+#define VKRAY_MATERIAL_ENUMERATOR(number, name, properties) name = number,
+  VKRAY_MATERIAL_TYPES(VKRAY_MATERIAL_ENUMERATOR)
+#undef VKRAY_MATERIAL_ENUMERATOR
+};
+
+// The name a scene file gives the type ("mirror"), and the type of a name (nullopt: none).
+std::string_view material_type_name(MaterialType type);
+std::optional<MaterialType> material_type_named(std::string_view name);
 
 struct Material {
   std::string name;
@@ -76,7 +87,9 @@ struct Material {
 
   bool emissive() const { return emission != glm::vec3(0.0f); }
   bool textured() const { return albedo_texture.present() || emission_texture.present(); }
-  bool specular() const { return type != MaterialType::diffuse; }  // a delta BSDF
+  // Its properties (VKRAY_BSDF_* in shaders/shared/materials.h): code outside the BSDFs asks these.
+  uint32_t properties() const { return gpu::material_properties(uint32_t(type)); }
+  bool has(uint32_t property) const { return (properties() & property) != 0; }
 };
 
 // How light is carried to the camera (Mitsuba's integrators).

@@ -162,7 +162,7 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   const Scene& s = scene.scene();
   variant.path = s.integrator.type == Integrator::Type::path;
   variant.emitters = scene.lighting().emitter_count > 0;
-  variant.specular = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.specular(); });
+  variant.non_diffuse = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.properties() != VKRAY_BSDF_DIFFUSE; });
   variant.aovs = options.aovs;
   variant.textures = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.textured(); });
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))

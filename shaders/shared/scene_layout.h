@@ -5,6 +5,7 @@
 #define VKRAY_SHARED_SCENE_LAYOUT_H
 
 #include "glsl_cpp.h"
+#include "materials.h"
 
 VKRAY_SHARED_BEGIN
 
@@ -54,26 +55,10 @@ VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 // material has a texture.
 #define VKRAY_TEXELS_PER_TEXCOORDS 2
 
-// ---- Materials: VKRAY_TEXELS_PER_MATERIAL RGBA32F texels each -----------------------------------------
-//   VKRAY_MATERIAL_COLOR:             (albedo or reflectance, type as uint bits)
-//   VKRAY_MATERIAL_EMISSION:          (emitted radiance, index of refraction)
-//   VKRAY_MATERIAL_ALBEDO_TEXTURE:    the texture that multiplies the colour (texture_texel)
-//   VKRAY_MATERIAL_EMISSION_TEXTURE:  the texture that multiplies the emission
-//   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
-//                                     an emitter of this material, 0, 0, 0): scene/emitters.h
-#define VKRAY_TEXELS_PER_MATERIAL 5
-#define VKRAY_MATERIAL_COLOR 0
-#define VKRAY_MATERIAL_EMISSION 1
-#define VKRAY_MATERIAL_ALBEDO_TEXTURE 2
-#define VKRAY_MATERIAL_EMISSION_TEXTURE 3
-#define VKRAY_MATERIAL_LIGHT 4
-// The types, as vkray::MaterialType numbers them.
-#define VKRAY_MATERIAL_DIFFUSE 0u
-#define VKRAY_MATERIAL_MIRROR 1u
-#define VKRAY_MATERIAL_GLASS 2u
+// ---- Materials: shared/materials.h ------------------------------------------------------------------
 
-// The first texel of the material a primitive's flags name.
-VKRAY_INLINE int material_texel(uint flags) { return int(flags & VKRAY_PRIM_MATERIAL_MASK) * VKRAY_TEXELS_PER_MATERIAL; }
+// The material a primitive's flags name.
+VKRAY_INLINE uint primitive_material(uint flags) { return flags & VKRAY_PRIM_MATERIAL_MASK; }
 
 // ---- Textures: RGBA16F texels in one buffer, each texture's rows one after another ---------------------
 // A material names a texture by one texel, the bits of four uints: (its first texel in the buffer,

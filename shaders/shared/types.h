@@ -40,8 +40,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_PATH 2
 // false when no material emits: no area-light code.
 #define VKRAY_SPEC_EMITTERS 3
-// false when every material is diffuse: no code for mirrors and glass.
-#define VKRAY_SPEC_SPECULAR 4
+// false when every material is purely Lambertian: no code for the other BSDFs.
+#define VKRAY_SPEC_NON_DIFFUSE 4
 // true when the render also returns the first-hit passes (AOVs): aovs.glsl's code is compiled in.
 #define VKRAY_SPEC_AOVS 5
 // false when no material has a texture: no texture coordinates and no texture code.
@@ -51,7 +51,7 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_SHADOWS, SHADOW_RAYS, shadows, true)           \
   X(VKRAY_SPEC_PATH, PATH_TRACING, path, false)               \
   X(VKRAY_SPEC_EMITTERS, SCENE_HAS_EMITTERS, emitters, false) \
-  X(VKRAY_SPEC_SPECULAR, SCENE_HAS_SPECULAR, specular, false) \
+  X(VKRAY_SPEC_NON_DIFFUSE, SCENE_HAS_NON_DIFFUSE, non_diffuse, false) \
   X(VKRAY_SPEC_AOVS, FIRST_HIT_PASSES, aovs, false)           \
   X(VKRAY_SPEC_TEXTURES, SCENE_HAS_TEXTURES, textures, false)
 

@@ -1,0 +1,98 @@
+// The materials in one place, for both sides: each type's number and its name in scene files, the
+// properties that code outside the BSDFs asks of a material (never its type), and the texels that
+// carry its values to the shader (packed by the host, unpacked by the shader, with the functions
+// here). Adding a material is a row of VKRAY_MATERIAL_TYPES, its values below if it has new ones,
+// its paired BSDF functions (shaders/bsdf.glsl, host/cpu/bsdf.cpp) and its scene-file keys
+// (host/load/scene_parser.cpp): docs/developing.md, "Where a change goes".
+#ifndef VKRAY_SHARED_MATERIALS_H
+#define VKRAY_SHARED_MATERIALS_H
+
+#include "glsl_cpp.h"
+
+VKRAY_SHARED_BEGIN
+
+// ---- Properties: what a BSDF is made of (as pbrt-v4's BxDFFlags) ---------------------------------------
+// DIFFUSE       a Lambertian lobe
+// GLOSSY        a lobe that is neither Lambertian nor a delta: light sampling asks its eval and pdf
+// DELTA         delta lobes only: no light sampling there, and a light met after it counts whole
+// TRANSMISSION  light passes to the other side; inside and outside are told by the geometric normal
+// CLEAR         its albedo pass is 1, not its colour (clear glass)
+#define VKRAY_BSDF_DIFFUSE 1u
+#define VKRAY_BSDF_GLOSSY 2u
+#define VKRAY_BSDF_DELTA 4u
+#define VKRAY_BSDF_TRANSMISSION 8u
+#define VKRAY_BSDF_CLEAR 16u
+
+// ---- The types: X(number, name in scene files, properties) ---------------------------------------------
+// The host's MaterialType (scene/scene.h) and the scene parser's names are made from this table.
+#define VKRAY_MATERIAL_DIFFUSE 0u
+#define VKRAY_MATERIAL_MIRROR 1u
+#define VKRAY_MATERIAL_GLASS 2u
+#define VKRAY_MATERIAL_TYPES(X)                                                                    \
+  X(VKRAY_MATERIAL_DIFFUSE, diffuse, VKRAY_BSDF_DIFFUSE)                                           \
+  X(VKRAY_MATERIAL_MIRROR, mirror, VKRAY_BSDF_DELTA)                                               \
+  X(VKRAY_MATERIAL_GLASS, glass, VKRAY_BSDF_DELTA | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR)
+#define VKRAY_MATERIAL_TYPE_COUNT 3u
+
+VKRAY_INLINE uint material_properties(uint type) {
+#define VKRAY_MATERIAL_PROPERTIES_OF(number, name, properties) \
+  if (type == number) return properties;
+  VKRAY_MATERIAL_TYPES(VKRAY_MATERIAL_PROPERTIES_OF)
+#undef VKRAY_MATERIAL_PROPERTIES_OF
+  return 0u;
+}
+
+// ---- The values: what a BSDF is evaluated from, before textures -----------------------------------------
+struct MaterialValues {
+  vec3 color;      // diffuse: albedo; mirror: reflectance
+  uint type;       // VKRAY_MATERIAL_*
+  vec3 emission;   // radiance emitted on the side the geometric normal faces (the shader's: scaled)
+  float ior;       // glass: the index of refraction inside (outside: 1)
+};
+
+// ---- Texels: VKRAY_TEXELS_PER_MATERIAL RGBA32F each ---------------------------------------------------
+//   VKRAY_MATERIAL_COLOR:             (colour, type | properties << 8 as uint bits)
+//   VKRAY_MATERIAL_EMISSION:          (emitted radiance, ior)
+//   VKRAY_MATERIAL_ALBEDO_TEXTURE:    the texture that multiplies the colour (texture_texel)
+//   VKRAY_MATERIAL_EMISSION_TEXTURE:  the texture that multiplies the emission
+//   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
+//                                     an emitter of this material, 0, 0, 0): scene/emitters.h
+#define VKRAY_TEXELS_PER_MATERIAL 5
+#define VKRAY_MATERIAL_COLOR 0
+#define VKRAY_MATERIAL_EMISSION 1
+#define VKRAY_MATERIAL_ALBEDO_TEXTURE 2
+#define VKRAY_MATERIAL_EMISSION_TEXTURE 3
+#define VKRAY_MATERIAL_LIGHT 4
+#define VKRAY_MATERIAL_PROPERTY_SHIFT 8u
+
+// The first texel of material `index`.
+VKRAY_INLINE int material_texel(uint index) { return int(index) * VKRAY_TEXELS_PER_MATERIAL; }
+
+// The value texels (COLOR, EMISSION) of a material; its properties come from the table, never from the caller.
+struct MaterialValueTexels {
+  vec4 color;
+  vec4 emission;
+};
+
+VKRAY_INLINE MaterialValueTexels material_value_texels(MaterialValues m) {
+  MaterialValueTexels t;
+  t.color = vec4(m.color, uintBitsToFloat(m.type | (material_properties(m.type) << VKRAY_MATERIAL_PROPERTY_SHIFT)));
+  t.emission = vec4(m.emission, m.ior);
+  return t;
+}
+
+VKRAY_INLINE uint material_type_of(vec4 color_texel) { return floatBitsToUint(color_texel.w) & ((1u << VKRAY_MATERIAL_PROPERTY_SHIFT) - 1u); }
+VKRAY_INLINE uint material_properties_of(vec4 color_texel) { return floatBitsToUint(color_texel.w) >> VKRAY_MATERIAL_PROPERTY_SHIFT; }
+
+VKRAY_INLINE MaterialValues material_values(MaterialValueTexels t) {
+  MaterialValues m;
+  m.color = vec3(t.color.x, t.color.y, t.color.z);
+  m.type = material_type_of(t.color);
+  m.emission = vec3(t.emission.x, t.emission.y, t.emission.z);
+  m.ior = t.emission.w;
+  return m;
+}
+
+VKRAY_SHARED_END
+
+#endif  // VKRAY_SHARED_MATERIALS_H

@@ -1,0 +1,288 @@
+// The CPU reference's BSDFs, each on its own, in the style of pbrt-v4's bsdfs_test and Mitsuba's
+// BSDF tests: sample, eval and pdf agree (a chi-square test of the sampled directions against the
+// pdf, and every sample's weight and density against eval and pdf), eval is reciprocal, and the
+// energy a BSDF reflects is at most what arrives (all of it where nothing is lost).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "cpu/bsdf.h"
+#include "cpu/warp.h"
+#include "shared/sampling.h"
+
+namespace vkray::cpu {
+namespace {
+
+using glm::dvec3;
+
+// ---- The chi-square distribution's upper tail: Q(dof / 2, x / 2) (Numerical Recipes' gammq) ----------
+
+double upper_incomplete_gamma_q(double a, double x) {
+  if (x <= 0) return 1;
+  const double log_prefix = -x + a * std::log(x) - std::lgamma(a);
+  if (x < a + 1) {  // the series for P, then Q = 1 - P
+    double term = 1 / a, sum = term;
+    for (int n = 1; n < 10000 && std::abs(term) > std::abs(sum) * 1e-15; ++n) sum += term *= x / (a + n);
+    return 1 - sum * std::exp(log_prefix);
+  }
+  // Lentz's continued fraction for Q.
+  double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
+  for (int i = 1; i < 10000; ++i) {
+    const double an = -i * (i - a);
+    b += 2;
+    d = an * d + b;
+    if (std::abs(d) < 1e-300) d = 1e-300;
+    c = b + an / c;
+    if (std::abs(c) < 1e-300) c = 1e-300;
+    d = 1 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::abs(delta - 1) < 1e-15) break;
+  }
+  return std::exp(log_prefix) * h;
+}
+
+TEST(BsdfTest, ChiSquareTailMatchesKnownValues) {
+  // Q(k/2, x/2) for the chi-square distribution: P(X > 3.841) = 0.05 at 1 dof, P(X > 18.307) = 0.05 at 10.
+  EXPECT_NEAR(upper_incomplete_gamma_q(0.5, 3.841 / 2), 0.05, 1e-4);
+  EXPECT_NEAR(upper_incomplete_gamma_q(5.0, 18.307 / 2), 0.05, 1e-4);
+  EXPECT_NEAR(upper_incomplete_gamma_q(50.0, 135.807 / 2), 0.01, 1e-4);  // 100 dof
+}
+
+// ---- The BSDFs under test -----------------------------------------------------------------------------
+
+struct Case {
+  std::string name;
+  Material material;
+};
+
+Material material_of(MaterialType type, glm::vec3 color) {
+  Material m;
+  m.type = type;
+  m.albedo = color;
+  return m;
+}
+
+std::vector<Case> glossy_cases() {
+  return {{"diffuse", material_of(MaterialType::diffuse, glm::vec3(0.8f, 0.5f, 0.2f))}};
+}
+
+// A normal that is not an axis, so that the frame about it is exercised, and directions around it.
+const dvec3 kNormal = glm::normalize(dvec3(0.3, -0.5, 0.8));
+
+dvec3 direction_at(double cos_theta, double phi, const dvec3& n) {
+  const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
+  return glm::normalize(to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta}, n));
+}
+
+// ---- sample against pdf ------------------------------------------------------------------------------
+
+// Bins over the whole sphere about n, equal in cos(theta) and phi: equal solid angles.
+constexpr int kThetaBins = 24, kPhiBins = 48, kSubdivisions = 12;
+constexpr int kSamples = 200000;
+
+int bin_of(const dvec3& local) {
+  const double cos_theta = std::clamp(local.z, -1.0, 1.0);
+  const double phi = std::atan2(local.y, local.x) + (local.y < 0 ? 2 * kPi : 0);
+  const int t = std::min(kThetaBins - 1, int((1 - cos_theta) / 2 * kThetaBins));
+  const int p = std::min(kPhiBins - 1, int(phi / (2 * kPi) * kPhiBins));
+  return t * kPhiBins + p;
+}
+
+struct ChiSquare {
+  double statistic = 0;
+  int dof = 0;
+  double p_value = 1;
+};
+
+// Sampled counts against the pdf integrated over each bin (the midpoint rule on a finer grid); the
+// samples that failed against the mass the pdf leaves outside the sphere. Bins expecting fewer than 5
+// are pooled, as the test requires.
+ChiSquare chi_square(const Bsdf& bsdf, const dvec3& wo, bool front) {
+  const int bins = kThetaBins * kPhiBins;
+  std::vector<double> observed(size_t(bins) + 1, 0.0), expected(size_t(bins) + 1, 0.0);
+  for (uint32_t i = 0; i < uint32_t(kSamples); ++i) {
+    uint32_t stream = gpu::pcg_hash(i * 0x9e3779b9u + 17u);
+    const BsdfSample b = sample_bsdf(bsdf, wo, kNormal, front, stream);
+    const bool failed = b.weight == dvec3(0.0);
+    observed[failed ? size_t(bins) : size_t(bin_of(to_local(b.dir, kNormal)))] += 1;
+  }
+  double total = 0;
+  const double d_cos = 2.0 / (kThetaBins * kSubdivisions), d_phi = 2 * kPi / (kPhiBins * kSubdivisions);
+  for (int t = 0; t < kThetaBins * kSubdivisions; ++t) {
+    const double cos_theta = 1 - (t + 0.5) * d_cos;
+    for (int p = 0; p < kPhiBins * kSubdivisions; ++p) {
+      const double phi = (p + 0.5) * d_phi;
+      const double mass = pdf_bsdf(bsdf, wo, direction_at(cos_theta, phi, kNormal), kNormal, front) * d_cos * d_phi;
+      expected[size_t((t / kSubdivisions) * kPhiBins + p / kSubdivisions)] += mass * kSamples;
+      total += mass;
+    }
+  }
+  expected[size_t(bins)] = std::max(0.0, 1 - total) * kSamples;
+  ChiSquare result;
+  double pooled_observed = 0, pooled_expected = 0;
+  for (size_t i = 0; i < observed.size(); ++i) {
+    if (expected[i] < 5) {
+      pooled_observed += observed[i];
+      pooled_expected += expected[i];
+      continue;
+    }
+    result.statistic += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+    ++result.dof;
+  }
+  if (pooled_expected >= 5) {
+    result.statistic += (pooled_observed - pooled_expected) * (pooled_observed - pooled_expected) / pooled_expected;
+    ++result.dof;
+  } else if (pooled_observed > 50) {
+    result.statistic = 1e30;  // many samples where the pdf says almost none
+  }
+  result.dof -= 1;  // the counts sum to kSamples
+  result.p_value = upper_incomplete_gamma_q(result.dof / 2.0, result.statistic / 2);
+  return result;
+}
+
+const double kViewCosines[] = {0.95, 0.6, 0.2};
+
+TEST(BsdfTest, SampledDirectionsFollowThePdf) {
+  const std::vector<Case> cases = glossy_cases();
+  // A 1% significance level over all the tests together (Sidak's correction).
+  const double level = 1 - std::pow(0.99, 1.0 / double(cases.size() * std::size(kViewCosines)));
+  for (const Case& c : cases) {
+    const Bsdf bsdf = bsdf_of(c.material, dvec3(c.material.albedo));
+    for (const double cos_o : kViewCosines) {
+      const ChiSquare chi = chi_square(bsdf, direction_at(cos_o, 1.0, kNormal), true);
+      EXPECT_GT(chi.p_value, level) << c.name << " at cos_o " << cos_o << ": chi^2 " << chi.statistic << " over " << chi.dof
+                                    << " degrees of freedom";
+    }
+  }
+}
+
+TEST(BsdfTest, EachSampleCarriesEvalOverPdf) {
+  for (const Case& c : glossy_cases()) {
+    const Bsdf bsdf = bsdf_of(c.material, dvec3(c.material.albedo));
+    for (const double cos_o : kViewCosines) {
+      const dvec3 wo = direction_at(cos_o, 2.0, kNormal);
+      for (uint32_t i = 0; i < 2000; ++i) {
+        uint32_t stream = gpu::pcg_hash(i + 5u);
+        const BsdfSample b = sample_bsdf(bsdf, wo, kNormal, true, stream);
+        if (b.weight == dvec3(0.0)) continue;
+        const double pdf = pdf_bsdf(bsdf, wo, b.dir, kNormal, true);
+        ASSERT_NEAR(b.pdf, pdf, 1e-6 * pdf) << c.name;
+        const dvec3 expected = eval_bsdf(bsdf, wo, b.dir, kNormal, true) / pdf;
+        for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(b.weight[ch], expected[ch], 1e-6 * std::max(1.0, expected[ch])) << c.name;
+      }
+    }
+  }
+}
+
+// ---- Reciprocity: f(wo, wi) = f(wi, wo) --------------------------------------------------------------
+
+TEST(BsdfTest, EvalIsReciprocal) {
+  for (const Case& c : glossy_cases()) {
+    const Bsdf bsdf = bsdf_of(c.material, dvec3(c.material.albedo));
+    uint32_t stream = 99;
+    for (int i = 0; i < 1000; ++i) {
+      const dvec3 a = direction_at(gpu::next_random(stream), 2 * kPi * gpu::next_random(stream), kNormal);
+      const dvec3 b = direction_at(gpu::next_random(stream), 2 * kPi * gpu::next_random(stream), kNormal);
+      const dvec3 f_ab = eval_bsdf(bsdf, a, b, kNormal, true) / glm::dot(b, kNormal);
+      const dvec3 f_ba = eval_bsdf(bsdf, b, a, kNormal, true) / glm::dot(a, kNormal);
+      for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(f_ab[ch], f_ba[ch], 1e-9 * std::max(1.0, f_ab[ch])) << c.name;
+    }
+  }
+}
+
+// ---- Energy -------------------------------------------------------------------------------------------
+
+// The directional albedo, the integral of f cos over wi, two ways: the mean sample weight, and eval
+// over directions uniform on the sphere; with the standard error of each.
+struct Albedo {
+  dvec3 sampled{0.0}, sampled_error{0.0};
+  dvec3 uniform{0.0}, uniform_error{0.0};
+};
+
+Albedo directional_albedo(const Bsdf& bsdf, const dvec3& wo, int samples) {
+  Albedo a;
+  dvec3 sum(0.0), sum2(0.0), usum(0.0), usum2(0.0);
+  for (uint32_t i = 0; i < uint32_t(samples); ++i) {
+    uint32_t stream = gpu::pcg_hash(i * 3u + 1u);
+    const BsdfSample b = sample_bsdf(bsdf, wo, kNormal, true, stream);
+    sum += b.weight;
+    sum2 += b.weight * b.weight;
+    const dvec3 w = uniform_sphere(gpu::next_random(stream), gpu::next_random(stream));
+    const dvec3 u = eval_bsdf(bsdf, wo, w, kNormal, true) * (4 * kPi);
+    usum += u;
+    usum2 += u * u;
+  }
+  const double n = samples;
+  a.sampled = sum / n;
+  a.sampled_error = glm::sqrt(glm::max(dvec3(0.0), sum2 / n - a.sampled * a.sampled) / n);
+  a.uniform = usum / n;
+  a.uniform_error = glm::sqrt(glm::max(dvec3(0.0), usum2 / n - a.uniform * a.uniform) / n);
+  return a;
+}
+
+TEST(BsdfTest, ReflectsAtMostWhatArrivesAndAllOfItWhereNothingIsLost) {
+  for (const Case& c : glossy_cases()) {
+    const Bsdf bsdf = bsdf_of(c.material, dvec3(c.material.albedo));
+    for (const double cos_o : kViewCosines) {
+      const Albedo a = directional_albedo(bsdf, direction_at(cos_o, 0.5, kNormal), 200000);
+      for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_LE(a.sampled[ch], 1 + 4 * a.sampled_error[ch]) << c.name << " cos_o " << cos_o;
+        // The two estimates of one integral agree (importance sampling hides no lobe eval has).
+        const double error = std::hypot(a.sampled_error[ch], a.uniform_error[ch]);
+        EXPECT_NEAR(a.sampled[ch], a.uniform[ch], 5 * error + 1e-3) << c.name << " cos_o " << cos_o;
+      }
+    }
+  }
+  // A Lambertian surface reflects its albedo exactly, every sample.
+  const Bsdf white = bsdf_of(material_of(MaterialType::diffuse, glm::vec3(1.0f)), dvec3(1.0));
+  const Albedo a = directional_albedo(white, direction_at(0.3, 0.0, kNormal), 1000);
+  EXPECT_EQ(a.sampled, dvec3(1.0));
+}
+
+// ---- The delta BSDFs -----------------------------------------------------------------------------------
+
+TEST(BsdfTest, AMirrorReflectsAboutTheNormal) {
+  const Bsdf mirror = bsdf_of(material_of(MaterialType::mirror, glm::vec3(0.9f)), dvec3(0.9));
+  const dvec3 wo = direction_at(0.4, 1.0, kNormal);
+  uint32_t stream = 1;
+  const BsdfSample b = sample_bsdf(mirror, wo, kNormal, true, stream);
+  EXPECT_TRUE(b.delta);
+  EXPECT_NEAR(glm::length(b.dir + wo - 2 * glm::dot(wo, kNormal) * kNormal), 0.0, 1e-12);
+  EXPECT_EQ(b.weight, dvec3(0.9));
+  EXPECT_EQ(stream, 1u);  // no number drawn
+  EXPECT_EQ(eval_bsdf(mirror, wo, b.dir, kNormal, true), dvec3(0.0));
+  EXPECT_EQ(pdf_bsdf(mirror, wo, b.dir, kNormal, true), 0.0);
+}
+
+TEST(BsdfTest, GlassReflectsWithTheFresnelProbabilityAndKeepsThePower) {
+  const Bsdf glass = bsdf_of(material_of(MaterialType::glass, glm::vec3(0.0f)), dvec3(0.0));
+  for (const bool front : {true, false}) {
+    const double cos_i = 0.5, eta = front ? 1.5 : 1 / 1.5;
+    double cos_t;
+    const double f = fresnel_dielectric(cos_i, eta, cos_t);
+    const dvec3 wo = direction_at(cos_i, 0.3, kNormal);
+    int reflected = 0;
+    const int n = 100000;
+    for (uint32_t i = 0; i < uint32_t(n); ++i) {
+      uint32_t stream = gpu::pcg_hash(i);
+      const BsdfSample b = sample_bsdf(glass, wo, kNormal, front, stream);
+      ASSERT_TRUE(b.delta);
+      if (!b.transmitted) {
+        ++reflected;
+        EXPECT_EQ(b.weight, dvec3(1.0));
+      } else {
+        // Radiance scales by 1 / eta^2; the power it carries (times eta^2) is kept.
+        EXPECT_NEAR(b.weight.x * eta * eta, 1.0, 1e-12);
+        EXPECT_NEAR(std::sqrt(1 - glm::dot(b.dir, kNormal) * glm::dot(b.dir, kNormal)) * eta,
+                    std::sqrt(1 - cos_i * cos_i), 1e-9);  // Snell's law
+      }
+    }
+    EXPECT_NEAR(double(reflected) / n, f, 4 * std::sqrt(f * (1 - f) / n)) << (front ? "outside" : "inside");
+  }
+}
+
+}  // namespace
+}  // namespace vkray::cpu
