@@ -24,8 +24,16 @@ Mapping (vkray's docs/scene-format.md and docs/rendering.md):
               right = normalize(f x up), as in vkray); fov_axis 'y', vertical_fov = 2 atan(0.5/f);
               aperture_radius > 0 -> 'thinlens'. Box pixel filter, hdrfilm rgb float32.
   materials   diffuse -> twosided(diffuse); mirror -> twosided(conductor, material 'none',
-              specular_reflectance); glass -> dielectric(int_ior=ior, ext_ior=1); "emission" ->
-              an 'area' emitter on each shape with the material (emits on the normal side).
+              specular_reflectance); glass -> dielectric(int_ior=ior, ext_ior=1);
+              roughconductor -> twosided(roughconductor, distribution 'ggx', sample_visible, alpha
+              or alpha_u/alpha_v, specular_reflectance, eta/k, else material 'none': Fresnel 1);
+              roughdielectric -> roughdielectric(distribution 'ggx', sample_visible, alpha,
+              int_ior (default 1.5, not Mitsuba's bk7), ext_ior 1). eta and k go in as 'srgb'
+              with unbounded true (Mitsuba's dict reader refuses an 'rgb' value above 1).
+              alpha_u runs along Mitsuba's dp/du (a sphere: around its world z axis; a mesh without
+              UVs: coordinate_system(n)), so anisotropic surfaces agree only where vkray's tangent does;
+              "emission" -> an 'area' emitter on each shape with the material (emits on the
+              normal side).
   objects     triangles/mesh are built in memory with the transform applied (M = T Rz Ry Rx S or
               the row-major matrix); flat shading = no vertex normals; "smooth": the file's
               normals, else area-weighted normals of the vertices welded by position (vkray's
@@ -191,6 +199,28 @@ def make_mesh(mi, name, positions, faces, normals, props):
 
 # ---- the conversion ------------------------------------------------------------------------------
 
+def rough_conductor(m, where):
+    """Mitsuba's roughconductor (one-sided: the caller wraps it in twosided) for a vkray material."""
+    b = {"type": "roughconductor", "distribution": "ggx", "sample_visible": True,
+         "specular_reflectance": {"type": "rgb", "value": m.get("specular_reflectance", [1.0, 1.0, 1.0])}}
+    if "alpha_u" in m or "alpha_v" in m:
+        if "alpha" in m or "alpha_u" not in m or "alpha_v" not in m:
+            raise ValueError(f"{where}: give either alpha or both alpha_u and alpha_v")
+        b.update(alpha_u=float(m["alpha_u"]), alpha_v=float(m["alpha_v"]))
+    else:
+        b["alpha"] = float(m.get("alpha", 0.1))
+    if ("eta" in m) != ("k" in m):
+        raise ValueError(f"{where}: give both eta and k, or neither (then the Fresnel term is 1)")
+    if "eta" in m:
+        # An 'rgb' dict is read as a reflectance and refused above 1; 'srgb' with unbounded is how
+        # Mitsuba's own XML reader and its material presets pass an index in RGB variants.
+        for key in ("eta", "k"):
+            b[key] = {"type": "srgb", "color": [float(x) for x in vec3(m[key], f"{where}/{key}")], "unbounded": True}
+    else:
+        b["material"] = "none"
+    return b
+
+
 def scene_dict(path, overrides=None):
     """(Mitsuba scene dict, info) for the vkray scene at `path`. Call mi.set_variant first."""
     import mitsuba as mi
@@ -274,6 +304,11 @@ def scene_dict(path, overrides=None):
         elif kind == "glass":
             specular = True
             b = {"type": "dielectric", "int_ior": float(m.get("ior", 1.5)), "ext_ior": 1.0}
+        elif kind == "roughconductor":
+            b = {"type": "twosided", "bsdf": rough_conductor(m, f"{path}: /materials/{name}")}
+        elif kind == "roughdielectric":
+            b = {"type": "roughdielectric", "distribution": "ggx", "sample_visible": True,
+                 "alpha": float(m.get("alpha", 0.1)), "int_ior": float(m.get("int_ior", 1.5)), "ext_ior": 1.0}
         else:
             raise ValueError(f"{path}: /materials/{name}/type: unknown material type {kind!r}")
         bsdfs[name] = mi.load_dict(b)  # one instance, shared by every shape with the material
@@ -405,6 +440,18 @@ def write_image(mi, path, rgb):
 
 # ---- the command line ----------------------------------------------------------------------------
 
+def printable(value):
+    """The scene dict with Mitsuba's objects (meshes, BSDFs, transforms) as their own text: pprint
+    cannot format them (their __repr__ is an unhashable pybind11 instancemethod)."""
+    if isinstance(value, dict):
+        return {k: printable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return type(value)(printable(v) for v in value)
+    if value is None or isinstance(value, (str, int, float, bool)):
+        return value
+    return " ".join(str(value).split())  # one line
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scene")
@@ -429,7 +476,7 @@ def main(argv=None):
     overrides = {"spp": a.spp, "width": a.width, "height": a.height, "max_depth": a.max_depth, "rr_depth": a.rr_depth}
     d, info = scene_dict(a.scene, overrides)
     if not a.out:
-        pprint.pprint(d, width=110)
+        pprint.pprint(printable(d), width=110)
         return 0
 
     scene = mi.load_dict(d)
