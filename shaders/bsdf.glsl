@@ -4,9 +4,12 @@
 //   mirror          perfect specular reflection times the reflectance, both sides (no numbers)
 //   glass           a smooth dielectric, ior inside and 1 outside (the geometric normal points out):
 //                   Fresnel reflection or refraction, picked with probability F (one number)
+//   roughconductor  GGX microfacets with Smith's masking, both sides, as Mitsuba's: the conductor's
+//                   Fresnel term times the specular reflectance; visible normals sampled (two numbers)
 // Every function takes wo, unit, back along the incoming ray; n, the shading normal turned to the
-// ray's side; front, whether the ray met the side the geometric normal faces. The CPU reference
-// implements the same (host/cpu/bsdf.h).
+// ray's side; front, whether the ray met the side the geometric normal faces. Glossy lobes live in
+// the frame frame_about(n) builds, whose first tangent is alpha's u. The CPU reference implements
+// the same (host/cpu/bsdf.h).
 #ifndef VKRAY_BSDF_GLSL
 #define VKRAY_BSDF_GLSL
 
@@ -39,17 +42,86 @@ float fresnel_dielectric(float cos_i, float eta, out float cos_t) {
   return 0.5 * (rs * rs + rp * rp);
 }
 
+// The unpolarized Fresnel reflectance of a conductor of complex index eta + i k, per channel, for
+// cos_i in [0, 1] (the s and p terms in the form of pbrt-v3's FrConductor).
+vec3 fresnel_conductor(float cos_i, vec3 eta, vec3 k) {
+  float cos2 = cos_i * cos_i, sin2 = 1.0 - cos2;
+  vec3 eta2 = eta * eta, k2 = k * k;
+  vec3 t0 = eta2 - k2 - sin2;
+  vec3 a2_plus_b2 = sqrt(t0 * t0 + 4.0 * eta2 * k2);
+  vec3 t1 = a2_plus_b2 + cos2;
+  vec3 a = sqrt(max(vec3(0.0), 0.5 * (a2_plus_b2 + t0)));
+  vec3 t2 = 2.0 * cos_i * a;
+  vec3 rs = (t1 - t2) / (t1 + t2);
+  vec3 t3 = cos2 * a2_plus_b2 + sin2 * sin2;
+  vec3 t4 = t2 * sin2;
+  vec3 rp = rs * (t3 - t4) / (t3 + t4);
+  return 0.5 * (rs + rp);
+}
+
+// ---- GGX microfacets ---------------------------------------------------------------------------------
+
+// The Trowbridge-Reitz density of unit microfacet normals m in the local frame (z: the normal).
+float ggx_density(vec3 m, vec2 alpha) {
+  if (m.z <= 0.0) return 0.0;
+  vec2 slope = m.xy / alpha;
+  float e = dot(slope, slope) + m.z * m.z;
+  return 1.0 / (PI * alpha.x * alpha.y * e * e);
+}
+
+// Smith's masking of v by microfacets of normal m: 1 / (1 + Lambda(v)).
+float smith_masking(vec3 v, vec3 m, vec2 alpha) {
+  if (dot(v, m) * v.z <= 0.0) return 0.0;  // a facet is seen only from its side, v only from above
+  vec2 av = alpha * v.xy;
+  float xy = dot(av, av);
+  if (xy == 0.0) return 1.0;
+  return 2.0 / (1.0 + sqrt(1.0 + xy / (v.z * v.z)));
+}
+
+// A microfacet normal visible from v (v.z > 0), with density G1(v, m) max(0, v . m) D(m) / v.z (Heitz
+// 2018: stretch to the hemisphere configuration, a point on the visible half's projected disk, lifted).
+vec3 sample_visible_normal(vec3 v, vec2 alpha, vec2 u) {
+  vec3 vh = normalize(vec3(alpha * v.xy, v.z));
+  float len2 = dot(vh.xy, vh.xy);
+  vec3 t1 = len2 > 0.0 ? vec3(-vh.y, vh.x, 0.0) * inversesqrt(len2) : vec3(1.0, 0.0, 0.0);
+  vec3 t2 = cross(vh, t1);
+  float r = sqrt(u.x), phi = 2.0 * PI * u.y;
+  float p1 = r * cos(phi);
+  float s = 0.5 * (1.0 + vh.z);
+  float p2 = (1.0 - s) * sqrt(1.0 - p1 * p1) + s * (r * sin(phi));
+  vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
+  return normalize(vec3(alpha * nh.xy, max(0.0, nh.z)));
+}
+
+// ---- roughconductor: F(wo . m) D(m) G1(wo) G1(wi) / (4 cos_o cos_i), in the local frame -------------------
+
+vec3 conductor_eval(Surface s, vec3 wo, vec3 wi) {
+  if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
+  vec3 m = normalize(wo + wi);
+  float dg = ggx_density(m, s.alpha) * smith_masking(wo, m, s.alpha) * smith_masking(wi, m, s.alpha);
+  return s.albedo * fresnel_conductor(dot(wo, m), s.eta, s.k) * (dg / (4.0 * wo.z));  // times cos_i
+}
+
+float conductor_pdf(Surface s, vec3 wo, vec3 wi) {
+  if (wo.z <= 0.0 || wi.z <= 0.0) return 0.0;
+  vec3 m = normalize(wo + wi);
+  // The visible normals' density G1(wo) (wo . m) D / cos_o, times the reflection's 1 / (4 wi . m).
+  return ggx_density(m, s.alpha) * smith_masking(wo, m, s.alpha) / (4.0 * wo.z);
+}
+
 // ---- The three functions -----------------------------------------------------------------------------
 
 // f(wo, wi) |n . wi|; 0 for delta BSDFs and directions a lobe does not reach.
 vec3 eval_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return s.albedo * (max(0.0, dot(wi, n)) / PI);
+  if (s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_eval(s, to_local(wo, n), to_local(wi, n));
   return vec3(0.0);
 }
 
 // The solid-angle density with which sample_bsdf picks wi; 0 for delta BSDFs.
 float pdf_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return max(0.0, dot(wi, n)) / PI;
+  if (s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_pdf(s, to_local(wo, n), to_local(wi, n));
   return 0.0;
 }
 
@@ -69,6 +141,21 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     b.dir = normalize(to_world(local, n));
     b.pdf = local.z / PI;
     b.weight = s.albedo;
+    return b;
+  }
+  if (s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) {
+    vec2 u = vec2(next_random(stream), next_random(stream));
+    vec3 o = to_local(wo, n);
+    b.dir = n;
+    b.weight = vec3(0.0);
+    if (o.z <= 0.0) return b;  // seen from below its shading normal: no light
+    vec3 m = sample_visible_normal(o, s.alpha, u);
+    vec3 i = 2.0 * dot(o, m) * m - o;
+    if (i.z <= 0.0) return b;  // reflected below the surface
+    b.dir = normalize(to_world(i, n));
+    b.pdf = conductor_pdf(s, o, i);
+    // f cos / pdf = F G1(wi): D, G1(wo) and the cosines cancel.
+    b.weight = s.albedo * fresnel_conductor(dot(o, m), s.eta, s.k) * smith_masking(i, m, s.alpha);
     return b;
   }
   float cos_i = dot(wo, n);

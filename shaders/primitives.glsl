@@ -23,6 +23,9 @@ struct Surface {
   uint properties;        // VKRAY_BSDF_*: what everything else asks
   vec3 emission;          // its texture applied
   float ior;
+  vec3 eta;               // a conductor's complex index of refraction
+  vec3 k;
+  vec2 alpha;             // GGX roughness along the frame's two tangents
   float light_pdf_area;   // the density per unit area with which light sampling picks this point (emitters.glsl)
 };
 
@@ -35,11 +38,17 @@ Surface hit_surface(Hit hit, vec3 position) {
   MaterialValueTexels t;
   t.color = texelFetch(materials, material + VKRAY_MATERIAL_COLOR);
   t.emission = vec4(0.0, 0.0, 0.0, 1.0);
+  t.eta = vec4(0.0);
+  t.k = vec4(0.0);
   uint properties = material_properties_of(t.color);
   float light_pdf_area = 0.0;
   if (SCENE_HAS_EMITTERS || SCENE_HAS_NON_DIFFUSE) {
     t.emission = texelFetch(materials, material + VKRAY_MATERIAL_EMISSION);
     light_pdf_area = texelFetch(materials, material + VKRAY_MATERIAL_LIGHT).x;
+  }
+  if (SCENE_HAS_NON_DIFFUSE && (properties & VKRAY_BSDF_GLOSSY) != 0u) {
+    t.eta = texelFetch(materials, material + VKRAY_MATERIAL_ETA);
+    t.k = texelFetch(materials, material + VKRAY_MATERIAL_K);
   }
   MaterialValues m = material_values(t);
   Surface s;
@@ -48,6 +57,9 @@ Surface hit_surface(Hit hit, vec3 position) {
   s.properties = properties;
   s.emission = m.emission;
   s.ior = m.ior;
+  s.eta = m.eta;
+  s.k = m.k;
+  s.alpha = vec2(m.alpha_u, m.alpha_v);
   s.light_pdf_area = light_pdf_area;
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     s.geometric_normal = (position - a.xyz) / sphere_radius(texelFetch(primitives, base + 1));

@@ -38,14 +38,28 @@ vec3 uniform_triangle(vec2 u) {
   return vec3(b0, b1, 1.0 - b0 - b1);
 }
 
-// A local direction (x, y, z) turned so that +z is the unit vector n (Duff et al. 2017, branchless).
-vec3 to_world(vec3 local, vec3 n) {
+// The two tangents of an orthonormal basis about the unit vector n (Duff et al. 2017, branchless);
+// (t, bt, n) is right-handed.
+void frame_about(vec3 n, out vec3 t, out vec3 bt) {
   float sign = n.z >= 0.0 ? 1.0 : -1.0;
   float a = -1.0 / (sign + n.z);
   float b = n.x * n.y * a;
-  vec3 t = vec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-  vec3 bt = vec3(b, sign + n.y * n.y * a, -n.y);
+  t = vec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  bt = vec3(b, sign + n.y * n.y * a, -n.y);
+}
+
+// A local direction (x, y, z) turned so that +z is the unit vector n.
+vec3 to_world(vec3 local, vec3 n) {
+  vec3 t, bt;
+  frame_about(n, t, bt);
   return local.x * t + local.y * bt + local.z * n;
+}
+
+// The world direction v in the frame about n: (t . v, bt . v, n . v).
+vec3 to_local(vec3 v, vec3 n) {
+  vec3 t, bt;
+  frame_about(n, t, bt);
+  return vec3(dot(v, t), dot(v, bt), dot(v, n));
 }
 
 #endif

@@ -19,16 +19,9 @@
 namespace vkray::test {
 namespace {
 
-// The image's mean radiance per channel.
-glm::dvec3 mean(const Image& image) {
-  glm::dvec3 sum(0.0);
-  for (const glm::vec3& p : image.pixels) sum += glm::dvec3(p);
-  return sum / double(image.pixels.size());
-}
-
 // Expects each channel of the image's mean within `relative` of `expected`.
 void expect_mean(const Image& image, glm::dvec3 expected, double relative, const char* what) {
-  const glm::dvec3 m = mean(image);
+  const glm::dvec3 m = image_mean(image);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], expected[c], relative * expected[c]) << what << ", channel " << c;
 }
 
@@ -147,7 +140,7 @@ TEST_F(LightTransportTest, TheDirectModelIsPathsOfTwoVertices) {
   const Scene direct = parse_scene(room + "}", "direct.json");
   const Scene paths = parse_scene(room + R"(, "integrator": {"type": "path", "max_depth": 2}})", "paths.json");
   for (const bool cpu : {false, true}) {
-    const glm::dvec3 a = mean(render(direct, {32, 32, 256}, {}, cpu)), b = mean(render(paths, {32, 32, 256}, {}, cpu));
+    const glm::dvec3 a = image_mean(render(direct, {32, 32, 256}, {}, cpu)), b = image_mean(render(paths, {32, 32, 256}, {}, cpu));
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.02 * b[c]) << (cpu ? "CPU" : "GPU") << " channel " << c;
   }
 }

@@ -102,14 +102,22 @@ TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
     m.type = t;
     m.emission = vec3(3.0f, 5.0f, 7.0f);
     m.ior = 1.33f + float(t);
+    m.eta = vec3(0.2f, 0.4f, 1.4f);
+    m.k = vec3(3.9f, 2.4f, 1.6f);
+    m.alpha_u = 0.05f;
+    m.alpha_v = 0.6f;
     const MaterialValueTexels texels = material_value_texels(m);
     const MaterialValues back = material_values(texels);
     EXPECT_EQ(back.color, m.color);
     EXPECT_EQ(back.type, m.type);
     EXPECT_EQ(back.emission, m.emission);
     EXPECT_EQ(back.ior, m.ior);
+    EXPECT_EQ(back.eta, m.eta);
+    EXPECT_EQ(back.k, m.k);
+    EXPECT_EQ(back.alpha_u, m.alpha_u);
+    EXPECT_EQ(back.alpha_v, m.alpha_v);
     EXPECT_EQ(material_properties_of(texels.color), material_properties(t));
-    static_assert(sizeof(MaterialValues) == 32, "a MaterialValues member is not checked here");
+    static_assert(sizeof(MaterialValues) == 64, "a MaterialValues member is not checked here");
   }
 }
 

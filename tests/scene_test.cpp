@@ -20,6 +20,14 @@ constexpr const char* kCamera = R"("camera": {"position": [0, 0, 0], "direction"
 std::string with_camera(const std::string& rest) { return std::string("{") + kCamera + (rest.empty() ? "" : ", ") + rest + "}"; }
 
 // Parsing `json` throws a SceneError whose message starts with "test.json" and contains `where`.
+// The scene's material of that name (the file's materials come in the JSON reader's order).
+Material material_named(const Scene& scene, const std::string& name) {
+  for (const Material& m : scene.materials)
+    if (m.name == name) return m;
+  ADD_FAILURE() << "no material " << name;
+  return Material{};
+}
+
 void expect_error(const std::string& json, const std::string& where, const std::string& what = "") {
   try {
     parse_scene(json, "test.json");
@@ -134,12 +142,7 @@ TEST(SceneTest, IntegratorMaterialsLensAndSeed) {
   EXPECT_FLOAT_EQ(scene.camera.aperture_radius, 0.1f);
   EXPECT_FLOAT_EQ(scene.camera.focus_distance, 4.0f);  // the distance to look_at
   ASSERT_EQ(scene.materials.size(), 4u);
-  const auto material = [&](const char* name) {
-    for (const Material& m : scene.materials)
-      if (m.name == name) return m;
-    ADD_FAILURE() << "no material " << name;
-    return Material{};
-  };
+  const auto material = [&](const char* name) { return material_named(scene, name); };
   EXPECT_EQ(material("d").type, MaterialType::diffuse);
   EXPECT_EQ(material("d").emission, glm::vec3(1, 2, 3));
   EXPECT_TRUE(material("d").emissive());
@@ -152,6 +155,36 @@ TEST(SceneTest, IntegratorMaterialsLensAndSeed) {
   EXPECT_TRUE(scene.spheres[0].inward);
   EXPECT_EQ(scene.triangles[0].v[1], glm::vec3(0, 1, 0));  // wound the other way
   EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+}
+
+TEST(SceneTest, RoughConductorsTakeMitsubasNamesAndDefaults) {
+  const Scene scene = parse_scene(with_camera(R"("materials": {
+      "plain": {"type": "roughconductor"},
+      "gold": {"type": "roughconductor", "alpha": 0.3, "eta": [0.14, 0.37, 1.44], "k": [3.98, 2.38, 1.6]},
+      "brushed": {"type": "roughconductor", "alpha_u": 0.05, "alpha_v": 0.5, "specular_reflectance": [0.9, 0.8, 0.7]}})"),
+                                  "t.json");
+  ASSERT_EQ(scene.materials.size(), 3u);
+  const Material plain = material_named(scene, "plain"), gold = material_named(scene, "gold"),
+                 brushed = material_named(scene, "brushed");
+  EXPECT_EQ(plain.type, MaterialType::roughconductor);
+  EXPECT_EQ(plain.alpha, glm::vec2(0.1f));                   // Mitsuba's default roughness
+  EXPECT_EQ(plain.albedo, glm::vec3(1.0f));                  // specular_reflectance
+  EXPECT_EQ(plain.eta, glm::vec3(0.0f));                     // material "none": the Fresnel term is 1
+  EXPECT_EQ(plain.k, glm::vec3(1.0f));
+  EXPECT_TRUE(plain.has(VKRAY_BSDF_GLOSSY));
+  EXPECT_FALSE(plain.has(VKRAY_BSDF_DELTA));
+  EXPECT_EQ(gold.alpha, glm::vec2(0.3f));
+  EXPECT_EQ(gold.eta, glm::vec3(0.14f, 0.37f, 1.44f));
+  EXPECT_EQ(gold.k, glm::vec3(3.98f, 2.38f, 1.6f));
+  EXPECT_EQ(brushed.alpha, glm::vec2(0.05f, 0.5f));
+  EXPECT_EQ(brushed.albedo, glm::vec3(0.9f, 0.8f, 0.7f));
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+  // The unknown type's message names every type there is.
+  expect_error(with_camera(R"("materials": {"m": {"type": "metal"}})"), "/materials/m/type",
+               "(expected \"diffuse\", \"mirror\", \"glass\" or \"roughconductor\")");
+  expect_error(with_camera(R"("materials": {"m": {"type": "roughconductor", "alpha": 1.5}})"), "/materials/m/alpha", "from 0.0001 to 1");
+  expect_error(with_camera(R"("materials": {"m": {"type": "roughconductor", "alpha_v": 0.2}})"), "/materials/m", "together");
+  expect_error(with_camera(R"("materials": {"m": {"type": "roughconductor", "k": [1, -1, 1]}})"), "/materials/m/k", "non-negative");
 }
 
 TEST(SceneTest, TheDirectModelIsTheDefault) {

@@ -8,6 +8,7 @@
 
 namespace vkray::cpu {
 
+using glm::dvec2;
 using glm::dvec3;
 
 Bsdf bsdf_of(const Material& material, const dvec3& color) {
@@ -16,6 +17,9 @@ Bsdf bsdf_of(const Material& material, const dvec3& color) {
   b.properties = material.properties();
   b.color = color;
   b.ior = material.ior;
+  b.alpha = dvec2(material.alpha);
+  b.eta = dvec3(material.eta);
+  b.k = dvec3(material.k);
   return b;
 }
 
@@ -34,12 +38,88 @@ double fresnel_dielectric(double cos_i, double eta, double& cos_t) {
   return (rs * rs + rp * rp) / 2;
 }
 
+dvec3 fresnel_conductor(double cos_i, const dvec3& eta, const dvec3& k) {
+  // The s and p reflectances for a complex index eta + i k (pbrt-v3's FrConductor, Mitsuba's
+  // fresnel_conductor), channel by channel.
+  const double cos2 = cos_i * cos_i, sin2 = 1 - cos2;
+  dvec3 r;
+  for (int c = 0; c < 3; ++c) {
+    const double eta2 = eta[c] * eta[c], k2 = k[c] * k[c];
+    const double t0 = eta2 - k2 - sin2;
+    const double a2_plus_b2 = std::sqrt(t0 * t0 + 4 * eta2 * k2);
+    const double t1 = a2_plus_b2 + cos2;
+    const double a = std::sqrt(std::max(0.0, (a2_plus_b2 + t0) / 2));
+    const double t2 = 2 * cos_i * a;
+    const double rs = (t1 - t2) / (t1 + t2);
+    const double t3 = cos2 * a2_plus_b2 + sin2 * sin2;
+    const double t4 = t2 * sin2;
+    const double rp = rs * (t3 - t4) / (t3 + t4);
+    r[c] = (rs + rp) / 2;
+  }
+  return r;
+}
+
+// ---- GGX microfacets (Trowbridge and Reitz 1975; Walter et al. 2007; Heitz 2014, 2018) -----------------
+
+double ggx_density(const dvec3& m, const dvec2& alpha) {
+  if (m.z <= 0) return 0;
+  // D(m) = 1 / (pi ax ay (mx^2 / ax^2 + my^2 / ay^2 + mz^2)^2) for a unit m.
+  const double e = (m.x / alpha.x) * (m.x / alpha.x) + (m.y / alpha.y) * (m.y / alpha.y) + m.z * m.z;
+  return 1 / (kPi * alpha.x * alpha.y * e * e);
+}
+
+double smith_masking(const dvec3& v, const dvec3& m, const dvec2& alpha) {
+  // A microfacet is seen only from its own side, and v only from above the surface.
+  if (glm::dot(v, m) * v.z <= 0) return 0;
+  const double xy = (alpha.x * v.x) * (alpha.x * v.x) + (alpha.y * v.y) * (alpha.y * v.y);
+  if (xy == 0) return 1;  // straight down: nothing masks
+  // G1 = 1 / (1 + Lambda), Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2.
+  return 2 / (1 + std::sqrt(1 + xy / (v.z * v.z)));
+}
+
+dvec3 sample_visible_normal(const dvec3& v, const dvec2& alpha, double u1, double u2) {
+  // Heitz 2018: stretch v to the hemisphere configuration, pick a point on the projected disk of the
+  // visible half, lift it to the hemisphere, unstretch.
+  const dvec3 vh = glm::normalize(dvec3(alpha.x * v.x, alpha.y * v.y, v.z));
+  const double len2 = vh.x * vh.x + vh.y * vh.y;
+  const dvec3 t1 = len2 > 0 ? dvec3(-vh.y, vh.x, 0) / std::sqrt(len2) : dvec3(1, 0, 0);
+  const dvec3 t2 = glm::cross(vh, t1);
+  const double r = std::sqrt(u1), phi = 2 * kPi * u2;
+  const double p1 = r * std::cos(phi);
+  const double s = (1 + vh.z) / 2;
+  const double p2 = (1 - s) * std::sqrt(1 - p1 * p1) + s * (r * std::sin(phi));
+  const dvec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1 - p1 * p1 - p2 * p2)) * vh;
+  return glm::normalize(dvec3(alpha.x * nh.x, alpha.y * nh.y, std::max(0.0, nh.z)));
+}
+
+namespace {
+
+// ---- roughconductor: F(wo . m) D(m) G1(wo) G1(wi) / (4 cos_o cos_i), as Mitsuba's with GGX ------------
+
+dvec3 conductor_eval(const Bsdf& b, const dvec3& wo, const dvec3& wi) {
+  if (wo.z <= 0 || wi.z <= 0) return dvec3(0.0);
+  const dvec3 m = glm::normalize(wo + wi);
+  const double dg = ggx_density(m, b.alpha) * smith_masking(wo, m, b.alpha) * smith_masking(wi, m, b.alpha);
+  return b.color * fresnel_conductor(glm::dot(wo, m), b.eta, b.k) * (dg / (4 * wo.z));  // times cos_i
+}
+
+double conductor_pdf(const Bsdf& b, const dvec3& wo, const dvec3& wi) {
+  if (wo.z <= 0 || wi.z <= 0) return 0;
+  const dvec3 m = glm::normalize(wo + wi);
+  // The visible normals' density G1(wo) (wo . m) D / cos_o, times the reflection's 1 / (4 wi . m).
+  return ggx_density(m, b.alpha) * smith_masking(wo, m, b.alpha) / (4 * wo.z);
+}
+
+}  // namespace
+
 // ---- The three functions, by material ---------------------------------------------------------------------
 
-dvec3 eval_bsdf(const Bsdf& b, const dvec3&, const dvec3& wi, const dvec3& n, bool) {
+dvec3 eval_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n, bool) {
   switch (b.type) {
     case MaterialType::diffuse:
       return b.color * (std::max(0.0, glm::dot(wi, n)) / kPi);
+    case MaterialType::roughconductor:
+      return conductor_eval(b, to_local(wo, n), to_local(wi, n));
     case MaterialType::mirror:
     case MaterialType::glass:
       return dvec3(0.0);  // delta lobes: no direction but one
@@ -47,10 +127,12 @@ dvec3 eval_bsdf(const Bsdf& b, const dvec3&, const dvec3& wi, const dvec3& n, bo
   return dvec3(0.0);
 }
 
-double pdf_bsdf(const Bsdf& b, const dvec3&, const dvec3& wi, const dvec3& n, bool) {
+double pdf_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n, bool) {
   switch (b.type) {
     case MaterialType::diffuse:
       return std::max(0.0, glm::dot(wi, n)) / kPi;
+    case MaterialType::roughconductor:
+      return conductor_pdf(b, to_local(wo, n), to_local(wi, n));
     case MaterialType::mirror:
     case MaterialType::glass:
       return 0;
@@ -89,6 +171,21 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
       b.transmitted = true;
       b.eta = eta;
       b.weight = dvec3(1 / (eta * eta));  // radiance is compressed into the narrower cone
+      return b;
+    }
+    case MaterialType::roughconductor: {
+      const double u1 = gpu::next_random(stream), u2 = gpu::next_random(stream);
+      const dvec3 o = to_local(wo, n);
+      b.dir = n;
+      b.weight = dvec3(0.0);
+      if (o.z <= 0) return b;  // seen from below its shading normal: no light
+      const dvec3 m = sample_visible_normal(o, bsdf.alpha, u1, u2);
+      const dvec3 i = 2 * glm::dot(o, m) * m - o;
+      if (i.z <= 0) return b;  // reflected below the surface
+      b.dir = glm::normalize(to_world(i, n));
+      b.pdf = conductor_pdf(bsdf, o, i);
+      // f cos / pdf = F G1(wi): D, G1(wo) and the cosines cancel.
+      b.weight = bsdf.color * fresnel_conductor(glm::dot(o, m), bsdf.eta, bsdf.k) * smith_masking(i, m, bsdf.alpha);
       return b;
     }
   }

@@ -3,7 +3,8 @@
 //
 // Every function takes wo, unit, back along the incoming ray; n, the unit shading normal turned to
 // the side the ray came from (so conductors and diffuse surfaces reflect on both sides); and front,
-// whether the ray met the side the geometric normal faces (a dielectric's outside).
+// whether the ray met the side the geometric normal faces (a dielectric's outside). Glossy lobes
+// are written in the frame to_world builds about n (cpu/warp.h), whose first tangent is alpha_u's.
 #pragma once
 
 #include <cstdint>
@@ -18,8 +19,10 @@ namespace vkray::cpu {
 struct Bsdf {
   MaterialType type = MaterialType::diffuse;
   uint32_t properties = 0;  // VKRAY_BSDF_* (shared/materials.h)
-  glm::dvec3 color{0.0};    // albedo or reflectance
+  glm::dvec3 color{0.0};    // albedo, reflectance or specular reflectance
   double ior = 1.5;
+  glm::dvec2 alpha{0.1};
+  glm::dvec3 eta{0.0}, k{1.0};
 
   bool has(uint32_t property) const { return (properties & property) != 0; }
 };
@@ -47,4 +50,14 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const glm::dvec3& wo, const glm::dvec3&
 // Fresnel reflectance of a smooth dielectric: cos_i > 0 on the incident side, eta = n_t / n_i. Sets
 // cos_t, the cosine on the other side (0 past the critical angle, where it returns 1).
 double fresnel_dielectric(double cos_i, double eta, double& cos_t);
+// Fresnel reflectance of a conductor of complex index eta + i k, unpolarized, for cos_i in [0, 1].
+glm::dvec3 fresnel_conductor(double cos_i, const glm::dvec3& eta, const glm::dvec3& k);
+
+// The GGX (Trowbridge-Reitz) microfacet distribution in the local frame (z: the normal).
+double ggx_density(const glm::dvec3& m, const glm::dvec2& alpha);
+// Smith's masking of direction v by microfacets of normal m.
+double smith_masking(const glm::dvec3& v, const glm::dvec3& m, const glm::dvec2& alpha);
+// A microfacet normal visible from v (v.z > 0), drawn with density G1(v, m) max(0, v.m) D(m) / v.z.
+glm::dvec3 sample_visible_normal(const glm::dvec3& v, const glm::dvec2& alpha, double u1, double u2);
+
 }  // namespace vkray::cpu

@@ -19,6 +19,10 @@ constexpr float kMaxFocalLength = 1e6f;
 // The largest index of refraction: past every real material (diamond is 2.4), so that a typo shows.
 constexpr float kMaxIor = 100.0f;
 
+// The smoothest GGX surface: its peak density 1 / (pi alpha^2), 3e7, and the pdfs made from it stay
+// far inside a float. Smoother than that is a mirror.
+constexpr float kMinAlpha = 1e-4f;
+
 }  // namespace
 
 void SceneParser::parse(const json& root_json) {
@@ -203,6 +207,17 @@ void SceneParser::parse_materials(const Value& v) {
         check_keys(m, {"type", "ior", "emission"});
         if (m.has("ior")) material.ior = index_of_refraction(m["ior"]);
         break;
+      case MaterialType::roughconductor:
+        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "specular_reflectance", "eta", "k", "emission"});
+        material.alpha = roughness(m);
+        material.albedo = m.has("specular_reflectance") ? reflectance(m["specular_reflectance"]) : glm::vec3(1.0f);
+        if (m.has("eta")) material.eta = bounded_color(m["eta"], kMaxIor, "indices of refraction up to 100");
+        if (m.has("k")) material.k = bounded_color(m["k"], kMaxIor, "absorption coefficients up to 100");
+        for (int c = 0; c < 3; ++c)
+          if (material.eta[c] == 0.0f && material.k[c] == 0.0f)
+            fail(m.has("k") ? m["k"] : m["eta"], "eta and k are both 0 in one channel, which is no conductor (without "
+                                                 "either, eta 0 and k 1 reflect everything)");
+        break;
     }
     if (m.has("emission")) material.emission = color(m["emission"]);
     material_index_[name] = static_cast<uint32_t>(scene_.materials.size());
@@ -228,6 +243,30 @@ float SceneParser::index_of_refraction(const Value& v) const {
   const float ior = positive(v);
   if (!(ior <= kMaxIor)) fail(v, "expected an index of refraction up to 100, got " + brief(v.j));
   return ior;
+}
+
+glm::vec3 SceneParser::bounded_color(const Value& v, float max, const char* expected) const {
+  const glm::vec3 c = color(v);
+  if (!(c.r <= max && c.g <= max && c.b <= max)) fail(v, std::string("expected ") + expected + ", got " + brief(v.j));
+  return c;
+}
+
+// "alpha", or "alpha_u" and "alpha_v" (Mitsuba's names), each from kMinAlpha to 1; 0.1 when none is given.
+glm::vec2 SceneParser::roughness(const Value& m) const {
+  const auto one = [&](const Value& a) {
+    const float alpha = number(a);
+    if (!(alpha >= kMinAlpha && alpha <= 1.0f))
+      fail(a, "expected a roughness (GGX alpha) from 0.0001 to 1, got " + brief(a.j) +
+                  " (for a perfectly smooth surface, use \"mirror\" or \"glass\")");
+    return alpha;
+  };
+  if (m.has("alpha")) {
+    if (m.has("alpha_u") || m.has("alpha_v")) fail(m, "give either \"alpha\" or \"alpha_u\" and \"alpha_v\", not both");
+    return glm::vec2(one(m["alpha"]));
+  }
+  if (m.has("alpha_u") != m.has("alpha_v")) fail(m, "give \"alpha_u\" and \"alpha_v\" together");
+  if (m.has("alpha_u")) return {one(m["alpha_u"]), one(m["alpha_v"])};
+  return glm::vec2(0.1f);
 }
 
 std::string SceneParser::material_type_list() {

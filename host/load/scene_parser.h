@@ -123,6 +123,8 @@ class SceneParser {
   void parse_materials(const Value& v);
   glm::vec3 reflectance(const Value& v);  // a colour in [0, 1] (above 1: refused for paths, a warning otherwise)
   float index_of_refraction(const Value& v) const;
+  glm::vec3 bounded_color(const Value& v, float max, const char* expected) const;  // each channel in [0, max]
+  glm::vec2 roughness(const Value& material) const;
   static std::string material_type_list();  // "\"diffuse\", \"mirror\", ... or \"...\""
   // Fails unless the JSON value is an integer from `min` to `max`.
   int64_t integer(const Value& v, int64_t min, int64_t max) const;

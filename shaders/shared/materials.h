@@ -28,11 +28,13 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_MATERIAL_DIFFUSE 0u
 #define VKRAY_MATERIAL_MIRROR 1u
 #define VKRAY_MATERIAL_GLASS 2u
+#define VKRAY_MATERIAL_ROUGHCONDUCTOR 3u
 #define VKRAY_MATERIAL_TYPES(X)                                                                    \
   X(VKRAY_MATERIAL_DIFFUSE, diffuse, VKRAY_BSDF_DIFFUSE)                                           \
   X(VKRAY_MATERIAL_MIRROR, mirror, VKRAY_BSDF_DELTA)                                               \
-  X(VKRAY_MATERIAL_GLASS, glass, VKRAY_BSDF_DELTA | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR)
-#define VKRAY_MATERIAL_TYPE_COUNT 3u
+  X(VKRAY_MATERIAL_GLASS, glass, VKRAY_BSDF_DELTA | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR) \
+  X(VKRAY_MATERIAL_ROUGHCONDUCTOR, roughconductor, VKRAY_BSDF_GLOSSY)
+#define VKRAY_MATERIAL_TYPE_COUNT 4u
 
 VKRAY_INLINE uint material_properties(uint type) {
 #define VKRAY_MATERIAL_PROPERTIES_OF(number, name, properties) \
@@ -44,40 +46,52 @@ VKRAY_INLINE uint material_properties(uint type) {
 
 // ---- The values: what a BSDF is evaluated from, before textures -----------------------------------------
 struct MaterialValues {
-  vec3 color;      // diffuse: albedo; mirror: reflectance
+  vec3 color;      // diffuse: albedo; mirror: reflectance; roughconductor: specular_reflectance
   uint type;       // VKRAY_MATERIAL_*
   vec3 emission;   // radiance emitted on the side the geometric normal faces (the shader's: scaled)
   float ior;       // glass: the index of refraction inside (outside: 1)
+  vec3 eta;        // roughconductor: the real part of its index of refraction (0 with k = 1: F = 1)
+  float alpha_u;   // roughconductor: GGX roughness along the shading frame's first tangent
+  vec3 k;          // roughconductor: the imaginary part (absorption)
+  float alpha_v;   // along the second tangent
 };
 
 // ---- Texels: VKRAY_TEXELS_PER_MATERIAL RGBA32F each ---------------------------------------------------
 //   VKRAY_MATERIAL_COLOR:             (colour, type | properties << 8 as uint bits)
 //   VKRAY_MATERIAL_EMISSION:          (emitted radiance, ior)
+//   VKRAY_MATERIAL_ETA:               (eta, alpha_u)          read only by GLOSSY materials
+//   VKRAY_MATERIAL_K:                 (k, alpha_v)            read only by GLOSSY materials
 //   VKRAY_MATERIAL_ALBEDO_TEXTURE:    the texture that multiplies the colour (texture_texel)
 //   VKRAY_MATERIAL_EMISSION_TEXTURE:  the texture that multiplies the emission
 //   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
 //                                     an emitter of this material, 0, 0, 0): scene/emitters.h
-#define VKRAY_TEXELS_PER_MATERIAL 5
+#define VKRAY_TEXELS_PER_MATERIAL 7
 #define VKRAY_MATERIAL_COLOR 0
 #define VKRAY_MATERIAL_EMISSION 1
-#define VKRAY_MATERIAL_ALBEDO_TEXTURE 2
-#define VKRAY_MATERIAL_EMISSION_TEXTURE 3
-#define VKRAY_MATERIAL_LIGHT 4
+#define VKRAY_MATERIAL_ETA 2
+#define VKRAY_MATERIAL_K 3
+#define VKRAY_MATERIAL_ALBEDO_TEXTURE 4
+#define VKRAY_MATERIAL_EMISSION_TEXTURE 5
+#define VKRAY_MATERIAL_LIGHT 6
 #define VKRAY_MATERIAL_PROPERTY_SHIFT 8u
 
 // The first texel of material `index`.
 VKRAY_INLINE int material_texel(uint index) { return int(index) * VKRAY_TEXELS_PER_MATERIAL; }
 
-// The value texels (COLOR, EMISSION) of a material; its properties come from the table, never from the caller.
+// The value texels (COLOR to K) of a material; its properties come from the table, never from the caller.
 struct MaterialValueTexels {
   vec4 color;
   vec4 emission;
+  vec4 eta;
+  vec4 k;
 };
 
 VKRAY_INLINE MaterialValueTexels material_value_texels(MaterialValues m) {
   MaterialValueTexels t;
   t.color = vec4(m.color, uintBitsToFloat(m.type | (material_properties(m.type) << VKRAY_MATERIAL_PROPERTY_SHIFT)));
   t.emission = vec4(m.emission, m.ior);
+  t.eta = vec4(m.eta, m.alpha_u);
+  t.k = vec4(m.k, m.alpha_v);
   return t;
 }
 
@@ -90,6 +104,10 @@ VKRAY_INLINE MaterialValues material_values(MaterialValueTexels t) {
   m.type = material_type_of(t.color);
   m.emission = vec3(t.emission.x, t.emission.y, t.emission.z);
   m.ior = t.emission.w;
+  m.eta = vec3(t.eta.x, t.eta.y, t.eta.z);
+  m.alpha_u = t.eta.w;
+  m.k = vec3(t.k.x, t.k.y, t.k.z);
+  m.alpha_v = t.k.w;
   return m;
 }
 

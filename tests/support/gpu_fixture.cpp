@@ -36,4 +36,10 @@ Image GpuTest::render(const Scene& scene, const ImageSettings& image, RenderOpti
   return session().render(session().upload(std::make_shared<const Scene>(scene)), options).image;
 }
 
+glm::dvec3 image_mean(const Image& image) {
+  glm::dvec3 sum(0.0);
+  for (const glm::vec3& p : image.pixels) sum += glm::dvec3(p);
+  return sum / double(image.pixels.size());
+}
+
 }  // namespace vkray::test

@@ -25,6 +25,9 @@ class GpuTest : public ::testing::Test {
   std::unique_ptr<Session> session_;
 };
 
+// The image's mean radiance per channel, in double.
+glm::dvec3 image_mean(const Image& image);
+
 // `options` with the image settings overridden by `image`.
 RenderOptions with_image(RenderOptions options, const ImageSettings& image);
 
