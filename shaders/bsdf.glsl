@@ -6,6 +6,9 @@
 //                   Fresnel reflection or refraction, picked with probability F (one number)
 //   roughconductor  GGX microfacets with Smith's masking, both sides, as Mitsuba's: the conductor's
 //                   Fresnel term times the specular reflectance; visible normals sampled (two numbers)
+//   roughdielectric GGX reflection and refraction (Walter et al. 2007), ior inside and 1 outside; a
+//                   visible normal, then reflection with probability F or refraction (three numbers);
+//                   an ior of 1 is no interface: light passes straight on
 // Every function takes wo, unit, back along the incoming ray; n, the shading normal turned to the
 // ray's side; front, whether the ray met the side the geometric normal faces. Glossy lobes live in
 // the frame frame_about(n) builds, whose first tangent is alpha's u. The CPU reference implements
@@ -109,12 +112,58 @@ float conductor_pdf(Surface s, vec3 wo, vec3 wi) {
   return ggx_density(m, s.alpha) * smith_masking(wo, m, s.alpha) / (4.0 * wo.z);
 }
 
+// ---- roughdielectric, in the local frame, wo above it; eta = n_t / n_i across the surface ----------------
+
+// The half vector of a refraction from wo into wi, turned to wo's side; 0 when wo and wi do not lie
+// on its two sides.
+vec3 refraction_half_vector(vec3 wo, vec3 wi, float eta) {
+  vec3 h = normalize(wo + eta * wi);
+  if (h.z < 0.0) h = -h;
+  if (dot(wo, h) <= 0.0 || dot(wi, h) >= 0.0) return vec3(0.0);
+  return h;
+}
+
+vec3 dielectric_eval(Surface s, vec3 wo, vec3 wi, float eta) {
+  if (wo.z <= 0.0 || wi.z == 0.0 || eta == 1.0) return vec3(0.0);
+  float cos_t;
+  if (wi.z > 0.0) {  // reflection: F D G / (4 cos_o cos_i), times cos_i
+    vec3 h = normalize(wo + wi);
+    float f = fresnel_dielectric(dot(wo, h), eta, cos_t);
+    return vec3(f * ggx_density(h, s.alpha) * smith_masking(wo, h, s.alpha) * smith_masking(wi, h, s.alpha) / (4.0 * wo.z));
+  }
+  // Transmission, in the radiance form: |wi.h| wo.h (1 - F) D G / (cos_o (wo.h + eta wi.h)^2).
+  vec3 h = refraction_half_vector(wo, wi, eta);
+  if (h == vec3(0.0)) return vec3(0.0);
+  float oh = dot(wo, h), ih = dot(wi, h), denominator = oh + eta * ih;
+  float f = fresnel_dielectric(oh, eta, cos_t);
+  return vec3((1.0 - f) * ggx_density(h, s.alpha) * smith_masking(wo, h, s.alpha) * smith_masking(wi, h, s.alpha) * oh * abs(ih) /
+              (wo.z * denominator * denominator));
+}
+
+float dielectric_pdf(Surface s, vec3 wo, vec3 wi, float eta) {
+  if (wo.z <= 0.0 || wi.z == 0.0 || eta == 1.0) return 0.0;
+  float cos_t;
+  if (wi.z > 0.0) {  // the visible normal, the choice of reflection (F), the Jacobian 1 / (4 wo.h)
+    vec3 h = normalize(wo + wi);
+    float f = fresnel_dielectric(dot(wo, h), eta, cos_t);
+    return ggx_density(h, s.alpha) * smith_masking(wo, h, s.alpha) * f / (4.0 * wo.z);
+  }
+  vec3 h = refraction_half_vector(wo, wi, eta);
+  if (h == vec3(0.0)) return 0.0;
+  float oh = dot(wo, h), ih = dot(wi, h), denominator = oh + eta * ih;
+  float f = fresnel_dielectric(oh, eta, cos_t);
+  // ... and of refraction (1 - F), with the Jacobian eta^2 |wi.h| / (wo.h + eta wi.h)^2.
+  return smith_masking(wo, h, s.alpha) * oh * ggx_density(h, s.alpha) / wo.z * (1.0 - f) * eta * eta * abs(ih) /
+         (denominator * denominator);
+}
+
 // ---- The three functions -----------------------------------------------------------------------------
 
 // f(wo, wi) |n . wi|; 0 for delta BSDFs and directions a lobe does not reach.
 vec3 eval_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return s.albedo * (max(0.0, dot(wi, n)) / PI);
   if (s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_eval(s, to_local(wo, n), to_local(wi, n));
+  if (s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_eval(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
   return vec3(0.0);
 }
 
@@ -122,6 +171,7 @@ vec3 eval_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
 float pdf_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return max(0.0, dot(wi, n)) / PI;
   if (s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_pdf(s, to_local(wo, n), to_local(wi, n));
+  if (s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_pdf(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
   return 0.0;
 }
 
@@ -156,6 +206,43 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     b.pdf = conductor_pdf(s, o, i);
     // f cos / pdf = F G1(wi): D, G1(wo) and the cosines cancel.
     b.weight = s.albedo * fresnel_conductor(dot(o, m), s.eta, s.k) * smith_masking(i, m, s.alpha);
+    return b;
+  }
+  if (s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) {
+    vec2 u = vec2(next_random(stream), next_random(stream));
+    float u_choice = next_random(stream);
+    float eta = front ? s.ior : 1.0 / s.ior;
+    if (eta == 1.0) {  // no interface: straight on, whole
+      b.delta = true;
+      b.transmitted = true;
+      b.dir = -wo;
+      b.weight = vec3(1.0);
+      return b;
+    }
+    vec3 o = to_local(wo, n);
+    b.dir = n;
+    b.weight = vec3(0.0);
+    if (o.z <= 0.0) return b;
+    vec3 m = sample_visible_normal(o, s.alpha, u);
+    float cos_i = dot(o, m);
+    float cos_t;
+    float f = fresnel_dielectric(cos_i, eta, cos_t);
+    if (u_choice < f) {  // reflection, with probability F: f cos / pdf = G1(wi)
+      vec3 i = 2.0 * cos_i * m - o;
+      if (i.z <= 0.0) return b;
+      b.dir = normalize(to_world(i, n));
+      b.pdf = dielectric_pdf(s, o, i, eta);
+      b.weight = vec3(smith_masking(i, m, s.alpha));
+      return b;
+    }
+    // Refraction about m, with probability 1 - F: f cos / pdf = G1(wi) / eta^2.
+    vec3 i = normalize((cos_i / eta - cos_t) * m - o / eta);
+    if (i.z >= 0.0) return b;
+    b.dir = normalize(to_world(i, n));
+    b.pdf = dielectric_pdf(s, o, i, eta);
+    b.transmitted = true;
+    b.eta = eta;
+    b.weight = vec3(smith_masking(i, m, s.alpha) / (eta * eta));
     return b;
   }
   float cos_i = dot(wo, n);

@@ -72,20 +72,21 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   vec3 wo = -p.ray.dir;
   if (!SCENE_HAS_NON_DIFFUSE || (s.properties & VKRAY_BSDF_DELTA) == 0u) {
     // ---- Next-event estimation: f cos times the light over its density, weighed against BSDF sampling --
+    LitPoint lit = lit_point(x, n, n_geometric, s);
     vec3 from_points = vec3(0.0);
-    add_point_lights(x, n, origin, s, wo, front, from_points, rays);
+    add_point_lights(lit, s, wo, front, from_points, rays);
     p.radiance += p.throughput * from_points;
     if (SCENE_HAS_EMITTERS) {
-      AreaLightSample light = sample_area_light_from(x, n, origin, stream, rays);
+      AreaLightSample light = sample_area_light_from(lit, stream, rays);
       if (light.pdf > 0.0)
         p.radiance += p.throughput * eval_bsdf(s, wo, light.dir, n, front) * light.radiance *
                       (power_heuristic(light.pdf, pdf_bsdf(s, wo, light.dir, n, front)) / light.pdf);
     }
     if (background_sampled) {
       vec3 w = uniform_sphere(vec2(next_random(stream), next_random(stream)));
-      if (dot(n, w) > 0.0) {
+      if (faces(lit, dot(n, w))) {
         rays += 1u;
-        if (!trace_any(Ray(origin, w), frame.epsilon, FAR))
+        if (!trace_any(Ray(origin_toward(lit, w), w), frame.epsilon, FAR))
           p.radiance += p.throughput * eval_bsdf(s, wo, w, n, front) * frame.background.rgb *
                         (power_heuristic(BACKGROUND_PDF, pdf_bsdf(s, wo, w, n, front)) / BACKGROUND_PDF);
       }

@@ -17,24 +17,44 @@
 #include "traversal.glsl"
 #include "warp.glsl"
 
-// One area-light sample as a point x sees it (n faces the incoming ray; shadow rays leave from
-// shadow_origin). Draws three numbers from the stream.
+// A point lit by the lights: x, its shading normal n turned toward the incoming ray, and where its
+// shadow rays leave: epsilon off the surface on the ray's side, or, for a BSDF that transmits (lit
+// from behind too), on the side of the light.
+struct LitPoint {
+  vec3 x;
+  vec3 n;
+  vec3 origin_front;  // x + epsilon n_geometric
+  vec3 origin_back;   // x - epsilon n_geometric
+  bool both_sides;
+};
+
+LitPoint lit_point(vec3 x, vec3 n, vec3 n_geometric, Surface s) {
+  bool transmits = SCENE_HAS_NON_DIFFUSE && (s.properties & VKRAY_BSDF_TRANSMISSION) != 0u;
+  return LitPoint(x, n, x + frame.epsilon * n_geometric, x - frame.epsilon * n_geometric, transmits);
+}
+
+// Whether light from a direction of cosine cos_w to n can reach the BSDF: above n, or either side.
+bool faces(LitPoint p, float cos_w) { return cos_w > 0.0 || (p.both_sides && cos_w < 0.0); }
+vec3 origin_toward(LitPoint p, vec3 w) { return p.both_sides && dot(p.n, w) < 0.0 ? p.origin_back : p.origin_front; }
+
+// One area-light sample as a point p sees it. Draws three numbers from the stream.
 struct AreaLightSample {
   vec3 radiance;  // 0 when the point is behind x's side, faces away, or is hidden
   vec3 dir;       // unit, from x to the point
-  float cos_x;    // at x, to the point
+  float cos_x;    // at x, to the point (negative: behind, for a BSDF that transmits)
   float pdf;      // per unit solid angle at x
 };
 
-AreaLightSample sample_area_light_from(vec3 x, vec3 n, vec3 shadow_origin, inout uint stream, inout uint rays) {
+AreaLightSample sample_area_light_from(LitPoint p, inout uint stream, inout uint rays) {
   LightPoint light = sample_area_light(stream);
-  vec3 to_light = light.position - x;
+  vec3 to_light = light.position - p.x;
   float r2 = dot(to_light, to_light);
   vec3 w = to_light * inversesqrt(r2);
   float cos_l = -dot(light.normal, w);
-  AreaLightSample s = AreaLightSample(vec3(0.0), w, dot(n, w), 0.0);
-  if (!(s.cos_x > 0.0 && cos_l > 0.0)) return s;
+  AreaLightSample s = AreaLightSample(vec3(0.0), w, dot(p.n, w), 0.0);
+  if (!(faces(p, s.cos_x) && cos_l > 0.0)) return s;
   if (SHADOW_RAYS) {
+    vec3 shadow_origin = origin_toward(p, w);
     vec3 shadow_dir = light.position - shadow_origin;
     float shadow_dist = length(shadow_dir);
     rays += 1u;
@@ -46,9 +66,9 @@ AreaLightSample sample_area_light_from(vec3 x, vec3 n, vec3 shadow_origin, inout
   return s;
 }
 
-// Adds V f(wo, w) (n . w) I / r^2 for every point light to `radiance`: the surface s at x, seen along
-// wo, n its normal facing the incoming ray; adds the shadow rays it casts to `rays`.
-void add_point_lights(vec3 x, vec3 n, vec3 shadow_origin, Surface s, vec3 wo, bool front, inout vec3 radiance, inout uint rays) {
+// Adds V f(wo, w) |n . w| I / r^2 for every point light to `radiance`: the surface s at p, seen along
+// wo; adds the shadow rays it casts to `rays`.
+void add_point_lights(LitPoint p, Surface s, vec3 wo, bool front, inout vec3 radiance, inout uint rays) {
   // A do-while without `continue`, as the sample loop in trace.comp: a loop that tests first costs
   // a masked pass more, and so does one with a `continue` (the compiler moves the test to the top
   // of the next pass, for every lane).
@@ -56,12 +76,15 @@ void add_point_lights(vec3 x, vec3 n, vec3 shadow_origin, Surface s, vec3 wo, bo
   if (frame.light_count > 0u) do {
     int base = int(i) * VKRAY_TEXELS_PER_LIGHT;
     vec3 light_pos = texelFetch(lights, base + VKRAY_LIGHT_POSITION).xyz;
-    vec3 to_light = light_pos - x;
+    vec3 to_light = light_pos - p.x;
     float r2 = dot(to_light, to_light);
     // Lit only by a light more than epsilon above the plane of n at x (the contract's height rule:
-    // a light on the surface, or at x itself, lights nothing there, whatever the rounding of x).
-    bool lit = dot(n, to_light) > frame.epsilon;
+    // a light on the surface, or at x itself, lights nothing there, whatever the rounding of x), or
+    // below it for a BSDF that transmits.
+    float height = dot(p.n, to_light);
+    bool lit = height > frame.epsilon || (p.both_sides && height < -frame.epsilon);
     if (SHADOW_RAYS && lit) {
+      vec3 shadow_origin = origin_toward(p, to_light);
       vec3 shadow_dir = light_pos - shadow_origin;
       float shadow_dist = length(shadow_dir);
       rays += 1u;
@@ -69,7 +92,7 @@ void add_point_lights(vec3 x, vec3 n, vec3 shadow_origin, Surface s, vec3 wo, bo
       lit = !trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon);
     }
     if (lit)
-      radiance += eval_bsdf(s, wo, to_light * inversesqrt(r2), n, front) * (texelFetch(lights, base + VKRAY_LIGHT_INTENSITY).rgb / r2);
+      radiance += eval_bsdf(s, wo, to_light * inversesqrt(r2), p.n, front) * (texelFetch(lights, base + VKRAY_LIGHT_INTENSITY).rgb / r2);
   } while (++i < frame.light_count);
 }
 
@@ -82,12 +105,12 @@ vec3 shade(Ray ray, vec3 x, Surface surface, inout uint stream, inout uint rays)
   vec3 n = front ? surface.shading_normal : -surface.shading_normal;
   vec3 wo = -ray.dir;
 
-  // Shadow rays start a little off the surface, on the side the ray came from.
-  vec3 shadow_origin = x + frame.epsilon * n_geometric;
+  // Shadow rays start a little off the surface, on the side the ray came from (or the light's).
+  LitPoint p = lit_point(x, n, n_geometric, surface);
   vec3 radiance = surface.albedo * frame.ambient.rgb;
-  add_point_lights(x, n, shadow_origin, surface, wo, front, radiance, rays);
+  add_point_lights(p, surface, wo, front, radiance, rays);
   if (SCENE_HAS_EMITTERS) {  // one light sample: f cos Le / pdf
-    AreaLightSample light = sample_area_light_from(x, n, shadow_origin, stream, rays);
+    AreaLightSample light = sample_area_light_from(p, stream, rays);
     if (light.pdf > 0.0) radiance += eval_bsdf(surface, wo, light.dir, n, front) * (light.radiance / light.pdf);
   }
   return radiance;

@@ -56,6 +56,7 @@ TEST(BsdfTest, ChiSquareTailMatchesKnownValues) {
 struct Case {
   std::string name;
   Material material;
+  bool front = true;  // seen from the side the geometric normal faces (a dielectric's outside)
 };
 
 Material material_of(MaterialType type, glm::vec3 color) {
@@ -73,6 +74,13 @@ Material conductor(glm::vec2 alpha, glm::vec3 eta = glm::vec3(0.0f), glm::vec3 k
   return m;
 }
 
+Material dielectric(glm::vec2 alpha, float ior) {
+  Material m = material_of(MaterialType::roughdielectric, glm::vec3(1.0f));
+  m.alpha = alpha;
+  m.ior = ior;
+  return m;
+}
+
 // Gold: Mitsuba 3's Au preset as its RGB variants reduce it (read back with mi.traverse).
 const glm::vec3 kGoldEta(0.143036f, 0.375307f, 1.44205f), kGoldK(3.983f, 2.38556f, 1.60336f);
 
@@ -82,7 +90,11 @@ std::vector<Case> glossy_cases() {
           {"conductor_alpha_0.2", conductor(glm::vec2(0.2f))},
           {"conductor_alpha_0.5_gold", conductor(glm::vec2(0.5f), kGoldEta, kGoldK)},
           {"conductor_alpha_1", conductor(glm::vec2(1.0f))},
-          {"conductor_anisotropic", conductor(glm::vec2(0.1f, 0.6f), kGoldEta, kGoldK, glm::vec3(0.9f, 0.8f, 0.7f))}};
+          {"conductor_anisotropic", conductor(glm::vec2(0.1f, 0.6f), kGoldEta, kGoldK, glm::vec3(0.9f, 0.8f, 0.7f))},
+          {"dielectric_alpha_0.1_outside", dielectric(glm::vec2(0.1f), 1.5f)},
+          {"dielectric_alpha_0.5_outside", dielectric(glm::vec2(0.5f), 1.5f)},
+          {"dielectric_alpha_0.3_inside", dielectric(glm::vec2(0.3f), 1.5f), false},
+          {"dielectric_anisotropic_inside", dielectric(glm::vec2(0.6f, 0.15f), 1.33f), false}};
 }
 
 // A normal that is not an axis, so that the frame about it is exercised, and directions around it.
@@ -95,14 +107,15 @@ dvec3 direction_at(double cos_theta, double phi, const dvec3& n) {
 
 // ---- sample against pdf ------------------------------------------------------------------------------
 
-// Bins over the whole sphere about n, equal in cos(theta) and phi: equal solid angles.
-constexpr int kThetaBins = 24, kPhiBins = 48, kSubdivisions = 12;
+// Bins over the whole sphere about n, equal in theta and phi (so a lobe near the normal still spans
+// several), the pdf integrated over each on a grid kSubdivisions times finer.
+constexpr int kThetaBins = 24, kPhiBins = 48, kSubdivisions = 16;
 constexpr int kSamples = 200000;
 
 int bin_of(const dvec3& local) {
-  const double cos_theta = std::clamp(local.z, -1.0, 1.0);
+  const double theta = std::acos(std::clamp(local.z, -1.0, 1.0));
   const double phi = std::atan2(local.y, local.x) + (local.y < 0 ? 2 * kPi : 0);
-  const int t = std::min(kThetaBins - 1, int((1 - cos_theta) / 2 * kThetaBins));
+  const int t = std::min(kThetaBins - 1, int(theta / kPi * kThetaBins));
   const int p = std::min(kPhiBins - 1, int(phi / (2 * kPi) * kPhiBins));
   return t * kPhiBins + p;
 }
@@ -126,12 +139,13 @@ ChiSquare chi_square(const Bsdf& bsdf, const dvec3& wo, bool front) {
     observed[failed ? size_t(bins) : size_t(bin_of(to_local(b.dir, kNormal)))] += 1;
   }
   double total = 0;
-  const double d_cos = 2.0 / (kThetaBins * kSubdivisions), d_phi = 2 * kPi / (kPhiBins * kSubdivisions);
+  const double d_theta = kPi / (kThetaBins * kSubdivisions), d_phi = 2 * kPi / (kPhiBins * kSubdivisions);
   for (int t = 0; t < kThetaBins * kSubdivisions; ++t) {
-    const double cos_theta = 1 - (t + 0.5) * d_cos;
+    const double theta = (t + 0.5) * d_theta;
+    const double solid_angle = std::sin(theta) * d_theta * d_phi;
     for (int p = 0; p < kPhiBins * kSubdivisions; ++p) {
       const double phi = (p + 0.5) * d_phi;
-      const double mass = pdf_bsdf(bsdf, wo, direction_at(cos_theta, phi, kNormal), kNormal, front) * d_cos * d_phi;
+      const double mass = pdf_bsdf(bsdf, wo, direction_at(std::cos(theta), phi, kNormal), kNormal, front) * solid_angle;
       expected[size_t((t / kSubdivisions) * kPhiBins + p / kSubdivisions)] += mass * kSamples;
       total += mass;
     }
@@ -168,7 +182,7 @@ TEST(BsdfTest, SampledDirectionsFollowThePdf) {
   for (const Case& c : cases) {
     const Bsdf bsdf = bsdf_of(c.material, dvec3(c.material.albedo));
     for (const double cos_o : kViewCosines) {
-      const ChiSquare chi = chi_square(bsdf, direction_at(cos_o, 1.0, kNormal), true);
+      const ChiSquare chi = chi_square(bsdf, direction_at(cos_o, 1.0, kNormal), c.front);
       EXPECT_GT(chi.p_value, level) << c.name << " at cos_o " << cos_o << ": chi^2 " << chi.statistic << " over " << chi.dof
                                     << " degrees of freedom";
     }
@@ -182,29 +196,39 @@ TEST(BsdfTest, EachSampleCarriesEvalOverPdf) {
       const dvec3 wo = direction_at(cos_o, 2.0, kNormal);
       for (uint32_t i = 0; i < 2000; ++i) {
         uint32_t stream = gpu::pcg_hash(i + 5u);
-        const BsdfSample b = sample_bsdf(bsdf, wo, kNormal, true, stream);
+        const BsdfSample b = sample_bsdf(bsdf, wo, kNormal, c.front, stream);
         if (b.weight == dvec3(0.0)) continue;
-        const double pdf = pdf_bsdf(bsdf, wo, b.dir, kNormal, true);
+        const double pdf = pdf_bsdf(bsdf, wo, b.dir, kNormal, c.front);
         ASSERT_NEAR(b.pdf, pdf, 1e-6 * pdf) << c.name;
-        const dvec3 expected = eval_bsdf(bsdf, wo, b.dir, kNormal, true) / pdf;
+        const dvec3 expected = eval_bsdf(bsdf, wo, b.dir, kNormal, c.front) / pdf;
         for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(b.weight[ch], expected[ch], 1e-6 * std::max(1.0, expected[ch])) << c.name;
       }
     }
   }
 }
 
-// ---- Reciprocity: f(wo, wi) = f(wi, wo) --------------------------------------------------------------
+// ---- Reciprocity: f(wo, wi) = f(wi, wo), and f(wo, wi) / n_i^2 = f(wi, wo) / n_o^2 across a dielectric ---
 
 TEST(BsdfTest, EvalIsReciprocal) {
   for (const Case& c : glossy_cases()) {
     const Bsdf bsdf = bsdf_of(c.material, dvec3(c.material.albedo));
+    const bool transmits = bsdf.has(VKRAY_BSDF_TRANSMISSION);
+    if (transmits && c.material.alpha.x != c.material.alpha.y) continue;  // the frame about -n is another frame
     uint32_t stream = 99;
     for (int i = 0; i < 1000; ++i) {
       const dvec3 a = direction_at(gpu::next_random(stream), 2 * kPi * gpu::next_random(stream), kNormal);
-      const dvec3 b = direction_at(gpu::next_random(stream), 2 * kPi * gpu::next_random(stream), kNormal);
-      const dvec3 f_ab = eval_bsdf(bsdf, a, b, kNormal, true) / glm::dot(b, kNormal);
-      const dvec3 f_ba = eval_bsdf(bsdf, b, a, kNormal, true) / glm::dot(a, kNormal);
-      for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(f_ab[ch], f_ba[ch], 1e-9 * std::max(1.0, f_ab[ch])) << c.name;
+      // b below the surface too where light passes through it.
+      const double cos_b = transmits ? 2 * gpu::next_random(stream) - 1 : gpu::next_random(stream);
+      const dvec3 b = direction_at(cos_b, 2 * kPi * gpu::next_random(stream), kNormal);
+      const dvec3 f_ab = eval_bsdf(bsdf, a, b, kNormal, c.front) / std::abs(cos_b);
+      dvec3 f_ba;
+      if (cos_b > 0) {
+        f_ba = eval_bsdf(bsdf, b, a, kNormal, c.front) / glm::dot(a, kNormal);
+      } else {  // seen from the other side, whose index is the other
+        const double eta = c.front ? bsdf.ior : 1 / bsdf.ior;  // n_b / n_a
+        f_ba = eval_bsdf(bsdf, b, a, -kNormal, !c.front) / glm::dot(a, kNormal) / (eta * eta);
+      }
+      for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(f_ab[ch], f_ba[ch], 1e-9 * std::max(1.0, f_ab[ch])) << c.name << " cos_b " << cos_b;
     }
   }
 }
@@ -212,22 +236,25 @@ TEST(BsdfTest, EvalIsReciprocal) {
 // ---- Energy -------------------------------------------------------------------------------------------
 
 // The directional albedo, the integral of f cos over wi, two ways: the mean sample weight, and eval
-// over directions uniform on the sphere; with the standard error of each.
+// over directions uniform on the sphere; with the standard error of each. What passes through a
+// dielectric counts by its power, its radiance times eta^2, the square of the relative index it crossed.
 struct Albedo {
   dvec3 sampled{0.0}, sampled_error{0.0};
   dvec3 uniform{0.0}, uniform_error{0.0};
 };
 
-Albedo directional_albedo(const Bsdf& bsdf, const dvec3& wo, int samples) {
+Albedo directional_albedo(const Bsdf& bsdf, const dvec3& wo, int samples, bool front = true) {
+  const double eta = front ? bsdf.ior : 1 / bsdf.ior;
   Albedo a;
   dvec3 sum(0.0), sum2(0.0), usum(0.0), usum2(0.0);
   for (uint32_t i = 0; i < uint32_t(samples); ++i) {
     uint32_t stream = gpu::pcg_hash(i * 3u + 1u);
-    const BsdfSample b = sample_bsdf(bsdf, wo, kNormal, true, stream);
-    sum += b.weight;
-    sum2 += b.weight * b.weight;
+    const BsdfSample b = sample_bsdf(bsdf, wo, kNormal, front, stream);
+    const dvec3 power = b.weight * (b.transmitted ? b.eta * b.eta : 1.0);
+    sum += power;
+    sum2 += power * power;
     const dvec3 w = uniform_sphere(gpu::next_random(stream), gpu::next_random(stream));
-    const dvec3 u = eval_bsdf(bsdf, wo, w, kNormal, true) * (4 * kPi);
+    const dvec3 u = eval_bsdf(bsdf, wo, w, kNormal, front) * (4 * kPi) * (glm::dot(w, kNormal) < 0 ? eta * eta : 1.0);
     usum += u;
     usum2 += u * u;
   }
@@ -243,7 +270,7 @@ TEST(BsdfTest, ReflectsAtMostWhatArrivesAndAllOfItWhereNothingIsLost) {
   for (const Case& c : glossy_cases()) {
     const Bsdf bsdf = bsdf_of(c.material, dvec3(c.material.albedo));
     for (const double cos_o : kViewCosines) {
-      const Albedo a = directional_albedo(bsdf, direction_at(cos_o, 0.5, kNormal), 200000);
+      const Albedo a = directional_albedo(bsdf, direction_at(cos_o, 0.5, kNormal), 200000, c.front);
       for (int ch = 0; ch < 3; ++ch) {
         EXPECT_LE(a.sampled[ch], 1 + 4 * a.sampled_error[ch]) << c.name << " cos_o " << cos_o;
         // The two estimates of one integral agree (importance sampling hides no lobe eval has).
@@ -263,6 +290,21 @@ TEST(BsdfTest, ReflectsAtMostWhatArrivesAndAllOfItWhereNothingIsLost) {
   const Albedo rough = directional_albedo(bsdf_of(conductor(glm::vec2(1.0f)), dvec3(1.0)), direction_at(0.2, 0.0, kNormal), 200000);
   EXPECT_LT(rough.sampled.x, 0.9);
   EXPECT_GT(rough.sampled.x, 0.3);
+  // A smooth dielectric keeps the power, reflected and passed on, from either side; one of index 1
+  // is no surface: all of the light goes straight on.
+  for (const bool front : {true, false}) {
+    const Albedo clear = directional_albedo(bsdf_of(dielectric(glm::vec2(0.01f), 1.5f), dvec3(1.0)), direction_at(0.9, 0.0, kNormal),
+                                            20000, front);
+    EXPECT_NEAR(clear.sampled.x, 1.0, 2e-3) << (front ? "outside" : "inside");
+  }
+  const Bsdf matched = bsdf_of(dielectric(glm::vec2(0.5f), 1.0f), dvec3(1.0));
+  const dvec3 wo = direction_at(0.3, 0.0, kNormal);
+  uint32_t stream = 7;
+  const BsdfSample through = sample_bsdf(matched, wo, kNormal, true, stream);
+  EXPECT_TRUE(through.delta && through.transmitted);
+  EXPECT_EQ(through.dir, -wo);
+  EXPECT_EQ(through.weight, dvec3(1.0));
+  EXPECT_EQ(stream, gpu::pcg_hash(0) * 0 + [] { uint32_t s = 7; for (int i = 0; i < 3; ++i) gpu::next_random(s); return s; }());
 }
 
 // ---- The delta BSDFs -----------------------------------------------------------------------------------

@@ -181,10 +181,30 @@ TEST(SceneTest, RoughConductorsTakeMitsubasNamesAndDefaults) {
   EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
   // The unknown type's message names every type there is.
   expect_error(with_camera(R"("materials": {"m": {"type": "metal"}})"), "/materials/m/type",
-               "(expected \"diffuse\", \"mirror\", \"glass\" or \"roughconductor\")");
+               "(expected \"diffuse\", \"mirror\", \"glass\", \"roughconductor\" or \"roughdielectric\")");
   expect_error(with_camera(R"("materials": {"m": {"type": "roughconductor", "alpha": 1.5}})"), "/materials/m/alpha", "from 0.0001 to 1");
   expect_error(with_camera(R"("materials": {"m": {"type": "roughconductor", "alpha_v": 0.2}})"), "/materials/m", "together");
   expect_error(with_camera(R"("materials": {"m": {"type": "roughconductor", "k": [1, -1, 1]}})"), "/materials/m/k", "non-negative");
+}
+
+TEST(SceneTest, RoughDielectricsTakeMitsubasNames) {
+  const Scene scene = parse_scene(with_camera(R"("materials": {
+      "plain": {"type": "roughdielectric"},
+      "water": {"type": "roughdielectric", "alpha": 0.3, "int_ior": 1.33},
+      "brushed": {"type": "roughdielectric", "alpha_u": 0.05, "alpha_v": 0.5}})"),
+                                  "t.json");
+  const Material plain = material_named(scene, "plain"), water = material_named(scene, "water"),
+                 brushed = material_named(scene, "brushed");
+  EXPECT_EQ(plain.type, MaterialType::roughdielectric);
+  EXPECT_EQ(plain.alpha, glm::vec2(0.1f));
+  EXPECT_EQ(plain.ior, 1.5f);  // vkray's glass default (Mitsuba's is bk7's 1.5046)
+  EXPECT_EQ(plain.albedo, glm::vec3(1.0f));
+  EXPECT_TRUE(plain.has(VKRAY_BSDF_TRANSMISSION) && plain.has(VKRAY_BSDF_GLOSSY) && plain.has(VKRAY_BSDF_CLEAR));
+  EXPECT_EQ(water.alpha, glm::vec2(0.3f));
+  EXPECT_EQ(water.ior, 1.33f);
+  EXPECT_EQ(brushed.alpha, glm::vec2(0.05f, 0.5f));
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+  expect_error(with_camera(R"("materials": {"m": {"type": "roughdielectric", "int_ior": 101}})"), "/materials/m/int_ior", "up to 100");
 }
 
 TEST(SceneTest, TheDirectModelIsTheDefault) {

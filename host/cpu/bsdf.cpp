@@ -110,16 +110,66 @@ double conductor_pdf(const Bsdf& b, const dvec3& wo, const dvec3& wi) {
   return ggx_density(m, b.alpha) * smith_masking(wo, m, b.alpha) / (4 * wo.z);
 }
 
+// ---- roughdielectric: Walter et al. 2007, reflection and transmission through GGX microfacets ----------
+// wo above the local frame (its side of the surface), eta = n_t / n_i across it. An index of 1 is no
+// interface at all: light passes straight on, a delta (eval and pdf 0; sample says so).
+
+// The half vector of a refraction from wo into wi, turned to wo's side; (0, 0, 0) when wo and wi do
+// not lie on the two sides of it.
+dvec3 refraction_half_vector(const dvec3& wo, const dvec3& wi, double eta) {
+  dvec3 h = glm::normalize(wo + eta * wi);
+  if (h.z < 0) h = -h;
+  if (glm::dot(wo, h) <= 0 || glm::dot(wi, h) >= 0) return dvec3(0.0);
+  return h;
+}
+
+dvec3 dielectric_eval(const Bsdf& b, const dvec3& wo, const dvec3& wi, double eta) {
+  if (wo.z <= 0 || wi.z == 0 || eta == 1) return dvec3(0.0);
+  double cos_t;
+  if (wi.z > 0) {  // reflection: F D G / (4 cos_o cos_i), times cos_i
+    const dvec3 h = glm::normalize(wo + wi);
+    const double f = fresnel_dielectric(glm::dot(wo, h), eta, cos_t);
+    return dvec3(f * ggx_density(h, b.alpha) * smith_masking(wo, h, b.alpha) * smith_masking(wi, h, b.alpha) / (4 * wo.z));
+  }
+  // Transmission: |wi.h| |wo.h| (1 - F) D G / (|cos_i| cos_o (wo.h + eta wi.h)^2), times |cos_i|: the
+  // radiance form, which carries the 1 / eta^2 by which refraction compresses radiance.
+  const dvec3 h = refraction_half_vector(wo, wi, eta);
+  if (h == dvec3(0.0)) return dvec3(0.0);
+  const double oh = glm::dot(wo, h), ih = glm::dot(wi, h), denominator = oh + eta * ih;
+  const double f = fresnel_dielectric(oh, eta, cos_t);
+  return dvec3((1 - f) * ggx_density(h, b.alpha) * smith_masking(wo, h, b.alpha) * smith_masking(wi, h, b.alpha) * oh *
+               std::abs(ih) / (wo.z * denominator * denominator));
+}
+
+double dielectric_pdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, double eta) {
+  if (wo.z <= 0 || wi.z == 0 || eta == 1) return 0;
+  double cos_t;
+  if (wi.z > 0) {  // the visible normal's density, the choice of reflection (F), the Jacobian 1 / (4 wo.h)
+    const dvec3 h = glm::normalize(wo + wi);
+    const double f = fresnel_dielectric(glm::dot(wo, h), eta, cos_t);
+    return ggx_density(h, b.alpha) * smith_masking(wo, h, b.alpha) * f / (4 * wo.z);
+  }
+  const dvec3 h = refraction_half_vector(wo, wi, eta);
+  if (h == dvec3(0.0)) return 0;
+  const double oh = glm::dot(wo, h), ih = glm::dot(wi, h), denominator = oh + eta * ih;
+  const double f = fresnel_dielectric(oh, eta, cos_t);
+  // ... and of refraction (1 - F), with the Jacobian eta^2 |wi.h| / (wo.h + eta wi.h)^2.
+  return smith_masking(wo, h, b.alpha) * oh * ggx_density(h, b.alpha) / wo.z * (1 - f) * eta * eta * std::abs(ih) /
+         (denominator * denominator);
+}
+
 }  // namespace
 
 // ---- The three functions, by material ---------------------------------------------------------------------
 
-dvec3 eval_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n, bool) {
+dvec3 eval_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n, bool front) {
   switch (b.type) {
     case MaterialType::diffuse:
       return b.color * (std::max(0.0, glm::dot(wi, n)) / kPi);
     case MaterialType::roughconductor:
       return conductor_eval(b, to_local(wo, n), to_local(wi, n));
+    case MaterialType::roughdielectric:
+      return dielectric_eval(b, to_local(wo, n), to_local(wi, n), front ? b.ior : 1 / b.ior);
     case MaterialType::mirror:
     case MaterialType::glass:
       return dvec3(0.0);  // delta lobes: no direction but one
@@ -127,12 +177,14 @@ dvec3 eval_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n,
   return dvec3(0.0);
 }
 
-double pdf_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n, bool) {
+double pdf_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n, bool front) {
   switch (b.type) {
     case MaterialType::diffuse:
       return std::max(0.0, glm::dot(wi, n)) / kPi;
     case MaterialType::roughconductor:
       return conductor_pdf(b, to_local(wo, n), to_local(wi, n));
+    case MaterialType::roughdielectric:
+      return dielectric_pdf(b, to_local(wo, n), to_local(wi, n), front ? b.ior : 1 / b.ior);
     case MaterialType::mirror:
     case MaterialType::glass:
       return 0;
@@ -186,6 +238,40 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
       b.pdf = conductor_pdf(bsdf, o, i);
       // f cos / pdf = F G1(wi): D, G1(wo) and the cosines cancel.
       b.weight = bsdf.color * fresnel_conductor(glm::dot(o, m), bsdf.eta, bsdf.k) * smith_masking(i, m, bsdf.alpha);
+      return b;
+    }
+    case MaterialType::roughdielectric: {
+      const double u1 = gpu::next_random(stream), u2 = gpu::next_random(stream), u3 = gpu::next_random(stream);
+      const double eta = front ? bsdf.ior : 1 / bsdf.ior;
+      if (eta == 1) {  // no interface: straight on, whole
+        b.delta = b.transmitted = true;
+        b.dir = -wo;
+        return b;
+      }
+      const dvec3 o = to_local(wo, n);
+      b.dir = n;
+      b.weight = dvec3(0.0);
+      if (o.z <= 0) return b;
+      const dvec3 m = sample_visible_normal(o, bsdf.alpha, u1, u2);
+      const double cos_i = glm::dot(o, m);
+      double cos_t;
+      const double f = fresnel_dielectric(cos_i, eta, cos_t);
+      if (u3 < f) {  // reflection, with probability F: f cos / pdf = G1(wi)
+        const dvec3 i = 2 * cos_i * m - o;
+        if (i.z <= 0) return b;
+        b.dir = glm::normalize(to_world(i, n));
+        b.pdf = dielectric_pdf(bsdf, o, i, eta);
+        b.weight = dvec3(smith_masking(i, m, bsdf.alpha));
+        return b;
+      }
+      // Refraction about m, with probability 1 - F: f cos / pdf = G1(wi) / eta^2.
+      const dvec3 i = glm::normalize((cos_i / eta - cos_t) * m - o / eta);
+      if (i.z >= 0) return b;
+      b.dir = glm::normalize(to_world(i, n));
+      b.pdf = dielectric_pdf(bsdf, o, i, eta);
+      b.transmitted = true;
+      b.eta = eta;
+      b.weight = dvec3(smith_masking(i, m, bsdf.alpha) / (eta * eta));
       return b;
     }
   }

@@ -19,10 +19,11 @@ dvec3 shade(const Tracer& tracer, const Lights& lights, const SurfacePoint& s, c
   const Scene& scene = tracer.scene();
   const dvec3 x = s.position;
   dvec3 radiance = bsdf.color * dvec3(scene.ambient);
-  const dvec3 shadow_origin = x + tracer.epsilon() * n_geometric;
-  lights.add_point_lights(x, n, shadow_origin, bsdf, wo, front, radiance, first ? &state.signature : nullptr, state.rays);
+  const LitPoint p{x, n, x + tracer.epsilon() * n_geometric, x - tracer.epsilon() * n_geometric,
+                   bsdf.has(VKRAY_BSDF_TRANSMISSION)};
+  lights.add_point_lights(p, bsdf, wo, front, radiance, first ? &state.signature : nullptr, state.rays);
   if (lights.has_area_lights()) {
-    const AreaLightSample light = lights.sample_area_light_from(x, n, shadow_origin, state.stream, state.rays);
+    const AreaLightSample light = lights.sample_area_light_from(p, state.stream, state.rays);
     if (light.pdf > 0) radiance += eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance / light.pdf;
   }
   return radiance;

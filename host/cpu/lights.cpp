@@ -14,40 +14,42 @@ Lights::Lights(const Tracer& tracer, bool shadows)
   if (!table_.entries.empty()) inv_weight_ = 1 / table_.total_weight;
 }
 
-void Lights::add_point_lights(const dvec3& x, const dvec3& n, const dvec3& shadow_origin, const Bsdf& bsdf, const dvec3& wo,
-                              bool front, dvec3& radiance, uint64_t* signature, uint64_t& rays) const {
+void Lights::add_point_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& wo, bool front, dvec3& radiance, uint64_t* signature,
+                              uint64_t& rays) const {
   const Scene& scene = tracer_.scene();
   for (size_t l = 0; l < scene.lights.size(); ++l) {
     const dvec3 light(scene.lights[l].position);
-    const dvec3 to_light = light - x;
+    const dvec3 to_light = light - p.x;
     const double r2 = glm::dot(to_light, to_light);
-    // The light must stand more than epsilon above the plane of the normal: one on the surface
-    // (or at x) lights nothing there.
-    if (!(glm::dot(n, to_light) > epsilon_)) continue;
+    // The light must stand more than epsilon above the plane of the normal (or below it, for a BSDF
+    // that transmits): one on the surface (or at x) lights nothing there.
+    const double height = glm::dot(p.n, to_light);
+    if (!(height > epsilon_ || (p.both_sides && height < -epsilon_))) continue;
     if (shadows_) {
       ++rays;
-      const dvec3 shadow = light - shadow_origin;
+      const dvec3& origin = p.origin_toward(to_light);
+      const dvec3 shadow = light - origin;
       const double distance = glm::length(shadow);
-      if (tracer_.occluded({shadow_origin, shadow / distance}, epsilon_, distance - epsilon_)) continue;
+      if (tracer_.occluded({origin, shadow / distance}, epsilon_, distance - epsilon_)) continue;
     }
     if (signature) mix(*signature, 0x8000000000000000ull | l);
-    radiance += eval_bsdf(bsdf, wo, to_light / std::sqrt(r2), n, front) * dvec3(scene.lights[l].intensity) / r2;
+    radiance += eval_bsdf(bsdf, wo, to_light / std::sqrt(r2), p.n, front) * dvec3(scene.lights[l].intensity) / r2;
   }
 }
 
-AreaLightSample Lights::sample_area_light_from(const dvec3& x, const dvec3& n, const dvec3& origin, uint32_t& stream,
-                                               uint64_t& rays) const {
+AreaLightSample Lights::sample_area_light_from(const LitPoint& p, uint32_t& stream, uint64_t& rays) const {
   const LightPoint light = sample_area_light(stream);
-  const dvec3 to_light = light.position - x;
+  const dvec3 to_light = light.position - p.x;
   const double r2 = glm::dot(to_light, to_light);
   const dvec3 w = to_light / std::sqrt(r2);
   AreaLightSample s;
   s.dir = w;
-  s.cos_x = glm::dot(n, w);
+  s.cos_x = glm::dot(p.n, w);
   const double cos_l = -glm::dot(light.normal, w);
-  if (!(s.cos_x > 0 && cos_l > 0)) return s;
+  if (!(p.faces(s.cos_x) && cos_l > 0)) return s;
   if (shadows_) {
     ++rays;
+    const dvec3& origin = p.origin_toward(w);
     const dvec3 d = light.position - origin;
     const double distance = glm::length(d);
     // Stopped epsilon short of the light: the surface the point lies on is not in the way.

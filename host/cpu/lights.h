@@ -23,11 +23,26 @@ struct LightPoint {
   double pdf_area;    // density per unit area
 };
 
+// A point lit by the lights: x, its shading normal n turned toward the incoming ray, and where its
+// shadow rays leave: epsilon off the surface on the ray's side, or, for a BSDF that transmits (lit
+// from behind too), on the side of the light.
+struct LitPoint {
+  dvec3 x;
+  dvec3 n;
+  dvec3 origin_front;      // x + epsilon n_geometric
+  dvec3 origin_back;       // x - epsilon n_geometric
+  bool both_sides = false;
+
+  // Whether light from direction w (unit or not) can reach the BSDF at all: above n, or either side.
+  bool faces(double cos_w) const { return cos_w > 0 || (both_sides && cos_w < 0); }
+  const dvec3& origin_toward(const dvec3& w) const { return both_sides && glm::dot(n, w) < 0 ? origin_back : origin_front; }
+};
+
 // One area-light sample as a point x sees it.
 struct AreaLightSample {
   dvec3 radiance{0.0};  // 0 when the point is behind x's side, faces away, or is hidden
   dvec3 dir{0.0};       // unit, from x to the point
-  double cos_x = 0;     // at x, to the point
+  double cos_x = 0;     // at x, to the point (negative: behind, for a BSDF that transmits)
   double pdf = 0;       // per unit solid angle at x
 };
 
@@ -36,21 +51,18 @@ class Lights {
   // shadows false: every light counts as visible (benchmarks).
   Lights(const Tracer& tracer, bool shadows);
 
-  // Adds V f(wo, w) (n . w) I / r^2 of every point light to `radiance`, n facing the incoming ray
-  // (for a diffuse surface, albedo V I (n . w) / (pi r^2), the scene contract's term); counts shadow
+  // Adds V f(wo, w) |n . w| I / r^2 of every point light to `radiance` (for a diffuse surface, albedo V I (n . w) / (pi r^2), the scene contract's term); counts shadow
   // rays in `rays`; mixes each light that lights x into `signature` when given.
-  void add_point_lights(const dvec3& x, const dvec3& n, const dvec3& shadow_origin, const Bsdf& bsdf, const dvec3& wo, bool front,
-                        dvec3& radiance, uint64_t* signature, uint64_t& rays) const;
+  void add_point_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& wo, bool front, dvec3& radiance, uint64_t* signature,
+                        uint64_t& rays) const;
 
   bool has_area_lights() const { return !table_.entries.empty(); }
   // Draws three numbers: the light, then the point on it.
   LightPoint sample_area_light(uint32_t& stream) const;
   // The density per unit area with which sample_area_light finds a point emitting `emission`.
   double area_pdf(const glm::vec3& emission) const;
-  // A point on the area lights (three numbers) as x sees it: n faces the incoming ray, and shadow
-  // rays leave from `origin`.
-  AreaLightSample sample_area_light_from(const dvec3& x, const dvec3& n, const dvec3& origin, uint32_t& stream,
-                                         uint64_t& rays) const;
+  // A point on the area lights (three numbers) as p sees it.
+  AreaLightSample sample_area_light_from(const LitPoint& p, uint32_t& stream, uint64_t& rays) const;
 
  private:
   const Tracer& tracer_;

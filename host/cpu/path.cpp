@@ -57,11 +57,12 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     const dvec3 wo = -ray.dir;
     if (!bsdf.has(VKRAY_BSDF_DELTA)) {
       // Next-event estimation: each term f cos times the light over its density, weighed against BSDF sampling.
+      const LitPoint p{x, n, origin, x - epsilon * n_geometric, bsdf.has(VKRAY_BSDF_TRANSMISSION)};
       dvec3 from_points(0.0);
-      lights.add_point_lights(x, n, origin, bsdf, wo, front, from_points, depth == 1 ? &state.signature : nullptr, state.rays);
+      lights.add_point_lights(p, bsdf, wo, front, from_points, depth == 1 ? &state.signature : nullptr, state.rays);
       radiance += throughput * from_points;
       if (lights.has_area_lights()) {
-        const AreaLightSample light = lights.sample_area_light_from(x, n, origin, state.stream, state.rays);
+        const AreaLightSample light = lights.sample_area_light_from(p, state.stream, state.rays);
         if (light.pdf > 0)
           radiance += throughput * eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance *
                       (power_heuristic(light.pdf, pdf_bsdf(bsdf, wo, light.dir, n, front)) / light.pdf);
@@ -69,9 +70,9 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
       if (background_sampled) {
         const double u1 = gpu::next_random(state.stream), u2 = gpu::next_random(state.stream);
         const dvec3 w = uniform_sphere(u1, u2);
-        if (glm::dot(n, w) > 0) {
+        if (p.faces(glm::dot(n, w))) {
           ++state.rays;
-          if (!tracer.occluded({origin, w}, epsilon, kFar))
+          if (!tracer.occluded({p.origin_toward(w), w}, epsilon, kFar))
             radiance += throughput * eval_bsdf(bsdf, wo, w, n, front) * background *
                         (power_heuristic(kBackgroundPdf, pdf_bsdf(bsdf, wo, w, n, front)) / kBackgroundPdf);
         }

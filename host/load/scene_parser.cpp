@@ -218,6 +218,12 @@ void SceneParser::parse_materials(const Value& v) {
             fail(m.has("k") ? m["k"] : m["eta"], "eta and k are both 0 in one channel, which is no conductor (without "
                                                  "either, eta 0 and k 1 reflect everything)");
         break;
+      case MaterialType::roughdielectric:
+        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "int_ior", "emission"});
+        material.alpha = roughness(m);
+        material.albedo = glm::vec3(1.0f);  // clear: Mitsuba's specular reflectance and transmittance, 1
+        if (m.has("int_ior")) material.ior = index_of_refraction(m["int_ior"]);
+        break;
     }
     if (m.has("emission")) material.emission = color(m["emission"]);
     material_index_[name] = static_cast<uint32_t>(scene_.materials.size());

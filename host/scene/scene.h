@@ -77,12 +77,14 @@ std::optional<MaterialType> material_type_named(std::string_view name);
 struct Material {
   std::string name;
   MaterialType type = MaterialType::diffuse;
-  // diffuse: the albedo; mirror: the reflectance; roughconductor: the specular reflectance; glass: unused
+  // diffuse: the albedo; mirror: the reflectance; roughconductor: the specular reflectance;
+  // roughdielectric: 1; glass: unused
   glm::vec3 albedo{0.0f};
-  float ior = 1.5f;          // glass: the index of refraction inside (outside: 1, vacuum)
+  float ior = 1.5f;          // glass, roughdielectric: the index of refraction inside (outside: 1, vacuum)
   glm::vec3 emission{0.0f};  // radiance emitted on the side the geometric normal faces
-  // roughconductor: GGX roughness along the two tangents of the shading frame (Mitsuba's alpha_u,
-  // alpha_v), and the complex index of refraction eta + i k; eta 0 with k 1 makes the Fresnel term 1.
+  // The rough materials' GGX roughness along the two tangents of the shading frame (Mitsuba's
+  // alpha_u, alpha_v); roughconductor's complex index of refraction eta + i k (eta 0 with k 1 makes
+  // the Fresnel term 1).
   glm::vec2 alpha{0.1f};
   glm::vec3 eta{0.0f};
   glm::vec3 k{1.0f};

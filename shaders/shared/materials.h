@@ -29,12 +29,14 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_MATERIAL_MIRROR 1u
 #define VKRAY_MATERIAL_GLASS 2u
 #define VKRAY_MATERIAL_ROUGHCONDUCTOR 3u
+#define VKRAY_MATERIAL_ROUGHDIELECTRIC 4u
 #define VKRAY_MATERIAL_TYPES(X)                                                                    \
   X(VKRAY_MATERIAL_DIFFUSE, diffuse, VKRAY_BSDF_DIFFUSE)                                           \
   X(VKRAY_MATERIAL_MIRROR, mirror, VKRAY_BSDF_DELTA)                                               \
   X(VKRAY_MATERIAL_GLASS, glass, VKRAY_BSDF_DELTA | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR) \
-  X(VKRAY_MATERIAL_ROUGHCONDUCTOR, roughconductor, VKRAY_BSDF_GLOSSY)
-#define VKRAY_MATERIAL_TYPE_COUNT 4u
+  X(VKRAY_MATERIAL_ROUGHCONDUCTOR, roughconductor, VKRAY_BSDF_GLOSSY)                             \
+  X(VKRAY_MATERIAL_ROUGHDIELECTRIC, roughdielectric, VKRAY_BSDF_GLOSSY | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR)
+#define VKRAY_MATERIAL_TYPE_COUNT 5u
 
 VKRAY_INLINE uint material_properties(uint type) {
 #define VKRAY_MATERIAL_PROPERTIES_OF(number, name, properties) \
@@ -46,12 +48,12 @@ VKRAY_INLINE uint material_properties(uint type) {
 
 // ---- The values: what a BSDF is evaluated from, before textures -----------------------------------------
 struct MaterialValues {
-  vec3 color;      // diffuse: albedo; mirror: reflectance; roughconductor: specular_reflectance
+  vec3 color;      // diffuse: albedo; mirror: reflectance; roughconductor: specular_reflectance; dielectrics: 1
   uint type;       // VKRAY_MATERIAL_*
   vec3 emission;   // radiance emitted on the side the geometric normal faces (the shader's: scaled)
-  float ior;       // glass: the index of refraction inside (outside: 1)
+  float ior;       // glass, roughdielectric: the index of refraction inside (outside: 1)
   vec3 eta;        // roughconductor: the real part of its index of refraction (0 with k = 1: F = 1)
-  float alpha_u;   // roughconductor: GGX roughness along the shading frame's first tangent
+  float alpha_u;   // rough materials: GGX roughness along the shading frame's first tangent
   vec3 k;          // roughconductor: the imaginary part (absorption)
   float alpha_v;   // along the second tangent
 };
