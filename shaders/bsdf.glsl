@@ -162,16 +162,16 @@ float dielectric_pdf(Surface s, vec3 wo, vec3 wi, float eta) {
 // f(wo, wi) |n . wi|; 0 for delta BSDFs and directions a lobe does not reach.
 vec3 eval_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return s.albedo * (max(0.0, dot(wi, n)) / PI);
-  if (s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_eval(s, to_local(wo, n), to_local(wi, n));
-  if (s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_eval(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
+  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_eval(s, to_local(wo, n), to_local(wi, n));
+  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_eval(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
   return vec3(0.0);
 }
 
 // The solid-angle density with which sample_bsdf picks wi; 0 for delta BSDFs.
 float pdf_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return max(0.0, dot(wi, n)) / PI;
-  if (s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_pdf(s, to_local(wo, n), to_local(wi, n));
-  if (s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_pdf(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
+  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_pdf(s, to_local(wo, n), to_local(wi, n));
+  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_pdf(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
   return 0.0;
 }
 
@@ -193,7 +193,7 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     b.weight = s.albedo;
     return b;
   }
-  if (s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) {
+  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) {
     vec2 u = vec2(next_random(stream), next_random(stream));
     vec3 o = to_local(wo, n);
     b.dir = n;
@@ -208,7 +208,7 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     b.weight = s.albedo * fresnel_conductor(dot(o, m), s.eta, s.k) * smith_masking(i, m, s.alpha);
     return b;
   }
-  if (s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) {
+  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) {
     vec2 u = vec2(next_random(stream), next_random(stream));
     float u_choice = next_random(stream);
     float eta = front ? s.ior : 1.0 / s.ior;
@@ -245,25 +245,30 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     b.weight = vec3(smith_masking(i, m, s.alpha) / (eta * eta));
     return b;
   }
-  float cos_i = dot(wo, n);
-  vec3 reflected = normalize(2.0 * cos_i * n - wo);
-  if (s.material_type == VKRAY_MATERIAL_MIRROR) {
-    b.dir = reflected;
-    b.weight = s.albedo;
+  if ((SCENE_HAS_mirror && s.material_type == VKRAY_MATERIAL_MIRROR) || (SCENE_HAS_glass && s.material_type == VKRAY_MATERIAL_GLASS)) {
+    float cos_i = dot(wo, n);
+    vec3 reflected = normalize(2.0 * cos_i * n - wo);
+    if (SCENE_HAS_mirror && s.material_type == VKRAY_MATERIAL_MIRROR) {
+      b.dir = reflected;
+      b.weight = s.albedo;
+      return b;
+    }
+    float eta = front ? s.ior : 1.0 / s.ior;
+    float cos_t;
+    float f = fresnel_dielectric(cos_i, eta, cos_t);
+    if (next_random(stream) < f) {
+      b.dir = reflected;
+      b.weight = vec3(1.0);
+      return b;
+    }
+    b.dir = normalize((cos_i / eta - cos_t) * n - wo / eta);
+    b.transmitted = true;
+    b.eta = eta;
+    b.weight = vec3(1.0 / (eta * eta));  // radiance is compressed into the narrower cone
     return b;
   }
-  float eta = front ? s.ior : 1.0 / s.ior;
-  float cos_t;
-  float f = fresnel_dielectric(cos_i, eta, cos_t);
-  if (next_random(stream) < f) {
-    b.dir = reflected;
-    b.weight = vec3(1.0);
-    return b;
-  }
-  b.dir = normalize((cos_i / eta - cos_t) * n - wo / eta);
-  b.transmitted = true;
-  b.eta = eta;
-  b.weight = vec3(1.0 / (eta * eta));  // radiance is compressed into the narrower cone
+  b.dir = n;  // a type the scene has no material of: never reached
+  b.weight = vec3(0.0);
   return b;
 }
 

@@ -30,5 +30,9 @@ void load_frame() { frame = frame_block; }
 #define VKRAY_DECLARE_SPEC_CONSTANT(id, name, member, value) layout(constant_id = id) const bool name = value;
 VKRAY_SPECIALIZATION_CONSTANTS(VKRAY_DECLARE_SPEC_CONSTANT)
 #undef VKRAY_DECLARE_SPEC_CONSTANT
+#define VKRAY_DECLARE_MATERIAL_CONSTANT(number, name, properties) \
+  layout(constant_id = VKRAY_SPEC_MATERIALS + int(number)) const bool SCENE_HAS_##name = true;
+VKRAY_MATERIAL_TYPES(VKRAY_DECLARE_MATERIAL_CONSTANT)
+#undef VKRAY_DECLARE_MATERIAL_CONSTANT
 
 #endif

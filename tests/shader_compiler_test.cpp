@@ -18,6 +18,7 @@
 #include "gpu/pipeline.h"
 #include "gpu/shader_cache.h"
 #include "gpu/shader_compiler.h"
+#include "scene/scene.h"
 #include "shared/types.h"
 #include "support/temp_dir.h"
 
@@ -101,8 +102,9 @@ TEST(ShaderCompilerTest, ReflectsTheBindingsTheShaderDeclares) {
 }
 
 TEST(ShaderCompilerTest, DeclaresTheSpecializationConstantsOfThePipelinesTable) {
-  // The shader's constant_id declarations against gpu::kSpecConstants, which sets them: the same ids,
-  // the same names, and defaults that are ShaderVariant's, read from the SPIR-V itself.
+  // The shader's constant_id declarations against gpu::kSpecConstants and the material types, which
+  // the pipeline sets: the same ids, the same names, and defaults that are ShaderVariant's, read from
+  // the SPIR-V itself.
   const std::filesystem::path dir = VKRAY_SHADER_DIR;
   const gpu::CompiledShader shader = gpu::compile_compute_shader(dir / "trace.comp", {dir});
   std::map<uint32_t, std::string> names;  // by result id
@@ -127,6 +129,10 @@ TEST(ShaderCompilerTest, DeclaresTheSpecializationConstantsOfThePipelinesTable) 
   const gpu::ShaderVariant defaults_on_host;
   for (const gpu::SpecConstant& row : gpu::kSpecConstants)
     table.emplace(row.id, std::pair(std::string(row.name), defaults_on_host.*row.member));
+  // One more a material type, from the materials' table: SCENE_HAS_<its name in scene files>.
+  for (uint32_t t = 0; t < VKRAY_MATERIAL_TYPE_COUNT; ++t)
+    table.emplace(VKRAY_SPEC_MATERIALS + t, std::pair("SCENE_HAS_" + std::string(material_type_name(MaterialType(t))),
+                                                      ((defaults_on_host.materials >> t) & 1u) != 0));
   EXPECT_EQ(declared, table);
 }
 

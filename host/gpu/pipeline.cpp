@@ -1,5 +1,6 @@
 #include "gpu/pipeline.h"
 
+#include <algorithm>
 #include <array>
 #include <span>
 
@@ -7,6 +8,7 @@
 
 #include "base/errors.h"
 #include "gpu/shader_cache.h"
+#include "shared/materials.h"
 #include "shared/types.h"
 
 namespace vkray::gpu {
@@ -40,6 +42,9 @@ constexpr bool distinct_ids(std::span<const SpecConstant> table) {
   return true;
 }
 static_assert(distinct_ids(kSpecConstants), "a specialization constant id appears twice in VKRAY_SPECIALIZATION_CONSTANTS");
+static_assert(std::all_of(std::begin(kSpecConstants), std::end(kSpecConstants), [](const SpecConstant& c) { return c.id < VKRAY_SPEC_MATERIALS; }),
+              "a specialization constant takes an id of the material types'");
+static_assert(VKRAY_MATERIAL_TYPE_COUNT <= 32, "ShaderVariant::materials holds a bit per material type");
 
 // Whether a SPIR-V module declares `capability` (its OpCapability instructions come first).
 bool declares(const std::vector<uint32_t>& spirv, spv::Capability capability) {
@@ -115,11 +120,15 @@ std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVari
     inline_module = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, shader.spirv));
   }
   const vk::ShaderModule module = variant.inline_scene.empty() ? *module_ : *inline_module;
-  std::array<VkBool32, std::size(kSpecConstants)> values{};
-  std::array<vk::SpecializationMapEntry, std::size(kSpecConstants)> entries{};
-  for (size_t i = 0; i < std::size(kSpecConstants); ++i) {
-    values[i] = variant.*kSpecConstants[i].member;
-    entries[i] = vk::SpecializationMapEntry(kSpecConstants[i].id, uint32_t(i * sizeof(VkBool32)), sizeof(VkBool32));
+  constexpr size_t kCount = std::size(kSpecConstants) + VKRAY_MATERIAL_TYPE_COUNT;
+  std::array<VkBool32, kCount> values{};
+  std::array<vk::SpecializationMapEntry, kCount> entries{};
+  for (size_t i = 0; i < kCount; ++i) {
+    const bool material = i >= std::size(kSpecConstants);
+    const uint32_t type = uint32_t(i - std::size(kSpecConstants));
+    values[i] = material ? (variant.materials >> type) & 1u : variant.*kSpecConstants[i].member;
+    const uint32_t id = material ? VKRAY_SPEC_MATERIALS + type : kSpecConstants[i].id;
+    entries[i] = vk::SpecializationMapEntry(id, uint32_t(i * sizeof(VkBool32)), sizeof(VkBool32));
   }
   const vk::SpecializationInfo specialization(entries, vk::ArrayProxyNoTemporaries<const VkBool32>(values));
   const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, module, "main", &specialization);

@@ -31,6 +31,8 @@ struct ShaderVariant {
   VKRAY_SPECIALIZATION_CONSTANTS(VKRAY_SHADER_VARIANT_MEMBER)
 #undef VKRAY_SHADER_VARIANT_MEMBER
   std::string inline_scene;  // served as shaders/inline_scene.glsl; empty: that file, and the BVH is walked
+  // The material types the scene has, bit VKRAY_MATERIAL_* each (VKRAY_SPEC_MATERIALS in shared/types.h).
+  uint32_t materials = ~0u;
 
   auto operator<=>(const ShaderVariant&) const = default;
 };

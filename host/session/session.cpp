@@ -163,6 +163,8 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   variant.path = s.integrator.type == Integrator::Type::path;
   variant.emitters = scene.lighting().emitter_count > 0;
   variant.non_diffuse = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.properties() != VKRAY_BSDF_DIFFUSE; });
+  variant.materials = 0;
+  for (const Material& m : s.materials) variant.materials |= 1u << uint32_t(m.type);
   variant.aovs = options.aovs;
   variant.textures = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.textured(); });
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))

@@ -46,6 +46,10 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_AOVS 5
 // false when no material has a texture: no texture coordinates and no texture code.
 #define VKRAY_SPEC_TEXTURES 6
+// And one per material type, id VKRAY_SPEC_MATERIALS + its number (shared/materials.h): whether the
+// scene has a material of that type (gpu::ShaderVariant::materials, a bit each); the BSDF code of
+// the others is left out. Declared as SCENE_HAS_<name> (SCENE_HAS_roughconductor).
+#define VKRAY_SPEC_MATERIALS 16
 #define VKRAY_SPECIALIZATION_CONSTANTS(X)                     \
   X(VKRAY_SPEC_SPHERES, SCENE_HAS_SPHERES, spheres, true)     \
   X(VKRAY_SPEC_SHADOWS, SHADOW_RAYS, shadows, true)           \
