@@ -9,6 +9,9 @@
 //   roughdielectric GGX reflection and refraction (Walter et al. 2007), ior inside and 1 outside; a
 //                   visible normal, then reflection with probability F or refraction (three numbers);
 //                   an ior of 1 is no interface: light passes straight on
+//   metallic_roughness  glTF 2.0's, as its specification's Appendix B writes it: a mix by `metallic` of
+//                   a conductor with Schlick's Fresnel from the base colour and a dielectric (ior) over
+//                   Lambert; GGX with alpha = roughness^2; a lobe, then a direction (three numbers)
 // Every function takes wo, unit, back along the incoming ray; n, the shading normal turned to the
 // ray's side; front, whether the ray met the side the geometric normal faces. Glossy lobes live in
 // the frame frame_about(n) builds, whose first tangent is alpha's u. The CPU reference implements
@@ -157,6 +160,40 @@ float dielectric_pdf(Surface s, vec3 wo, vec3 wi, float eta) {
          (denominator * denominator);
 }
 
+// ---- metallic_roughness, in the local frame, wo above it --------------------------------------------------
+
+float metallic_roughness_alpha(Surface s) { return max(s.roughness * s.roughness, VKRAY_MIN_GGX_ALPHA); }
+
+float dielectric_f0(Surface s) { return ((s.ior - 1.0) / (s.ior + 1.0)) * ((s.ior - 1.0) / (s.ior + 1.0)); }
+
+// The probability of sampling the specular lobe seen from wo: the metal's weight and the dielectric's
+// Schlick reflectance at wo, against the diffuse lobe's (1 - F) times the base colour's luminance.
+float specular_share(Surface s, vec3 wo) {
+  float f0 = dielectric_f0(s), f = f0 + (1.0 - f0) * pow(1.0 - min(1.0, wo.z), 5.0);
+  float specular = s.metallic + (1.0 - s.metallic) * f, diffuse = (1.0 - s.metallic) * (1.0 - f) * emission_luminance(s.albedo);
+  return specular + diffuse > 0.0 ? specular / (specular + diffuse) : 1.0;
+}
+
+vec3 metallic_roughness_eval(Surface s, vec3 wo, vec3 wi) {
+  if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
+  vec2 alpha = vec2(metallic_roughness_alpha(s));
+  vec3 h = normalize(wo + wi);
+  float schlick = pow(max(0.0, 1.0 - abs(dot(wo, h))), 5.0);  // (GLSL leaves pow of a negative undefined)
+  float specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) * smith_masking(wi, h, alpha) / (4.0 * wo.z * wi.z);
+  float f0 = dielectric_f0(s), fresnel = f0 + (1.0 - f0) * schlick;
+  vec3 dielectric = (1.0 - fresnel) * s.albedo / PI + vec3(fresnel * specular);
+  vec3 metal = specular * (s.albedo + (1.0 - s.albedo) * schlick);
+  return ((1.0 - s.metallic) * dielectric + s.metallic * metal) * wi.z;
+}
+
+float metallic_roughness_pdf(Surface s, vec3 wo, vec3 wi) {
+  if (wo.z <= 0.0 || wi.z <= 0.0) return 0.0;
+  vec2 alpha = vec2(metallic_roughness_alpha(s));
+  vec3 h = normalize(wo + wi);
+  float p = specular_share(s, wo);
+  return p * ggx_density(h, alpha) * smith_masking(wo, h, alpha) / (4.0 * wo.z) + (1.0 - p) * wi.z / PI;
+}
+
 // ---- The three functions -----------------------------------------------------------------------------
 
 // f(wo, wi) |n . wi|; 0 for delta BSDFs and directions a lobe does not reach.
@@ -164,6 +201,7 @@ vec3 eval_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return s.albedo * (max(0.0, dot(wi, n)) / PI);
   if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_eval(s, to_local(wo, n), to_local(wi, n));
   if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_eval(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
+  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_eval(s, to_local(wo, n), to_local(wi, n));
   return vec3(0.0);
 }
 
@@ -172,6 +210,7 @@ float pdf_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return max(0.0, dot(wi, n)) / PI;
   if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_pdf(s, to_local(wo, n), to_local(wi, n));
   if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_pdf(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
+  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_pdf(s, to_local(wo, n), to_local(wi, n));
   return 0.0;
 }
 
@@ -243,6 +282,28 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     b.transmitted = true;
     b.eta = eta;
     b.weight = vec3(smith_masking(i, m, s.alpha) / (eta * eta));
+    return b;
+  }
+  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) {
+    float u_lobe = next_random(stream);
+    vec2 u = vec2(next_random(stream), next_random(stream));
+    vec3 o = to_local(wo, n);
+    b.dir = n;
+    b.weight = vec3(0.0);
+    if (o.z <= 0.0) return b;
+    vec3 i;
+    if (u_lobe < specular_share(s, o)) {
+      vec3 m = sample_visible_normal(o, vec2(metallic_roughness_alpha(s)), u);
+      i = 2.0 * dot(o, m) * m - o;
+    } else {
+      i = cosine_hemisphere(u);
+    }
+    if (i.z <= 0.0) return b;
+    // Either lobe may have given the direction: the weight is the whole BSDF over the mixed density.
+    b.pdf = metallic_roughness_pdf(s, o, i);
+    if (!(b.pdf > 0.0)) return b;
+    b.dir = normalize(to_world(i, n));
+    b.weight = metallic_roughness_eval(s, o, i) / b.pdf;
     return b;
   }
   if ((SCENE_HAS_mirror && s.material_type == VKRAY_MATERIAL_MIRROR) || (SCENE_HAS_glass && s.material_type == VKRAY_MATERIAL_GLASS)) {

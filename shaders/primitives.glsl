@@ -26,6 +26,8 @@ struct Surface {
   vec3 eta;               // a conductor's complex index of refraction
   vec3 k;
   vec2 alpha;             // GGX roughness along the frame's two tangents
+  float metallic;         // metallic_roughness
+  float roughness;
   float light_pdf_area;   // the density per unit area with which light sampling picks this point (emitters.glsl)
 };
 
@@ -40,6 +42,7 @@ Surface hit_surface(Hit hit, vec3 position) {
   t.emission = vec4(0.0, 0.0, 0.0, 1.0);
   t.eta = vec4(0.0);
   t.k = vec4(0.0);
+  t.layers = vec4(0.0);
   uint properties = material_properties_of(t.color);
   float light_pdf_area = 0.0;
   if (SCENE_HAS_EMITTERS || SCENE_HAS_NON_DIFFUSE) {
@@ -49,6 +52,7 @@ Surface hit_surface(Hit hit, vec3 position) {
   if (SCENE_HAS_NON_DIFFUSE && (properties & VKRAY_BSDF_GLOSSY) != 0u) {
     t.eta = texelFetch(materials, material + VKRAY_MATERIAL_ETA);
     t.k = texelFetch(materials, material + VKRAY_MATERIAL_K);
+    t.layers = texelFetch(materials, material + VKRAY_MATERIAL_LAYERS);
   }
   MaterialValues m = material_values(t);
   Surface s;
@@ -60,6 +64,8 @@ Surface hit_surface(Hit hit, vec3 position) {
   s.eta = m.eta;
   s.k = m.k;
   s.alpha = vec2(m.alpha_u, m.alpha_v);
+  s.metallic = m.metallic;
+  s.roughness = m.roughness;
   s.light_pdf_area = light_pdf_area;
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     s.geometric_normal = (position - a.xyz) / sphere_radius(texelFetch(primitives, base + 1));

@@ -81,6 +81,14 @@ Material dielectric(glm::vec2 alpha, float ior) {
   return m;
 }
 
+Material metallic_roughness(glm::vec3 base, float metallic, float roughness, float ior = 1.5f) {
+  Material m = material_of(MaterialType::metallic_roughness, base);
+  m.metallic = metallic;
+  m.roughness = roughness;
+  m.ior = ior;
+  return m;
+}
+
 // Gold: Mitsuba 3's Au preset as its RGB variants reduce it (read back with mi.traverse).
 const glm::vec3 kGoldEta(0.143036f, 0.375307f, 1.44205f), kGoldK(3.983f, 2.38556f, 1.60336f);
 
@@ -94,7 +102,11 @@ std::vector<Case> glossy_cases() {
           {"dielectric_alpha_0.1_outside", dielectric(glm::vec2(0.1f), 1.5f)},
           {"dielectric_alpha_0.5_outside", dielectric(glm::vec2(0.5f), 1.5f)},
           {"dielectric_alpha_0.3_inside", dielectric(glm::vec2(0.3f), 1.5f), false},
-          {"dielectric_anisotropic_inside", dielectric(glm::vec2(0.6f, 0.15f), 1.33f), false}};
+          {"dielectric_anisotropic_inside", dielectric(glm::vec2(0.6f, 0.15f), 1.33f), false},
+          {"gltf_dielectric", metallic_roughness(glm::vec3(0.8f, 0.3f, 0.2f), 0.0f, 0.5f)},
+          {"gltf_metal", metallic_roughness(glm::vec3(0.95f, 0.75f, 0.3f), 1.0f, 0.3f)},
+          {"gltf_half_metal_ior_1.33", metallic_roughness(glm::vec3(0.2f, 0.6f, 0.9f), 0.5f, 0.8f, 1.33f)},
+          {"gltf_smooth_dielectric", metallic_roughness(glm::vec3(0.5f), 0.0f, 0.3f)}};
 }
 
 // A normal that is not an axis, so that the frame about it is exercised, and directions around it.

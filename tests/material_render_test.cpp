@@ -75,6 +75,24 @@ TEST_F(FurnaceTest, ReflectsTheSkyTimesItsDirectionalAlbedo) {
   }
 }
 
+TEST_F(FurnaceTest, AWhiteGltfMetalIsAWhiteRoughConductorOfAlphaRoughnessSquared) {
+  // glTF's metal with base colour 1 has Schlick's F = 1: under a constant sky it reflects the
+  // directional albedo of GGX with alpha = roughness^2, the same quadrature as above.
+  const double roughness = 0.5, alpha = roughness * roughness;
+  const std::string json = R"({
+    "camera": {"position": [0, 1, -1e-4], "look_at": [0, 0, 0], "up": [0, 0, 1], "vertical_fov": 0.5},
+    "integrator": {"type": "path"},
+    "background": [1, 1, 1],
+    "materials": {"metal": {"type": "metallic_roughness", "base_color": [1, 1, 1], "metallic": 1, "roughness": )" +
+                           std::to_string(roughness) + R"(}},
+    "objects": [{"type": "triangles", "material": "metal", "positions": [[-100, 0, -100], [100, 0, -100], [100, 0, 100], [-100, 0, 100]],
+                 "indices": [[0, 2, 1], [0, 3, 2]]}]})";
+  const Scene scene = parse_scene(json, "furnace.json");
+  const double expected = ggx_albedo(alpha, 1.0);
+  for (const bool cpu : {false, true})
+    EXPECT_NEAR(image_mean(render(scene, {16, 16, 256}, {}, cpu)).g, expected, 0.01 * expected) << (cpu ? "CPU" : "GPU");
+}
+
 TEST_F(FurnaceTest, TheQuadratureKeepsEverythingForASmoothSurface) {
   // The test's own integral: alpha -> 0 reflects everything at normal incidence.
   EXPECT_NEAR(ggx_albedo(0.02, 1.0), 1.0, 2e-3);
@@ -173,6 +191,43 @@ class ConductorWithItsTangentsSwapped : public BrokenConductor {
   ConductorWithItsTangentsSwapped() : BrokenConductor("vec2 slope = m.xy / alpha;", "vec2 slope = m.xy / alpha.yx;") {}
 };
 TEST_F(ConductorWithItsTangentsSwapped, IsCaught) { expect_caught("direct"); }
+
+// ---- ... in glTF's metallic-roughness material's (checks/metallic-roughness-*.json) ----------------------
+class BrokenMetallicRoughness : public BrokenMaterialShader {
+ protected:
+  BrokenMetallicRoughness(const std::string& good, const std::string& bad) : BrokenMaterialShader("metallic-roughness", "bsdf.glsl", good, bad) {}
+};
+
+class GltfRoughnessNotSquared : public BrokenMetallicRoughness {
+ protected:
+  // glTF's alpha is roughness squared; roughness itself makes every highlight wider.
+  GltfRoughnessNotSquared()
+      : BrokenMetallicRoughness("return max(s.roughness * s.roughness, VKRAY_MIN_GGX_ALPHA);", "return max(s.roughness, VKRAY_MIN_GGX_ALPHA);") {}
+};
+TEST_F(GltfRoughnessNotSquared, IsCaught) {
+  expect_caught("direct");
+  expect_caught("path");
+}
+
+class GltfMetalWithTheDielectricsFresnel : public BrokenMetallicRoughness {
+ protected:
+  // The metal's Schlick term from 0.04 instead of the base colour: gold turns grey.
+  GltfMetalWithTheDielectricsFresnel()
+      : BrokenMetallicRoughness("vec3 metal = specular * (s.albedo + (1.0 - s.albedo) * schlick);", "vec3 metal = vec3(specular * fresnel);") {}
+};
+TEST_F(GltfMetalWithTheDielectricsFresnel, IsCaught) {
+  expect_caught("direct");
+  expect_caught("path");
+}
+
+class GltfDiffuseWithoutFresnel : public BrokenMetallicRoughness {
+ protected:
+  // The dielectric's Lambert layer not weighed by 1 - F: light reflected twice.
+  GltfDiffuseWithoutFresnel()
+      : BrokenMetallicRoughness("vec3 dielectric = (1.0 - fresnel) * s.albedo / PI + vec3(fresnel * specular);",
+                                "vec3 dielectric = s.albedo / PI + vec3(fresnel * specular);") {}
+};
+TEST_F(GltfDiffuseWithoutFresnel, IsCaught) { expect_caught("direct"); }
 
 // ---- ... and in the rough dielectric's (checks/rough-dielectrics-*.json) --------------------------------
 class BrokenDielectric : public BrokenMaterialShader {

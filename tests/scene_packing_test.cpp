@@ -106,6 +106,8 @@ TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
     m.k = vec3(3.9f, 2.4f, 1.6f);
     m.alpha_u = 0.05f;
     m.alpha_v = 0.6f;
+    m.metallic = 0.25f;
+    m.roughness = 0.75f;
     const MaterialValueTexels texels = material_value_texels(m);
     const MaterialValues back = material_values(texels);
     EXPECT_EQ(back.color, m.color);
@@ -116,8 +118,10 @@ TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
     EXPECT_EQ(back.k, m.k);
     EXPECT_EQ(back.alpha_u, m.alpha_u);
     EXPECT_EQ(back.alpha_v, m.alpha_v);
+    EXPECT_EQ(back.metallic, m.metallic);
+    EXPECT_EQ(back.roughness, m.roughness);
     EXPECT_EQ(material_properties_of(texels.color), material_properties(t));
-    static_assert(sizeof(MaterialValues) == 64, "a MaterialValues member is not checked here");
+    static_assert(sizeof(MaterialValues) == 72, "a MaterialValues member is not checked here");
   }
 }
 

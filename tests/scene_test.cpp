@@ -181,7 +181,7 @@ TEST(SceneTest, RoughConductorsTakeMitsubasNamesAndDefaults) {
   EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
   // The unknown type's message names every type there is.
   expect_error(with_camera(R"("materials": {"m": {"type": "metal"}})"), "/materials/m/type",
-               "(expected \"diffuse\", \"mirror\", \"glass\", \"roughconductor\" or \"roughdielectric\")");
+               "(expected \"diffuse\", \"mirror\", \"glass\", \"roughconductor\", \"roughdielectric\" or \"metallic_roughness\")");
   expect_error(with_camera(R"("materials": {"m": {"type": "roughconductor", "alpha": 1.5}})"), "/materials/m/alpha", "from 0.0001 to 1");
   expect_error(with_camera(R"("materials": {"m": {"type": "roughconductor", "alpha_v": 0.2}})"), "/materials/m", "together");
   expect_error(with_camera(R"("materials": {"m": {"type": "roughconductor", "k": [1, -1, 1]}})"), "/materials/m/k", "non-negative");
@@ -205,6 +205,27 @@ TEST(SceneTest, RoughDielectricsTakeMitsubasNames) {
   EXPECT_EQ(brushed.alpha, glm::vec2(0.05f, 0.5f));
   EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
   expect_error(with_camera(R"("materials": {"m": {"type": "roughdielectric", "int_ior": 101}})"), "/materials/m/int_ior", "up to 100");
+}
+
+TEST(SceneTest, TheGltfMaterialTakesGltfsNamesAndDefaults) {
+  const Scene scene = parse_scene(with_camera(R"("materials": {
+      "plain": {"type": "metallic_roughness"},
+      "paint": {"type": "metallic_roughness", "base_color": [0.8, 0.1, 0.1], "metallic": 0, "roughness": 0.4, "ior": 1.45}})"),
+                                  "t.json");
+  const Material plain = material_named(scene, "plain"), paint = material_named(scene, "paint");
+  EXPECT_EQ(plain.type, MaterialType::metallic_roughness);
+  EXPECT_EQ(plain.albedo, glm::vec3(1.0f));  // glTF's defaults: a white, fully rough metal
+  EXPECT_EQ(plain.metallic, 1.0f);
+  EXPECT_EQ(plain.roughness, 1.0f);
+  EXPECT_EQ(plain.ior, 1.5f);
+  EXPECT_TRUE(plain.has(VKRAY_BSDF_DIFFUSE) && plain.has(VKRAY_BSDF_GLOSSY));
+  EXPECT_EQ(paint.albedo, glm::vec3(0.8f, 0.1f, 0.1f));
+  EXPECT_EQ(paint.metallic, 0.0f);
+  EXPECT_EQ(paint.roughness, 0.4f);
+  EXPECT_EQ(paint.ior, 1.45f);
+  expect_error(with_camera(R"("materials": {"m": {"type": "metallic_roughness", "metallic": 1.5}})"), "/materials/m/metallic", "from 0 to 1");
+  expect_error(with_camera(R"("materials": {"m": {"type": "metallic_roughness", "roughness": -0.1}})"), "/materials/m/roughness", "from 0 to 1");
+  expect_error(with_camera(R"("materials": {"m": {"type": "metallic_roughness", "ior": 0.5}})"), "/materials/m/ior", "from 1 to 100");
 }
 
 TEST(SceneTest, TheDirectModelIsTheDefault) {

@@ -20,6 +20,8 @@ Bsdf bsdf_of(const Material& material, const dvec3& color) {
   b.alpha = dvec2(material.alpha);
   b.eta = dvec3(material.eta);
   b.k = dvec3(material.k);
+  b.metallic = material.metallic;
+  b.roughness = material.roughness;
   return b;
 }
 
@@ -158,6 +160,46 @@ double dielectric_pdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, double et
          (denominator * denominator);
 }
 
+// ---- metallic_roughness: glTF 2.0's material, as its specification's Appendix B writes it --------------
+//   f = mix(dielectric, metal, metallic)
+//   metal = specular * (base + (1 - base) (1 - |wo.h|)^5)
+//   dielectric = mix(base / pi, specular, f0 + (1 - f0) (1 - |wo.h|)^5), f0 = ((ior - 1) / (ior + 1))^2
+//   specular = D(h) G1(wo) G1(wi) / (4 cos_o cos_i), GGX with alpha = roughness^2
+// Sampled by the visible normals or by cosine, picked by an estimate of each lobe's share.
+
+double metallic_roughness_alpha(const Bsdf& b) { return std::max(b.roughness * b.roughness, double(VKRAY_MIN_GGX_ALPHA)); }
+
+double dielectric_f0(const Bsdf& b) { return ((b.ior - 1) / (b.ior + 1)) * ((b.ior - 1) / (b.ior + 1)); }
+
+// The probability of sampling the specular lobe seen from wo: the metal's weight and the dielectric's
+// Schlick reflectance at wo, against the diffuse lobe's (1 - F) times the base colour's luminance.
+double specular_share(const Bsdf& b, const dvec3& wo) {
+  const double f0 = dielectric_f0(b), f = f0 + (1 - f0) * std::pow(1 - std::min(1.0, wo.z), 5);
+  const double luminance = 0.2126 * b.color.r + 0.7152 * b.color.g + 0.0722 * b.color.b;
+  const double specular = b.metallic + (1 - b.metallic) * f, diffuse = (1 - b.metallic) * (1 - f) * luminance;
+  return specular + diffuse > 0 ? specular / (specular + diffuse) : 1.0;
+}
+
+dvec3 metallic_roughness_eval(const Bsdf& b, const dvec3& wo, const dvec3& wi) {
+  if (wo.z <= 0 || wi.z <= 0) return dvec3(0.0);
+  const glm::dvec2 alpha(metallic_roughness_alpha(b));
+  const dvec3 h = glm::normalize(wo + wi);
+  const double schlick = std::pow(std::max(0.0, 1 - std::abs(glm::dot(wo, h))), 5);
+  const double specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) * smith_masking(wi, h, alpha) / (4 * wo.z * wi.z);
+  const double f0 = dielectric_f0(b), fresnel = f0 + (1 - f0) * schlick;
+  const dvec3 dielectric = (1 - fresnel) * b.color / kPi + dvec3(fresnel * specular);
+  const dvec3 metal = specular * (b.color + (1.0 - b.color) * schlick);
+  return ((1 - b.metallic) * dielectric + b.metallic * metal) * wi.z;
+}
+
+double metallic_roughness_pdf(const Bsdf& b, const dvec3& wo, const dvec3& wi) {
+  if (wo.z <= 0 || wi.z <= 0) return 0;
+  const glm::dvec2 alpha(metallic_roughness_alpha(b));
+  const dvec3 h = glm::normalize(wo + wi);
+  const double p = specular_share(b, wo);
+  return p * ggx_density(h, alpha) * smith_masking(wo, h, alpha) / (4 * wo.z) + (1 - p) * wi.z / kPi;
+}
+
 }  // namespace
 
 // ---- The three functions, by material ---------------------------------------------------------------------
@@ -170,6 +212,8 @@ dvec3 eval_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n,
       return conductor_eval(b, to_local(wo, n), to_local(wi, n));
     case MaterialType::roughdielectric:
       return dielectric_eval(b, to_local(wo, n), to_local(wi, n), front ? b.ior : 1 / b.ior);
+    case MaterialType::metallic_roughness:
+      return metallic_roughness_eval(b, to_local(wo, n), to_local(wi, n));
     case MaterialType::mirror:
     case MaterialType::glass:
       return dvec3(0.0);  // delta lobes: no direction but one
@@ -185,6 +229,8 @@ double pdf_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n,
       return conductor_pdf(b, to_local(wo, n), to_local(wi, n));
     case MaterialType::roughdielectric:
       return dielectric_pdf(b, to_local(wo, n), to_local(wi, n), front ? b.ior : 1 / b.ior);
+    case MaterialType::metallic_roughness:
+      return metallic_roughness_pdf(b, to_local(wo, n), to_local(wi, n));
     case MaterialType::mirror:
     case MaterialType::glass:
       return 0;
@@ -272,6 +318,27 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
       b.transmitted = true;
       b.eta = eta;
       b.weight = dvec3(smith_masking(i, m, bsdf.alpha) / (eta * eta));
+      return b;
+    }
+    case MaterialType::metallic_roughness: {
+      const double u_lobe = gpu::next_random(stream), u1 = gpu::next_random(stream), u2 = gpu::next_random(stream);
+      const dvec3 o = to_local(wo, n);
+      b.dir = n;
+      b.weight = dvec3(0.0);
+      if (o.z <= 0) return b;
+      dvec3 i;
+      if (u_lobe < specular_share(bsdf, o)) {
+        const dvec3 m = sample_visible_normal(o, glm::dvec2(metallic_roughness_alpha(bsdf)), u1, u2);
+        i = 2 * glm::dot(o, m) * m - o;
+      } else {
+        i = cosine_hemisphere(u1, u2);
+      }
+      if (i.z <= 0) return b;
+      // Either lobe may have given the direction: the weight is the whole BSDF over the mixed density.
+      b.pdf = metallic_roughness_pdf(bsdf, o, i);
+      if (!(b.pdf > 0)) return b;
+      b.dir = glm::normalize(to_world(i, n));
+      b.weight = metallic_roughness_eval(bsdf, o, i) / b.pdf;
       return b;
     }
   }

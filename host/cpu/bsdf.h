@@ -23,6 +23,7 @@ struct Bsdf {
   double ior = 1.5;
   glm::dvec2 alpha{0.1};
   glm::dvec3 eta{0.0}, k{1.0};
+  double metallic = 1, roughness = 1;
 
   bool has(uint32_t property) const { return (properties & property) != 0; }
 };

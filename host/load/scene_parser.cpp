@@ -19,9 +19,8 @@ constexpr float kMaxFocalLength = 1e6f;
 // The largest index of refraction: past every real material (diamond is 2.4), so that a typo shows.
 constexpr float kMaxIor = 100.0f;
 
-// The smoothest GGX surface: its peak density 1 / (pi alpha^2), 3e7, and the pdfs made from it stay
-// far inside a float. Smoother than that is a mirror.
-constexpr float kMinAlpha = 1e-4f;
+// The smoothest GGX surface (shared/materials.h says why); smoother than that is a mirror.
+constexpr float kMinAlpha = VKRAY_MIN_GGX_ALPHA;
 
 }  // namespace
 
@@ -224,6 +223,16 @@ void SceneParser::parse_materials(const Value& v) {
         material.albedo = glm::vec3(1.0f);  // clear: Mitsuba's specular reflectance and transmittance, 1
         if (m.has("int_ior")) material.ior = index_of_refraction(m["int_ior"]);
         break;
+      case MaterialType::metallic_roughness:  // glTF 2.0's, with its names and defaults
+        check_keys(m, {"type", "base_color", "metallic", "roughness", "ior", "emission"});
+        material.albedo = m.has("base_color") ? reflectance(m["base_color"]) : glm::vec3(1.0f);
+        if (m.has("metallic")) material.metallic = unit_interval(m["metallic"]);
+        if (m.has("roughness")) material.roughness = unit_interval(m["roughness"]);
+        if (m.has("ior")) {
+          material.ior = index_of_refraction(m["ior"]);
+          if (material.ior < 1.0f) fail(m["ior"], "expected an index of refraction from 1 to 100 (KHR_materials_ior), got " + brief(m["ior"].j));
+        }
+        break;
     }
     if (m.has("emission")) material.emission = color(m["emission"]);
     material_index_[name] = static_cast<uint32_t>(scene_.materials.size());
@@ -273,6 +282,12 @@ glm::vec2 SceneParser::roughness(const Value& m) const {
   if (m.has("alpha_u") != m.has("alpha_v")) fail(m, "give \"alpha_u\" and \"alpha_v\" together");
   if (m.has("alpha_u")) return {one(m["alpha_u"]), one(m["alpha_v"])};
   return glm::vec2(0.1f);
+}
+
+float SceneParser::unit_interval(const Value& v) const {
+  const float f = number(v);
+  if (!(f >= 0.0f && f <= 1.0f)) fail(v, "expected a number from 0 to 1, got " + brief(v.j));
+  return f;
 }
 
 std::string SceneParser::material_type_list() {

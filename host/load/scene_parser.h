@@ -125,6 +125,7 @@ class SceneParser {
   float index_of_refraction(const Value& v) const;
   glm::vec3 bounded_color(const Value& v, float max, const char* expected) const;  // each channel in [0, max]
   glm::vec2 roughness(const Value& material) const;
+  float unit_interval(const Value& v) const;  // a number in [0, 1]
   static std::string material_type_list();  // "\"diffuse\", \"mirror\", ... or \"...\""
   // Fails unless the JSON value is an integer from `min` to `max`.
   int64_t integer(const Value& v, int64_t min, int64_t max) const;

@@ -298,11 +298,13 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     const Material& m = scene.materials[i];
     glm::vec4* texels = &packed.materials[i * VKRAY_TEXELS_PER_MATERIAL];
     const MaterialValueTexels values = material_value_texels(
-        {m.albedo, uint32_t(m.type), scale_radiance(m.emission, exponent), m.ior, m.eta, m.alpha.x, m.k, m.alpha.y});
+        {m.albedo, uint32_t(m.type), scale_radiance(m.emission, exponent), m.ior, m.eta, m.alpha.x, m.k, m.alpha.y, m.metallic,
+         m.roughness});
     texels[VKRAY_MATERIAL_COLOR] = values.color;
     texels[VKRAY_MATERIAL_EMISSION] = values.emission;
     texels[VKRAY_MATERIAL_ETA] = values.eta;
     texels[VKRAY_MATERIAL_K] = values.k;
+    texels[VKRAY_MATERIAL_LAYERS] = values.layers;
     texels[VKRAY_MATERIAL_ALBEDO_TEXTURE] = header(m.albedo_texture);
     texels[VKRAY_MATERIAL_EMISSION_TEXTURE] = header(m.emission_texture);
     // In double on the host, then one rounding: no 1 / total power in float that could overflow.

@@ -88,6 +88,10 @@ struct Material {
   glm::vec2 alpha{0.1f};
   glm::vec3 eta{0.0f};
   glm::vec3 k{1.0f};
+  // metallic_roughness (glTF's model, its albedo the base colour): how metallic, and how rough (its
+  // GGX alpha is roughness squared); glTF's defaults.
+  float metallic = 1.0f;
+  float roughness = 1.0f;
   // Textures that multiply albedo (or reflectance) and emission where a triangle has texture
   // coordinates (glTF's baseColorTexture and emissiveTexture, an .mtl file's map_Kd).
   TextureRef albedo_texture;

@@ -30,13 +30,15 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_MATERIAL_GLASS 2u
 #define VKRAY_MATERIAL_ROUGHCONDUCTOR 3u
 #define VKRAY_MATERIAL_ROUGHDIELECTRIC 4u
+#define VKRAY_MATERIAL_METALLIC_ROUGHNESS 5u
 #define VKRAY_MATERIAL_TYPES(X)                                                                    \
   X(VKRAY_MATERIAL_DIFFUSE, diffuse, VKRAY_BSDF_DIFFUSE)                                           \
   X(VKRAY_MATERIAL_MIRROR, mirror, VKRAY_BSDF_DELTA)                                               \
   X(VKRAY_MATERIAL_GLASS, glass, VKRAY_BSDF_DELTA | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR) \
   X(VKRAY_MATERIAL_ROUGHCONDUCTOR, roughconductor, VKRAY_BSDF_GLOSSY)                             \
-  X(VKRAY_MATERIAL_ROUGHDIELECTRIC, roughdielectric, VKRAY_BSDF_GLOSSY | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR)
-#define VKRAY_MATERIAL_TYPE_COUNT 5u
+  X(VKRAY_MATERIAL_ROUGHDIELECTRIC, roughdielectric, VKRAY_BSDF_GLOSSY | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR) \
+  X(VKRAY_MATERIAL_METALLIC_ROUGHNESS, metallic_roughness, VKRAY_BSDF_DIFFUSE | VKRAY_BSDF_GLOSSY)
+#define VKRAY_MATERIAL_TYPE_COUNT 6u
 
 VKRAY_INLINE uint material_properties(uint type) {
 #define VKRAY_MATERIAL_PROPERTIES_OF(number, name, properties) \
@@ -46,16 +48,24 @@ VKRAY_INLINE uint material_properties(uint type) {
   return 0u;
 }
 
+// The smoothest GGX surface either renderer evaluates: at alpha 1e-4 the distribution's peak,
+// 1 / (pi alpha^2) = 3e7, and the densities made from it stay far inside a float. A rough material's
+// alpha is at least this (the scene parser refuses less; glTF's roughness 0 is taken as this).
+#define VKRAY_MIN_GGX_ALPHA 1e-4f
+
 // ---- The values: what a BSDF is evaluated from, before textures -----------------------------------------
 struct MaterialValues {
-  vec3 color;      // diffuse: albedo; mirror: reflectance; roughconductor: specular_reflectance; dielectrics: 1
+  vec3 color;      // diffuse: albedo; mirror: reflectance; roughconductor: specular_reflectance; dielectrics: 1;
+                   // metallic_roughness: the base colour
   uint type;       // VKRAY_MATERIAL_*
   vec3 emission;   // radiance emitted on the side the geometric normal faces (the shader's: scaled)
-  float ior;       // glass, roughdielectric: the index of refraction inside (outside: 1)
+  float ior;       // glass, roughdielectric: the index of refraction inside (outside: 1); metallic_roughness: its dielectric's
   vec3 eta;        // roughconductor: the real part of its index of refraction (0 with k = 1: F = 1)
   float alpha_u;   // rough materials: GGX roughness along the shading frame's first tangent
   vec3 k;          // roughconductor: the imaginary part (absorption)
   float alpha_v;   // along the second tangent
+  float metallic;  // metallic_roughness: glTF's metallicFactor
+  float roughness; // metallic_roughness: glTF's roughnessFactor (its GGX alpha is its square)
 };
 
 // ---- Texels: VKRAY_TEXELS_PER_MATERIAL RGBA32F each ---------------------------------------------------
@@ -63,29 +73,32 @@ struct MaterialValues {
 //   VKRAY_MATERIAL_EMISSION:          (emitted radiance, ior)
 //   VKRAY_MATERIAL_ETA:               (eta, alpha_u)          read only by GLOSSY materials
 //   VKRAY_MATERIAL_K:                 (k, alpha_v)            read only by GLOSSY materials
+//   VKRAY_MATERIAL_LAYERS:            (metallic, roughness, 0, 0)  read only by GLOSSY materials
 //   VKRAY_MATERIAL_ALBEDO_TEXTURE:    the texture that multiplies the colour (texture_texel)
 //   VKRAY_MATERIAL_EMISSION_TEXTURE:  the texture that multiplies the emission
 //   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
 //                                     an emitter of this material, 0, 0, 0): scene/emitters.h
-#define VKRAY_TEXELS_PER_MATERIAL 7
+#define VKRAY_TEXELS_PER_MATERIAL 8
 #define VKRAY_MATERIAL_COLOR 0
 #define VKRAY_MATERIAL_EMISSION 1
 #define VKRAY_MATERIAL_ETA 2
 #define VKRAY_MATERIAL_K 3
-#define VKRAY_MATERIAL_ALBEDO_TEXTURE 4
-#define VKRAY_MATERIAL_EMISSION_TEXTURE 5
-#define VKRAY_MATERIAL_LIGHT 6
+#define VKRAY_MATERIAL_LAYERS 4
+#define VKRAY_MATERIAL_ALBEDO_TEXTURE 5
+#define VKRAY_MATERIAL_EMISSION_TEXTURE 6
+#define VKRAY_MATERIAL_LIGHT 7
 #define VKRAY_MATERIAL_PROPERTY_SHIFT 8u
 
 // The first texel of material `index`.
 VKRAY_INLINE int material_texel(uint index) { return int(index) * VKRAY_TEXELS_PER_MATERIAL; }
 
-// The value texels (COLOR to K) of a material; its properties come from the table, never from the caller.
+// The value texels (COLOR to LAYERS) of a material; its properties come from the table, never from the caller.
 struct MaterialValueTexels {
   vec4 color;
   vec4 emission;
   vec4 eta;
   vec4 k;
+  vec4 layers;
 };
 
 VKRAY_INLINE MaterialValueTexels material_value_texels(MaterialValues m) {
@@ -94,6 +107,7 @@ VKRAY_INLINE MaterialValueTexels material_value_texels(MaterialValues m) {
   t.emission = vec4(m.emission, m.ior);
   t.eta = vec4(m.eta, m.alpha_u);
   t.k = vec4(m.k, m.alpha_v);
+  t.layers = vec4(m.metallic, m.roughness, 0.0f, 0.0f);
   return t;
 }
 
@@ -110,6 +124,8 @@ VKRAY_INLINE MaterialValues material_values(MaterialValueTexels t) {
   m.alpha_u = t.eta.w;
   m.k = vec3(t.k.x, t.k.y, t.k.z);
   m.alpha_v = t.k.w;
+  m.metallic = t.layers.x;
+  m.roughness = t.layers.y;
   return m;
 }
 
