@@ -49,6 +49,23 @@ class ShaderIncludesTest : public ::testing::Test {
   TempDir dir_;
 };
 
+TEST_F(ShaderIncludesTest, AnIncludedFileWhoseConditionalsDoNotBalanceIsRefused) {
+  // glslang's preprocessor crashed on an #else in one file closing an #if of another (a fuzzer's
+  // find); each included file must balance its own.
+  write({{"main.comp", kMain + "#ifndef X\n#include \"else.glsl\"\n#endif\nvoid main() {}\n"},
+         {"else.glsl", "// the other half\n#else\n"}});
+  std::string message = error(file("main.comp") + ":5");
+  EXPECT_NE(message.find(file("else.glsl") + ", line 2: #else with no #if before it in this file"), std::string::npos) << message;
+  write({{"main.comp", kMain + "#include \"open.glsl\"\n#endif\nvoid main() {}\n"},
+         {"open.glsl", "#ifdef Y\nfloat y;\n/* #endif in a comment\n#endif */\n"}});
+  message = error(file("main.comp") + ":4");
+  EXPECT_NE(message.find(file("open.glsl") + ", line 1: an #if with no #endif in this file"), std::string::npos) << message;
+  // Balanced, with directives in comments and an #elif, it compiles.
+  write({{"main.comp", kMain + "#include \"ok.glsl\"\nvoid main() {}\n"},
+         {"ok.glsl", "#if 0\n#elif 1\nfloat z; // #endif\n#else\n#endif\n/*\n#if 1\n*/\n"}});
+  EXPECT_NO_THROW(gpu::compile_compute_shader(dir_ / "main.comp", {dir_.path()}));
+}
+
 TEST_F(ShaderIncludesTest, ACycleIsAnErrorAtTheIncludeThatClosesIt) {
   write({{"main.comp", kMain + "#include \"a.glsl\"\nvoid main() {}\n"},
          {"a.glsl", "// a\n\n#include \"b.glsl\"\n"},

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "base/errors.h"
 
@@ -47,6 +49,51 @@ bool has_include_guard(std::string_view text) {
   size_t at = 0;
   const std::string_view guard = directive_word(text, at, "ifndef");
   return !guard.empty() && directive_word(text, at, "define") == guard;
+}
+
+// Where a file's #if, #ifdef and #ifndef fail to balance with its #endif (an #elif, #else or #endif
+// with none open, or one left open at the end): "line N: ..." for the first, "" when they balance.
+// glslang's preprocessor follows conditionals from file to file, and some that begin in one file and
+// end in another crash it (Debian 12's glslang, found by fuzzing): vkray asks that each file balance.
+std::string unbalanced_conditionals(std::string_view text) {
+  std::vector<size_t> open;  // the line of each #if still open
+  bool in_comment = false;
+  size_t line = 1;
+  for (size_t at = 0; at < text.size(); ++line) {
+    const size_t end = std::min(text.find('\n', at), text.size());
+    std::string_view row = text.substr(at, end - at);
+    at = end + 1;
+    // A directive is the first token of a line that does not start inside a block comment.
+    size_t i = 0;
+    if (in_comment) {
+      const size_t close = row.find("*/");
+      if (close == std::string_view::npos) continue;
+      in_comment = false;
+      i = close + 2;
+    }
+    i = row.find_first_not_of(" \t", i);
+    const bool directive = i != std::string_view::npos && row[i] == '#';
+    // Whether the line leaves a block comment open (strings aside: GLSL has none).
+    for (size_t c = 0; c + 1 < row.size(); ++c) {
+      if (!in_comment && row.substr(c, 2) == "//") break;
+      if (row.substr(c, 2) == (in_comment ? "*/" : "/*")) {
+        in_comment = !in_comment;
+        ++c;
+      }
+    }
+    if (!directive) continue;
+    const size_t word_begin = row.find_first_not_of(" \t", i + 1);
+    if (word_begin == std::string_view::npos) continue;
+    const std::string_view word = row.substr(word_begin, row.find_first_not_of("abcdefghijklmnopqrstuvwxyz", word_begin) - word_begin);
+    if (word == "if" || word == "ifdef" || word == "ifndef") {
+      open.push_back(line);
+    } else if (word == "elif" || word == "else" || word == "endif") {
+      if (open.empty()) return "line " + std::to_string(line) + ": #" + std::string(word) + " with no #if before it in this file";
+      if (word == "endif") open.pop_back();
+    }
+  }
+  if (!open.empty()) return "line " + std::to_string(open.back()) + ": an #if with no #endif in this file";
+  return {};
 }
 
 // An IncludeResult that owns its text.
@@ -147,6 +194,9 @@ glslang::TShader::Includer::IncludeResult* ShaderIncludes::include(const std::st
   if (included_bytes_ > kMaxIncludedBytes)
     return error("#include \"" + printable(header, 60) + "\": the shader's includes pass " + std::to_string(kMaxIncludedBytes >> 20) +
                  " MiB (counting a file each time it is included)");
+  if (const std::string where = unbalanced_conditionals(text); !where.empty())
+    return error("#include \"" + printable(header, 60) + "\": " + printable(key, 200) + ", " + where +
+                 " (each included file's conditionals must balance)");
   const bool open = std::any_of(chain_.begin(), chain_.end(), [&](const Open& o) { return o.key == key; });
   if (open && !has_include_guard(text)) return error("#include cycle: " + chain_text(header));
   if (!generated && std::find(sources_.begin(), sources_.end(), key) == sources_.end())
