@@ -14,7 +14,7 @@
 //                   Lambert; GGX with alpha = roughness^2; a lobe, then a direction (three numbers)
 // Every function takes wo, unit, back along the incoming ray; n, the shading normal turned to the
 // ray's side; front, whether the ray met the side the geometric normal faces. Glossy lobes live in
-// the frame frame_about(n) builds, whose first tangent is alpha's u. The CPU reference implements
+// the frame tangent_frame(n) builds (warp.glsl), whose first tangent is alpha_u's. The CPU reference implements
 // the same (host/cpu/bsdf.h).
 #ifndef VKRAY_BSDF_GLSL
 #define VKRAY_BSDF_GLSL
@@ -94,7 +94,7 @@ vec3 sample_visible_normal(vec3 v, vec2 alpha, vec2 u) {
   float r = sqrt(u.x), phi = 2.0 * PI * u.y;
   float p1 = r * cos(phi);
   float s = 0.5 * (1.0 + vh.z);
-  float p2 = (1.0 - s) * sqrt(1.0 - p1 * p1) + s * (r * sin(phi));
+  float p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * (r * sin(phi));
   vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
   return normalize(vec3(alpha * nh.xy, max(0.0, nh.z)));
 }
@@ -194,23 +194,29 @@ float metallic_roughness_pdf(Surface s, vec3 wo, vec3 wi) {
   return p * ggx_density(h, alpha) * smith_masking(wo, h, alpha) / (4.0 * wo.z) + (1.0 - p) * wi.z / PI;
 }
 
+// Whether the surface is no interface at all (a rough dielectric of index 1, which sample_bsdf passes
+// straight on): the direct model passes the ray on there, as at a delta BSDF, instead of shading it.
+bool passes_straight_on(Surface s) {
+  return SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC && s.ior == 1.0;
+}
+
 // ---- The three functions -----------------------------------------------------------------------------
 
 // f(wo, wi) |n . wi|; 0 for delta BSDFs and directions a lobe does not reach.
 vec3 eval_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return s.albedo * (max(0.0, dot(wi, n)) / PI);
-  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_eval(s, to_local(wo, n), to_local(wi, n));
-  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_eval(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
-  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_eval(s, to_local(wo, n), to_local(wi, n));
+  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_eval(s, to_tangent_space(wo, n), to_tangent_space(wi, n));
+  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_eval(s, to_tangent_space(wo, n), to_tangent_space(wi, n), front ? s.ior : 1.0 / s.ior);
+  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_eval(s, to_tangent_space(wo, n), to_tangent_space(wi, n));
   return vec3(0.0);
 }
 
 // The solid-angle density with which sample_bsdf picks wi; 0 for delta BSDFs.
 float pdf_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return max(0.0, dot(wi, n)) / PI;
-  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_pdf(s, to_local(wo, n), to_local(wi, n));
-  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_pdf(s, to_local(wo, n), to_local(wi, n), front ? s.ior : 1.0 / s.ior);
-  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_pdf(s, to_local(wo, n), to_local(wi, n));
+  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_pdf(s, to_tangent_space(wo, n), to_tangent_space(wi, n));
+  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_pdf(s, to_tangent_space(wo, n), to_tangent_space(wi, n), front ? s.ior : 1.0 / s.ior);
+  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_pdf(s, to_tangent_space(wo, n), to_tangent_space(wi, n));
   return 0.0;
 }
 
@@ -234,14 +240,14 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
   }
   if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) {
     vec2 u = vec2(next_random(stream), next_random(stream));
-    vec3 o = to_local(wo, n);
+    vec3 o = to_tangent_space(wo, n);
     b.dir = n;
     b.weight = vec3(0.0);
     if (o.z <= 0.0) return b;  // seen from below its shading normal: no light
     vec3 m = sample_visible_normal(o, s.alpha, u);
     vec3 i = 2.0 * dot(o, m) * m - o;
     if (i.z <= 0.0) return b;  // reflected below the surface
-    b.dir = normalize(to_world(i, n));
+    b.dir = normalize(from_tangent_space(i, n));
     b.pdf = conductor_pdf(s, o, i);
     // f cos / pdf = F G1(wi): D, G1(wo) and the cosines cancel.
     b.weight = s.albedo * fresnel_conductor(dot(o, m), s.eta, s.k) * smith_masking(i, m, s.alpha);
@@ -258,7 +264,7 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
       b.weight = vec3(1.0);
       return b;
     }
-    vec3 o = to_local(wo, n);
+    vec3 o = to_tangent_space(wo, n);
     b.dir = n;
     b.weight = vec3(0.0);
     if (o.z <= 0.0) return b;
@@ -269,7 +275,7 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     if (u_choice < f) {  // reflection, with probability F: f cos / pdf = G1(wi)
       vec3 i = 2.0 * cos_i * m - o;
       if (i.z <= 0.0) return b;
-      b.dir = normalize(to_world(i, n));
+      b.dir = normalize(from_tangent_space(i, n));
       b.pdf = dielectric_pdf(s, o, i, eta);
       b.weight = vec3(smith_masking(i, m, s.alpha));
       return b;
@@ -277,7 +283,7 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     // Refraction about m, with probability 1 - F: f cos / pdf = G1(wi) / eta^2.
     vec3 i = normalize((cos_i / eta - cos_t) * m - o / eta);
     if (i.z >= 0.0) return b;
-    b.dir = normalize(to_world(i, n));
+    b.dir = normalize(from_tangent_space(i, n));
     b.pdf = dielectric_pdf(s, o, i, eta);
     b.transmitted = true;
     b.eta = eta;
@@ -287,7 +293,7 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
   if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) {
     float u_lobe = next_random(stream);
     vec2 u = vec2(next_random(stream), next_random(stream));
-    vec3 o = to_local(wo, n);
+    vec3 o = to_tangent_space(wo, n);
     b.dir = n;
     b.weight = vec3(0.0);
     if (o.z <= 0.0) return b;
@@ -302,7 +308,7 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     // Either lobe may have given the direction: the weight is the whole BSDF over the mixed density.
     b.pdf = metallic_roughness_pdf(s, o, i);
     if (!(b.pdf > 0.0)) return b;
-    b.dir = normalize(to_world(i, n));
+    b.dir = normalize(from_tangent_space(i, n));
     b.weight = metallic_roughness_eval(s, o, i) / b.pdf;
     return b;
   }

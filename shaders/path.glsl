@@ -84,7 +84,7 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
     }
     if (background_sampled) {
       vec3 w = uniform_sphere(vec2(next_random(stream), next_random(stream)));
-      if (faces(lit, dot(n, w))) {
+      if (faces(lit, w)) {
         rays += 1u;
         if (!trace_any(Ray(origin_toward(lit, w), w), frame.epsilon, FAR))
           p.radiance += p.throughput * eval_bsdf(s, wo, w, n, front) * frame.background.rgb *

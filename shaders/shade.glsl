@@ -23,6 +23,7 @@
 struct LitPoint {
   vec3 x;
   vec3 n;
+  vec3 n_geometric;   // turned as n is
   vec3 origin_front;  // x + epsilon n_geometric
   vec3 origin_back;   // x - epsilon n_geometric
   bool both_sides;
@@ -30,12 +31,18 @@ struct LitPoint {
 
 LitPoint lit_point(vec3 x, vec3 n, vec3 n_geometric, Surface s) {
   bool transmits = SCENE_HAS_NON_DIFFUSE && (s.properties & VKRAY_BSDF_TRANSMISSION) != 0u;
-  return LitPoint(x, n, x + frame.epsilon * n_geometric, x - frame.epsilon * n_geometric, transmits);
+  return LitPoint(x, n, n_geometric, x + frame.epsilon * n_geometric, x - frame.epsilon * n_geometric, transmits);
 }
 
-// Whether light from a direction of cosine cos_w to n can reach the BSDF: above n, or either side.
-bool faces(LitPoint p, float cos_w) { return cos_w > 0.0 || (p.both_sides && cos_w < 0.0); }
-vec3 origin_toward(LitPoint p, vec3 w) { return p.both_sides && dot(p.n, w) < 0.0 ? p.origin_back : p.origin_front; }
+// Whether light from direction w can reach the BSDF: above n; or, for a BSDF that transmits, on
+// either side where the shading and geometric normals agree on the side (where they do not, the
+// BSDF's own sampling ends the path too, so light sampling must not count it either).
+bool faces(LitPoint p, vec3 w) {
+  float c = dot(p.n, w);
+  if (!p.both_sides) return c > 0.0;
+  return c != 0.0 && (c > 0.0) == (dot(p.n_geometric, w) > 0.0);
+}
+vec3 origin_toward(LitPoint p, vec3 w) { return p.both_sides && dot(p.n_geometric, w) < 0.0 ? p.origin_back : p.origin_front; }
 
 // One area-light sample as a point p sees it. Draws three numbers from the stream.
 struct AreaLightSample {
@@ -52,7 +59,7 @@ AreaLightSample sample_area_light_from(LitPoint p, inout uint stream, inout uint
   vec3 w = to_light * inversesqrt(r2);
   float cos_l = -dot(light.normal, w);
   AreaLightSample s = AreaLightSample(vec3(0.0), w, dot(p.n, w), 0.0);
-  if (!(faces(p, s.cos_x) && cos_l > 0.0)) return s;
+  if (!(faces(p, w) && cos_l > 0.0)) return s;
   if (SHADOW_RAYS) {
     vec3 shadow_origin = origin_toward(p, w);
     vec3 shadow_dir = light.position - shadow_origin;
@@ -82,7 +89,7 @@ void add_point_lights(LitPoint p, Surface s, vec3 wo, bool front, inout vec3 rad
     // a light on the surface, or at x itself, lights nothing there, whatever the rounding of x), or
     // below it for a BSDF that transmits.
     float height = dot(p.n, to_light);
-    bool lit = height > frame.epsilon || (p.both_sides && height < -frame.epsilon);
+    bool lit = (height > frame.epsilon || (p.both_sides && height < -frame.epsilon)) && faces(p, to_light);
     if (SHADOW_RAYS && lit) {
       vec3 shadow_origin = origin_toward(p, to_light);
       vec3 shadow_dir = light_pos - shadow_origin;

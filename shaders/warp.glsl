@@ -55,11 +55,32 @@ vec3 to_world(vec3 local, vec3 n) {
   return local.x * t + local.y * bt + local.z * n;
 }
 
-// The world direction v in the frame about n: (t . v, bt . v, n . v).
-vec3 to_local(vec3 v, vec3 n) {
+// The frame the microfacet BSDFs are written in, whose first tangent is alpha_u's: the direction
+// around the world's z axis, (-n.y, n.x, 0) normalized (a sphere's dp/du in Mitsuba), so that an
+// anisotropic grain runs on without a seam; where n is the z axis itself, frame_about's.
+void tangent_frame(vec3 n, out vec3 t, out vec3 bt) {
+  vec2 around = vec2(-n.y, n.x);
+  float len2 = dot(around, around);
+  if (len2 < 1e-12) {
+    frame_about(n, t, bt);
+    return;
+  }
+  t = vec3(around * inversesqrt(len2), 0.0);
+  bt = cross(n, t);
+}
+
+// The world direction v in the tangent frame about n: (t . v, bt . v, n . v).
+vec3 to_tangent_space(vec3 v, vec3 n) {
   vec3 t, bt;
-  frame_about(n, t, bt);
+  tangent_frame(n, t, bt);
   return vec3(dot(v, t), dot(v, bt), dot(v, n));
+}
+
+// A direction in the tangent frame about n, in the world.
+vec3 from_tangent_space(vec3 local, vec3 n) {
+  vec3 t, bt;
+  tangent_frame(n, t, bt);
+  return local.x * t + local.y * bt + local.z * n;
 }
 
 #endif

@@ -89,7 +89,7 @@ dvec3 sample_visible_normal(const dvec3& v, const dvec2& alpha, double u1, doubl
   const double r = std::sqrt(u1), phi = 2 * kPi * u2;
   const double p1 = r * std::cos(phi);
   const double s = (1 + vh.z) / 2;
-  const double p2 = (1 - s) * std::sqrt(1 - p1 * p1) + s * (r * std::sin(phi));
+  const double p2 = (1 - s) * std::sqrt(std::max(0.0, 1 - p1 * p1)) + s * (r * std::sin(phi));
   const dvec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1 - p1 * p1 - p2 * p2)) * vh;
   return glm::normalize(dvec3(alpha.x * nh.x, alpha.y * nh.y, std::max(0.0, nh.z)));
 }
@@ -202,6 +202,8 @@ double metallic_roughness_pdf(const Bsdf& b, const dvec3& wo, const dvec3& wi) {
 
 }  // namespace
 
+bool passes_straight_on(const Bsdf& b) { return b.type == MaterialType::roughdielectric && b.ior == 1; }
+
 // ---- The three functions, by material ---------------------------------------------------------------------
 
 dvec3 eval_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n, bool front) {
@@ -209,11 +211,11 @@ dvec3 eval_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n,
     case MaterialType::diffuse:
       return b.color * (std::max(0.0, glm::dot(wi, n)) / kPi);
     case MaterialType::roughconductor:
-      return conductor_eval(b, to_local(wo, n), to_local(wi, n));
+      return conductor_eval(b, to_tangent_space(wo, n), to_tangent_space(wi, n));
     case MaterialType::roughdielectric:
-      return dielectric_eval(b, to_local(wo, n), to_local(wi, n), front ? b.ior : 1 / b.ior);
+      return dielectric_eval(b, to_tangent_space(wo, n), to_tangent_space(wi, n), front ? b.ior : 1 / b.ior);
     case MaterialType::metallic_roughness:
-      return metallic_roughness_eval(b, to_local(wo, n), to_local(wi, n));
+      return metallic_roughness_eval(b, to_tangent_space(wo, n), to_tangent_space(wi, n));
     case MaterialType::mirror:
     case MaterialType::glass:
       return dvec3(0.0);  // delta lobes: no direction but one
@@ -226,11 +228,11 @@ double pdf_bsdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, const dvec3& n,
     case MaterialType::diffuse:
       return std::max(0.0, glm::dot(wi, n)) / kPi;
     case MaterialType::roughconductor:
-      return conductor_pdf(b, to_local(wo, n), to_local(wi, n));
+      return conductor_pdf(b, to_tangent_space(wo, n), to_tangent_space(wi, n));
     case MaterialType::roughdielectric:
-      return dielectric_pdf(b, to_local(wo, n), to_local(wi, n), front ? b.ior : 1 / b.ior);
+      return dielectric_pdf(b, to_tangent_space(wo, n), to_tangent_space(wi, n), front ? b.ior : 1 / b.ior);
     case MaterialType::metallic_roughness:
-      return metallic_roughness_pdf(b, to_local(wo, n), to_local(wi, n));
+      return metallic_roughness_pdf(b, to_tangent_space(wo, n), to_tangent_space(wi, n));
     case MaterialType::mirror:
     case MaterialType::glass:
       return 0;
@@ -273,14 +275,14 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
     }
     case MaterialType::roughconductor: {
       const double u1 = gpu::next_random(stream), u2 = gpu::next_random(stream);
-      const dvec3 o = to_local(wo, n);
+      const dvec3 o = to_tangent_space(wo, n);
       b.dir = n;
       b.weight = dvec3(0.0);
       if (o.z <= 0) return b;  // seen from below its shading normal: no light
       const dvec3 m = sample_visible_normal(o, bsdf.alpha, u1, u2);
       const dvec3 i = 2 * glm::dot(o, m) * m - o;
       if (i.z <= 0) return b;  // reflected below the surface
-      b.dir = glm::normalize(to_world(i, n));
+      b.dir = glm::normalize(from_tangent_space(i, n));
       b.pdf = conductor_pdf(bsdf, o, i);
       // f cos / pdf = F G1(wi): D, G1(wo) and the cosines cancel.
       b.weight = bsdf.color * fresnel_conductor(glm::dot(o, m), bsdf.eta, bsdf.k) * smith_masking(i, m, bsdf.alpha);
@@ -294,7 +296,7 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
         b.dir = -wo;
         return b;
       }
-      const dvec3 o = to_local(wo, n);
+      const dvec3 o = to_tangent_space(wo, n);
       b.dir = n;
       b.weight = dvec3(0.0);
       if (o.z <= 0) return b;
@@ -305,7 +307,7 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
       if (u3 < f) {  // reflection, with probability F: f cos / pdf = G1(wi)
         const dvec3 i = 2 * cos_i * m - o;
         if (i.z <= 0) return b;
-        b.dir = glm::normalize(to_world(i, n));
+        b.dir = glm::normalize(from_tangent_space(i, n));
         b.pdf = dielectric_pdf(bsdf, o, i, eta);
         b.weight = dvec3(smith_masking(i, m, bsdf.alpha));
         return b;
@@ -313,7 +315,7 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
       // Refraction about m, with probability 1 - F: f cos / pdf = G1(wi) / eta^2.
       const dvec3 i = glm::normalize((cos_i / eta - cos_t) * m - o / eta);
       if (i.z >= 0) return b;
-      b.dir = glm::normalize(to_world(i, n));
+      b.dir = glm::normalize(from_tangent_space(i, n));
       b.pdf = dielectric_pdf(bsdf, o, i, eta);
       b.transmitted = true;
       b.eta = eta;
@@ -322,7 +324,7 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
     }
     case MaterialType::metallic_roughness: {
       const double u_lobe = gpu::next_random(stream), u1 = gpu::next_random(stream), u2 = gpu::next_random(stream);
-      const dvec3 o = to_local(wo, n);
+      const dvec3 o = to_tangent_space(wo, n);
       b.dir = n;
       b.weight = dvec3(0.0);
       if (o.z <= 0) return b;
@@ -337,7 +339,7 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
       // Either lobe may have given the direction: the weight is the whole BSDF over the mixed density.
       b.pdf = metallic_roughness_pdf(bsdf, o, i);
       if (!(b.pdf > 0)) return b;
-      b.dir = glm::normalize(to_world(i, n));
+      b.dir = glm::normalize(from_tangent_space(i, n));
       b.weight = metallic_roughness_eval(bsdf, o, i) / b.pdf;
       return b;
     }

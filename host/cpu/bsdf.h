@@ -4,7 +4,7 @@
 // Every function takes wo, unit, back along the incoming ray; n, the unit shading normal turned to
 // the side the ray came from (so conductors and diffuse surfaces reflect on both sides); and front,
 // whether the ray met the side the geometric normal faces (a dielectric's outside). Glossy lobes
-// are written in the frame to_world builds about n (cpu/warp.h), whose first tangent is alpha_u's.
+// are written in the frame tangent_frame builds about n (cpu/warp.h), whose first tangent is alpha_u's.
 #pragma once
 
 #include <cstdint>
@@ -47,6 +47,10 @@ glm::dvec3 eval_bsdf(const Bsdf& bsdf, const glm::dvec3& wo, const glm::dvec3& w
 double pdf_bsdf(const Bsdf& bsdf, const glm::dvec3& wo, const glm::dvec3& wi, const glm::dvec3& n, bool front);
 // A direction drawn with density pdf_bsdf (or a delta lobe's), from `stream`.
 BsdfSample sample_bsdf(const Bsdf& bsdf, const glm::dvec3& wo, const glm::dvec3& n, bool front, uint32_t& stream);
+
+// Whether the surface is no interface at all (a rough dielectric of index 1, which sample_bsdf passes
+// straight on): the direct model passes the ray on there, as at a delta BSDF.
+bool passes_straight_on(const Bsdf& bsdf);
 
 // Fresnel reflectance of a smooth dielectric: cos_i > 0 on the incident side, eta = n_t / n_i. Sets
 // cos_t, the cosine on the other side (0 past the critical angle, where it returns 1).

@@ -19,7 +19,7 @@ dvec3 shade(const Tracer& tracer, const Lights& lights, const SurfacePoint& s, c
   const Scene& scene = tracer.scene();
   const dvec3 x = s.position;
   dvec3 radiance = bsdf.color * dvec3(scene.ambient);
-  const LitPoint p{x, n, x + tracer.epsilon() * n_geometric, x - tracer.epsilon() * n_geometric,
+  const LitPoint p{x, n, n_geometric, x + tracer.epsilon() * n_geometric, x - tracer.epsilon() * n_geometric,
                    bsdf.has(VKRAY_BSDF_TRANSMISSION)};
   lights.add_point_lights(p, bsdf, wo, front, radiance, first ? &state.signature : nullptr, state.rays);
   if (lights.has_area_lights()) {
@@ -52,7 +52,7 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
     const dvec3 n = front ? s.shading_normal : -s.shading_normal;
     if (front) radiance += throughput * s.emission;
     const Bsdf bsdf = bsdf_of(material, s.albedo);
-    if (!bsdf.has(VKRAY_BSDF_DELTA)) {
+    if (!bsdf.has(VKRAY_BSDF_DELTA) && !passes_straight_on(bsdf)) {
       radiance += throughput * shade(tracer, lights, s, bsdf, -ray.dir, front, n, n_geometric, state, bounce == 0);
       break;
     }

@@ -24,7 +24,7 @@ void Lights::add_point_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& 
     // The light must stand more than epsilon above the plane of the normal (or below it, for a BSDF
     // that transmits): one on the surface (or at x) lights nothing there.
     const double height = glm::dot(p.n, to_light);
-    if (!(height > epsilon_ || (p.both_sides && height < -epsilon_))) continue;
+    if (!(height > epsilon_ || (p.both_sides && height < -epsilon_)) || !p.faces(to_light)) continue;
     if (shadows_) {
       ++rays;
       const dvec3& origin = p.origin_toward(to_light);
@@ -46,7 +46,7 @@ AreaLightSample Lights::sample_area_light_from(const LitPoint& p, uint32_t& stre
   s.dir = w;
   s.cos_x = glm::dot(p.n, w);
   const double cos_l = -glm::dot(light.normal, w);
-  if (!(p.faces(s.cos_x) && cos_l > 0)) return s;
+  if (!(p.faces(w) && cos_l > 0)) return s;
   if (shadows_) {
     ++rays;
     const dvec3& origin = p.origin_toward(w);

@@ -29,13 +29,20 @@ struct LightPoint {
 struct LitPoint {
   dvec3 x;
   dvec3 n;
+  dvec3 n_geometric;       // turned as n is
   dvec3 origin_front;      // x + epsilon n_geometric
   dvec3 origin_back;       // x - epsilon n_geometric
   bool both_sides = false;
 
-  // Whether light from direction w (unit or not) can reach the BSDF at all: above n, or either side.
-  bool faces(double cos_w) const { return cos_w > 0 || (both_sides && cos_w < 0); }
-  const dvec3& origin_toward(const dvec3& w) const { return both_sides && glm::dot(n, w) < 0 ? origin_back : origin_front; }
+  // Whether light from direction w (unit or not) can reach the BSDF: above n; or, for a BSDF that
+  // transmits, on either side where the shading and geometric normals agree on the side (where they
+  // do not, BSDF sampling ends the path, and light sampling must not count it either).
+  bool faces(const dvec3& w) const {
+    const double c = glm::dot(n, w);
+    if (!both_sides) return c > 0;
+    return c != 0 && (c > 0) == (glm::dot(n_geometric, w) > 0);
+  }
+  const dvec3& origin_toward(const dvec3& w) const { return both_sides && glm::dot(n_geometric, w) < 0 ? origin_back : origin_front; }
 };
 
 // One area-light sample as a point x sees it.

@@ -57,7 +57,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     const dvec3 wo = -ray.dir;
     if (!bsdf.has(VKRAY_BSDF_DELTA)) {
       // Next-event estimation: each term f cos times the light over its density, weighed against BSDF sampling.
-      const LitPoint p{x, n, origin, x - epsilon * n_geometric, bsdf.has(VKRAY_BSDF_TRANSMISSION)};
+      const LitPoint p{x, n, n_geometric, origin, x - epsilon * n_geometric, bsdf.has(VKRAY_BSDF_TRANSMISSION)};
       dvec3 from_points(0.0);
       lights.add_point_lights(p, bsdf, wo, front, from_points, depth == 1 ? &state.signature : nullptr, state.rays);
       radiance += throughput * from_points;
@@ -70,7 +70,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
       if (background_sampled) {
         const double u1 = gpu::next_random(state.stream), u2 = gpu::next_random(state.stream);
         const dvec3 w = uniform_sphere(u1, u2);
-        if (p.faces(glm::dot(n, w))) {
+        if (p.faces(w)) {
           ++state.rays;
           if (!tracer.occluded({p.origin_toward(w), w}, epsilon, kFar))
             radiance += throughput * eval_bsdf(bsdf, wo, w, n, front) * background *

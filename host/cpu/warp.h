@@ -66,10 +66,27 @@ inline glm::dvec3 to_world(const glm::dvec3& local, const glm::dvec3& n) {
   return local.x * f.t + local.y * f.bt + local.z * f.n;
 }
 
-// The world direction v in the frame about n: (t . v, bt . v, n . v).
-inline glm::dvec3 to_local(const glm::dvec3& v, const glm::dvec3& n) {
-  const Frame f = frame_about(n);
+// The frame the microfacet BSDFs are written in, whose first tangent is alpha_u's: the direction
+// around the world's z axis, (-n.y, n.x, 0) normalized (a sphere's dp/du in Mitsuba), so that an
+// anisotropic grain runs on without a seam; where n is the z axis itself, frame_about's.
+inline Frame tangent_frame(const glm::dvec3& n) {
+  const glm::dvec2 around(-n.y, n.x);
+  const double len2 = glm::dot(around, around);
+  if (len2 < 1e-12) return frame_about(n);
+  const glm::dvec3 t(around / std::sqrt(len2), 0.0);
+  return {t, glm::cross(n, t), n};
+}
+
+// The world direction v in the tangent frame about n: (t . v, bt . v, n . v).
+inline glm::dvec3 to_tangent_space(const glm::dvec3& v, const glm::dvec3& n) {
+  const Frame f = tangent_frame(n);
   return {glm::dot(v, f.t), glm::dot(v, f.bt), glm::dot(v, f.n)};
+}
+
+// A direction in the tangent frame about n, in the world.
+inline glm::dvec3 from_tangent_space(const glm::dvec3& local, const glm::dvec3& n) {
+  const Frame f = tangent_frame(n);
+  return local.x * f.t + local.y * f.bt + local.z * f.n;
 }
 
 }  // namespace vkray::cpu

@@ -27,11 +27,12 @@ Mapping (vkray's docs/scene-format.md and docs/rendering.md):
               specular_reflectance); glass -> dielectric(int_ior=ior, ext_ior=1);
               roughconductor -> twosided(roughconductor, distribution 'ggx', sample_visible, alpha
               or alpha_u/alpha_v, specular_reflectance, eta/k, else material 'none': Fresnel 1);
-              roughdielectric -> roughdielectric(distribution 'ggx', sample_visible, alpha,
+              roughdielectric -> roughdielectric(distribution 'ggx', sample_visible, alpha or alpha_u/alpha_v,
               int_ior (default 1.5, not Mitsuba's bk7), ext_ior 1). eta and k go in as 'srgb'
               with unbounded true (Mitsuba's dict reader refuses an 'rgb' value above 1).
-              alpha_u runs along Mitsuba's dp/du (a sphere: around its world z axis; a mesh without
-              UVs: coordinate_system(n)), so anisotropic surfaces agree only where vkray's tangent does;
+              alpha_u runs along Mitsuba's dp/du (a sphere: around its world z axis, as vkray's
+              tangent does; a mesh without UVs: coordinate_system(n), where vkray's tangent still
+              runs around z), so anisotropic meshes agree only where the two tangents do;
               "emission" -> an 'area' emitter on each shape with the material (emits on the
               normal side).
   objects     triangles/mesh are built in memory with the transform applied (M = T Rz Ry Rx S or
@@ -199,23 +200,27 @@ def make_mesh(mi, name, positions, faces, normals, props):
 
 # ---- the conversion ------------------------------------------------------------------------------
 
-def rough_conductor(m, where):
-    """Mitsuba's roughconductor (one-sided: the caller wraps it in twosided) for a vkray material."""
-    b = {"type": "roughconductor", "distribution": "ggx", "sample_visible": True,
-         "specular_reflectance": {"type": "rgb", "value": m.get("specular_reflectance", [1.0, 1.0, 1.0])}}
+def roughness(m, where):
+    """A rough material's GGX roughness as Mitsuba's keys: alpha (default 0.1), or alpha_u and alpha_v."""
     if "alpha_u" in m or "alpha_v" in m:
         if "alpha" in m or "alpha_u" not in m or "alpha_v" not in m:
             raise ValueError(f"{where}: give either alpha or both alpha_u and alpha_v")
-        b.update(alpha_u=float(m["alpha_u"]), alpha_v=float(m["alpha_v"]))
-    else:
-        b["alpha"] = float(m.get("alpha", 0.1))
-    if ("eta" in m) != ("k" in m):
-        raise ValueError(f"{where}: give both eta and k, or neither (then the Fresnel term is 1)")
-    if "eta" in m:
-        # An 'rgb' dict is read as a reflectance and refused above 1; 'srgb' with unbounded is how
-        # Mitsuba's own XML reader and its material presets pass an index in RGB variants.
-        for key in ("eta", "k"):
-            b[key] = {"type": "srgb", "color": [float(x) for x in vec3(m[key], f"{where}/{key}")], "unbounded": True}
+        return {"alpha_u": float(m["alpha_u"]), "alpha_v": float(m["alpha_v"])}
+    return {"alpha": float(m.get("alpha", 0.1))}
+
+
+def rough_conductor(m, where):
+    """Mitsuba's roughconductor (one-sided: the caller wraps it in twosided) for a vkray material."""
+    b = {"type": "roughconductor", "distribution": "ggx", "sample_visible": True,
+         "specular_reflectance": {"type": "rgb", "value": m.get("specular_reflectance", [1.0, 1.0, 1.0])},
+         **roughness(m, where)}
+    if "eta" in m or "k" in m:
+        # eta 0 and k 1 where not given, as in vkray and in Mitsuba. An 'rgb' dict is read as a
+        # reflectance and refused above 1; 'srgb' with unbounded is how Mitsuba's own XML reader and
+        # its material presets pass an index in RGB variants.
+        for key, default in (("eta", 0.0), ("k", 1.0)):
+            value = vec3(m[key], f"{where}/{key}") if key in m else [default] * 3
+            b[key] = {"type": "srgb", "color": [float(x) for x in value], "unbounded": True}
     else:
         b["material"] = "none"
     return b
@@ -308,7 +313,7 @@ def scene_dict(path, overrides=None):
             b = {"type": "twosided", "bsdf": rough_conductor(m, f"{path}: /materials/{name}")}
         elif kind == "roughdielectric":
             b = {"type": "roughdielectric", "distribution": "ggx", "sample_visible": True,
-                 "alpha": float(m.get("alpha", 0.1)), "int_ior": float(m.get("int_ior", 1.5)), "ext_ior": 1.0}
+                 **roughness(m, f"{path}: /materials/{name}"), "int_ior": float(m.get("int_ior", 1.5)), "ext_ior": 1.0}
         else:
             raise ValueError(f"{path}: /materials/{name}/type: unknown material type {kind!r}")
         bsdfs[name] = mi.load_dict(b)  # one instance, shared by every shape with the material
