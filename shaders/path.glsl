@@ -1,8 +1,9 @@
 // The path integrator: the rendering equation by unidirectional path tracing, as Mitsuba 3's `path`.
 // At every vertex that is not a delta (diffuse or glossy), next-event estimation: each point light,
 // one area-light sample and one sample of the background (when it is not black), the last two
-// weighed against BSDF sampling by the power heuristic; then the BSDF picks the next direction. A hit on an emitter (or a miss, on
-// the background) adds its light weighed the same way, or whole after a mirror or glass.
+// weighed against BSDF sampling by the power heuristic; then the BSDF picks the next direction. A
+// hit on an emitter (or a miss, on the background) adds its light weighed the same way, or whole
+// after a mirror or glass.
 // Depth counts as Mitsuba's max_depth does; Russian roulette from rr_depth on.
 #ifndef VKRAY_PATH_GLSL
 #define VKRAY_PATH_GLSL
