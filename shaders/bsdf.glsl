@@ -205,18 +205,22 @@ bool passes_straight_on(Surface s) {
 // f(wo, wi) |n . wi|; 0 for delta BSDFs and directions a lobe does not reach.
 vec3 eval_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return s.albedo * (max(0.0, dot(wi, n)) / PI);
-  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_eval(s, to_tangent_space(wo, n), to_tangent_space(wi, n));
-  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_eval(s, to_tangent_space(wo, n), to_tangent_space(wi, n), front ? s.ior : 1.0 / s.ior);
-  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_eval(s, to_tangent_space(wo, n), to_tangent_space(wi, n));
+  vec3 o = to_tangent_space(wo, n), i = to_tangent_space(wi, n);  // once, for whichever lobe it is
+  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_eval(s, o, i);
+  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC)
+    return dielectric_eval(s, o, i, front ? s.ior : 1.0 / s.ior);
+  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_eval(s, o, i);
   return vec3(0.0);
 }
 
 // The solid-angle density with which sample_bsdf picks wi; 0 for delta BSDFs.
 float pdf_bsdf(Surface s, vec3 wo, vec3 wi, vec3 n, bool front) {
   if (!SCENE_HAS_NON_DIFFUSE || s.material_type == VKRAY_MATERIAL_DIFFUSE) return max(0.0, dot(wi, n)) / PI;
-  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_pdf(s, to_tangent_space(wo, n), to_tangent_space(wi, n));
-  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC) return dielectric_pdf(s, to_tangent_space(wo, n), to_tangent_space(wi, n), front ? s.ior : 1.0 / s.ior);
-  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_pdf(s, to_tangent_space(wo, n), to_tangent_space(wi, n));
+  vec3 o = to_tangent_space(wo, n), i = to_tangent_space(wi, n);
+  if (SCENE_HAS_roughconductor && s.material_type == VKRAY_MATERIAL_ROUGHCONDUCTOR) return conductor_pdf(s, o, i);
+  if (SCENE_HAS_roughdielectric && s.material_type == VKRAY_MATERIAL_ROUGHDIELECTRIC)
+    return dielectric_pdf(s, o, i, front ? s.ior : 1.0 / s.ior);
+  if (SCENE_HAS_metallic_roughness && s.material_type == VKRAY_MATERIAL_METALLIC_ROUGHNESS) return metallic_roughness_pdf(s, o, i);
   return 0.0;
 }
 
