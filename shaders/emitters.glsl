@@ -6,6 +6,7 @@
 #ifndef VKRAY_EMITTERS_GLSL
 #define VKRAY_EMITTERS_GLSL
 
+#include "intersect.glsl"
 #include "resources.glsl"
 #include "shared/sampling.h"
 #include "texture.glsl"
@@ -39,7 +40,7 @@ LightPoint sample_area_light(inout uint stream) {
   } else {
     w = uniform_triangle(u);
     light.position = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
-    light.normal = normalize(cross(b.xyz - a.xyz, c.xyz - a.xyz));
+    light.normal = triangle_normal(a.xyz, b.xyz, c.xyz);
   }
   vec4 emission = texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_EMISSION);
   vec4 density = texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_LIGHT);

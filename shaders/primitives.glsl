@@ -74,7 +74,7 @@ Surface hit_surface(Hit hit, vec3 position) {
     return s;
   }
   vec3 v1 = texelFetch(primitives, base + 1).xyz, v2 = texelFetch(primitives, base + 2).xyz;
-  s.geometric_normal = normalize(cross(v1 - a.xyz, v2 - a.xyz));
+  s.geometric_normal = triangle_normal(a.xyz, v1, v2);
   s.shading_normal = s.geometric_normal;
   bool smooth_normals = (flags & VKRAY_PRIM_SMOOTH) != 0u;
   vec4 albedo_texture = vec4(0.0), emission_texture = vec4(0.0);

@@ -1,4 +1,4 @@
-// The renderer's ray-triangle and ray-sphere routines (shaders/intersect.glsl), run on the device.
+// The renderer's ray-triangle and ray-sphere routines and triangle normals (shaders/intersect.glsl), run on the device.
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -25,6 +25,11 @@ Case triangle(glm::vec3 o, glm::vec3 d, glm::vec3 v0, glm::vec3 v1, glm::vec3 v2
 }
 Case sphere(glm::vec3 o, glm::vec3 d, glm::vec3 center, float radius, float t_min = 1e-4f, float t_max = kFar) {
   return {glm::vec4(o, 0), glm::vec4(glm::normalize(d), 0), glm::vec4(center, radius), {}, {}, glm::vec4(t_min, t_max, 1, 0)};
+}
+
+// The normal of the triangle v0 v1 v2 against the expected unit normal n: the kernel returns their dot product.
+Case normal(glm::vec3 v0, glm::vec3 v1, glm::vec3 v2, glm::vec3 n) {
+  return {{}, glm::vec4(n, 0), glm::vec4(v0, 0), glm::vec4(v1, 0), glm::vec4(v2, 0), glm::vec4(0, 0, 2, 0)};
 }
 
 class IntersectTest : public GpuTest {
@@ -102,6 +107,19 @@ TEST_F(IntersectTest, SharedEdgeHasNoCrack) {
   int cracks = 0;
   for (int i = 0; i < n; ++i) cracks += (t[2 * i] < 0 && t[2 * i + 1] < 0);
   EXPECT_EQ(cracks, 0);
+}
+
+TEST_F(IntersectTest, TriangleNormalsAreUnitAtEveryScale) {
+  // A tilted triangle, so that every component of its cross product is nonzero. At 6e-10 its squared
+  // cross product is near the smallest normal float (a device that flushes subnormals normalizes by
+  // too short a length); at 1e-12 it underflows to 0 and at 1e13 it overflows, on any device.
+  const glm::vec3 v0(0.3f, -0.2f, 0.1f), v1(1.1f, 0.4f, -0.5f), v2(-0.4f, 0.9f, 0.7f);
+  const glm::vec3 n = glm::normalize(glm::cross(glm::dvec3(v1 - v0), glm::dvec3(v2 - v0)));
+  for (const float scale : {1.0f, 6e-10f, 1e-12f, 1e-15f, 1e13f, 1e17f}) {
+    const glm::vec3 offset(scale * 2.0f, -scale, scale * 0.5f);
+    const float agreement = run_one(normal(v0 * scale + offset, v1 * scale + offset, v2 * scale + offset, n));
+    EXPECT_NEAR(agreement, 1.0f, 1e-5f) << "triangle scaled by " << scale;
+  }
 }
 
 TEST_F(IntersectTest, SphereFromOutsideHitsNearSide) {

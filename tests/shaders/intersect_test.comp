@@ -1,4 +1,4 @@
-// Runs the renderer's own intersection routines (shaders/intersect.glsl) on a list of test cases.
+// Runs the renderer's own intersection routines and triangle normals (shaders/intersect.glsl) on a list of test cases.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -16,6 +16,10 @@ void main() {
   if (i >= count) return;
   IntersectCase c = cases[i];
   Ray ray = Ray(c.origin.xyz, c.dir.xyz);
-  t[i] = (c.range.z == 0.0) ? intersect_triangle(ray, ray_shear(ray.dir), c.a.xyz, c.b.xyz, c.c.xyz, c.range.x, c.range.y)
-                            : intersect_sphere(ray, c.a.xyz, c.a.w, c.range.x, c.range.y);
+  if (c.range.z == 0.0)
+    t[i] = intersect_triangle(ray, ray_shear(ray.dir), c.a.xyz, c.b.xyz, c.c.xyz, c.range.x, c.range.y);
+  else if (c.range.z == 1.0)
+    t[i] = intersect_sphere(ray, c.a.xyz, c.a.w, c.range.x, c.range.y);
+  else  // the triangle's normal against the expected one, in dir: 1 when they agree
+    t[i] = dot(triangle_normal(c.a.xyz, c.b.xyz, c.c.xyz), c.dir.xyz);
 }
