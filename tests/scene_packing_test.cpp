@@ -1,7 +1,9 @@
 // The lighting as the shader reads it: radiance scaled by a power of two that keeps the shader's
 // floats in range, and the area lights' sampling densities computed in double.
+#include <bit>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <string>
 
@@ -44,6 +46,15 @@ TEST(ScenePackingTest, ScaledRadianceComesBackBitForBit) {
     EXPECT_EQ(unscale_radiance(glm::vec3(scaled), k).x, v) << v << " " << k;
   }
   EXPECT_EQ(unscale_radiance(glm::vec3(1.0f), -200).x, FLT_MAX);
+  // Bit for bit what ldexp gives, subnormal results and infinities and NaN included.
+  std::uniform_int_distribution<uint32_t> bits;
+  for (int i = 0; i < 100000; ++i) {
+    const float scaled = std::bit_cast<float>(bits(random));
+    const int k = scale(random);
+    const float expected = std::min(std::ldexp(scaled, -k), FLT_MAX);
+    EXPECT_EQ(std::bit_cast<uint32_t>(unscale_radiance(glm::vec3(scaled), k).x), std::bit_cast<uint32_t>(expected))
+        << scaled << " " << k;
+  }
 }
 
 TEST(ScenePackingTest, EveryRadianceIsScaledAlike) {

@@ -292,16 +292,22 @@ bool Renderer::Frame::read_tile_back(const vk::raii::Device& device, uint32_t in
   const TileConstants tile = tile_constants(slots[index % kSlots].rect, index % kSlots, plan.slot_pixels);
   output.invalidate(device);
   const auto* texels = static_cast<const glm::vec4*>(output.mapped) + tile.output_offset;
-  for (uint32_t y = 0; y < tile.height; ++y)
-    for (uint32_t x = 0; x < tile.width; ++x)
-      if (std::bit_cast<uint32_t>(texels[size_t(y) * tile.width + x].w) & VKRAY_LOOPS_CUT_SHORT) return false;
-  const int radiance_exponent = scene->lighting().radiance_exponent;  // the shader's radiance is scaled
-  for (uint32_t y = 0; y < tile.height; ++y)
+  const RadianceUnscale unscale(scene->lighting().radiance_exponent);  // the shader's radiance is scaled
+  // One pass: a tile whose loops were cut short is traced again, and what it left here is overwritten.
+  uint64_t tile_rays = 0;
+  uint32_t cut_short = 0;
+  for (uint32_t y = 0; y < tile.height; ++y) {
+    const glm::vec4* row = texels + size_t(y) * tile.width;
+    glm::vec3* out = &result.at(tile.x0 - region.x0, tile.y0 - region.y0 + y);
     for (uint32_t x = 0; x < tile.width; ++x) {
-      const glm::vec4& texel = texels[size_t(y) * tile.width + x];
-      result.at(tile.x0 - region.x0 + x, tile.y0 - region.y0 + y) = unscale_radiance(glm::vec3(texel), radiance_exponent);
-      rays += std::bit_cast<uint32_t>(texel.w);
+      const uint32_t count = std::bit_cast<uint32_t>(row[x].w);
+      out[x] = unscale(glm::vec3(row[x]));
+      tile_rays += count;
+      cut_short |= count & VKRAY_LOOPS_CUT_SHORT;
     }
+  }
+  if (cut_short != 0) return false;
+  rays += tile_rays;
   if (aovs) {
     aov_output.invalidate(device);
     const auto* first_hits = static_cast<const FirstHitTexels*>(aov_output.mapped) + tile.output_offset;

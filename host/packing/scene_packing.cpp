@@ -276,11 +276,7 @@ int radiance_exponent(const Scene& scene) {
   return 20 - exponent;
 }
 
-glm::vec3 unscale_radiance(glm::vec3 scaled, int radiance_exponent) {
-  glm::vec3 out;
-  for (int c = 0; c < 3; ++c) out[c] = std::min(std::ldexp(scaled[c], -radiance_exponent), FLT_MAX);
-  return out;
-}
+glm::vec3 unscale_radiance(glm::vec3 scaled, int radiance_exponent) { return RadianceUnscale(radiance_exponent)(scaled); }
 
 PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& order) {
   PackedLighting packed;

@@ -2,6 +2,9 @@
 // and the tile constants' row order. No Vulkan here, so it is testable without a device.
 #pragma once
 
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -32,7 +35,23 @@ struct LightingFrame {
 int radiance_exponent(const Scene& scene);
 
 // The shader's radiance back in the scene's units: `scaled` times 2^-radiance_exponent, exactly,
-// with values past the largest float held at it.
+// with values past the largest float held at it. A float times a power of two is exact in a double
+// and rounds once on the way back to float, as ldexp does; the factor is made once, since reading
+// an image back runs this for every pixel (three ldexp calls a pixel held a GPU's read back to
+// 50 Mpixels/s).
+class RadianceUnscale {
+ public:
+  explicit RadianceUnscale(int radiance_exponent) : factor_(std::ldexp(1.0, -radiance_exponent)) {}
+  glm::vec3 operator()(glm::vec3 scaled) const {
+    glm::vec3 out;
+    for (int c = 0; c < 3; ++c) out[c] = float(std::min(double(scaled[c]) * factor_, double(FLT_MAX)));
+    return out;
+  }
+
+ private:
+  double factor_;
+};
+
 glm::vec3 unscale_radiance(glm::vec3 scaled, int radiance_exponent);
 
 // The buffers that depend on the primitives alone (same_geometry), which a scene whose camera,
