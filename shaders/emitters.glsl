@@ -48,9 +48,10 @@ LightPoint sample_area_light(inout uint stream) {
   light.pdf_area = density.x;
   light.radiance = emission.rgb;
   if (SCENE_HAS_TEXTURES) {
-    vec4 emission_texture = texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_EMISSION_TEXTURE);
+    int slot = material_texel(primitive_material(flags)) + VKRAY_MATERIAL_EMISSION_TEXTURE;
+    vec4 emission_texture = texelFetch(materials, slot);
     bool sphere = SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u;  // spheres have no texture coordinates
-    if (!sphere && has_texture(emission_texture)) light.radiance *= sample_texture(emission_texture, triangle_texcoord(prim, w.yz));
+    if (!sphere && has_texture(emission_texture)) light.radiance *= sample_texture(emission_texture, slot, triangle_texcoord(prim, w.yz));
   }
   return light;
 }

@@ -77,12 +77,13 @@ Surface hit_surface(Hit hit, vec3 position) {
   s.geometric_normal = triangle_normal(a.xyz, v1, v2);
   s.shading_normal = s.geometric_normal;
   bool smooth_normals = (flags & VKRAY_PRIM_SMOOTH) != 0u;
-  vec4 albedo_texture = vec4(0.0), emission_texture = vec4(0.0);
+  vec4 albedo_texture = vec4(0.0), emission_texture = vec4(0.0), layers_texture = vec4(0.0);
   if (SCENE_HAS_TEXTURES) {
     albedo_texture = texelFetch(materials, material + VKRAY_MATERIAL_ALBEDO_TEXTURE);
     emission_texture = texelFetch(materials, material + VKRAY_MATERIAL_EMISSION_TEXTURE);
+    if (SCENE_HAS_metallic_roughness) layers_texture = texelFetch(materials, material + VKRAY_MATERIAL_LAYERS_TEXTURE);
   }
-  bool textured = SCENE_HAS_TEXTURES && (has_texture(albedo_texture) || has_texture(emission_texture));
+  bool textured = SCENE_HAS_TEXTURES && (has_texture(albedo_texture) || has_texture(emission_texture) || has_texture(layers_texture));
   if (!smooth_normals && !textured) return s;
   vec2 b = triangle_barycentrics(position, a.xyz, v1, v2);
   if (smooth_normals)
@@ -90,8 +91,13 @@ Surface hit_surface(Hit hit, vec3 position) {
                                  b.y * texelFetch(normals, base + 2).xyz);
   if (textured) {
     vec2 uv = triangle_texcoord(hit.prim, b);
-    if (has_texture(albedo_texture)) s.albedo *= sample_texture(albedo_texture, uv);
-    if (has_texture(emission_texture)) s.emission *= sample_texture(emission_texture, uv);
+    if (has_texture(albedo_texture)) s.albedo *= sample_texture(albedo_texture, material + VKRAY_MATERIAL_ALBEDO_TEXTURE, uv);
+    if (has_texture(emission_texture)) s.emission *= sample_texture(emission_texture, material + VKRAY_MATERIAL_EMISSION_TEXTURE, uv);
+    if (has_texture(layers_texture)) {  // glTF's metallicRoughnessTexture: metalness in blue, roughness in green
+      vec3 layers = sample_texture(layers_texture, material + VKRAY_MATERIAL_LAYERS_TEXTURE, uv);
+      s.metallic *= layers.b;
+      s.roughness *= layers.g;
+    }
   }
   return s;
 }

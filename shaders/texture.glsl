@@ -29,9 +29,15 @@ vec3 texture_fetch(TextureHeader t, int x, int y) {
   return texelFetch(textures, int(t.first + uint(y) * t.width + uint(x))).rgb;
 }
 
-// The texture a material texel names (texture_texel), at texture coordinate uv.
-vec3 sample_texture(vec4 header_texel, vec2 uv) {
+// The texture of the material's texture slot whose first texel (the header, texture_texel) is
+// header_texel, at index `slot` in the materials buffer, at the primitive's texture coordinate uv:
+// mapped by the slot's transform first where the header says it has one.
+vec3 sample_texture(vec4 header_texel, int slot, vec2 uv) {
   TextureHeader t = texture_header(header_texel);
+  if (texture_transformed(t.mode)) {
+    vec3 p = vec3(uv, 1.0);
+    uv = vec2(dot(texelFetch(materials, slot + 1).xyz, p), dot(texelFetch(materials, slot + 2).xyz, p));
+  }
   uint wrap_s = texture_wrap_s(t.mode), wrap_t = texture_wrap_t(t.mode);
   int width = int(t.width), height = int(t.height);
   float x = reduce_coordinate(uv.x, wrap_s) * float(width), y = reduce_coordinate(uv.y, wrap_t) * float(height);

@@ -200,14 +200,109 @@ TEST(GltfTest, MaterialsKeepTheirColourAndEmissionAndNameWhatIsNotRendered) {
   EXPECT_EQ(s.materials[0].emission, glm::vec3(4, 2, 1));
   EXPECT_TRUE(s.materials[0].emission_texture.present());
   EXPECT_EQ(s.materials[1].albedo, glm::vec3(0.2f, 0.3f, 0.4f));
-  EXPECT_EQ(s.materials[1].type, MaterialType::diffuse);
+  EXPECT_EQ(s.materials[1].type, MaterialType::metallic_roughness);
+  EXPECT_EQ(s.materials[1].metallic, 1.0f);
+  EXPECT_EQ(s.materials[1].roughness, 1.0f);  // glTF's default
   EXPECT_EQ(s.triangles.size(), 6u);
   std::string all;
   for (const auto& w : s.warnings) all += w + "\n";
-  EXPECT_EQ(s.warnings.size(), 3u) << all;  // once each, though two quads use the material
-  EXPECT_NE(all.find("materials[0]: metalness and roughness are not rendered"), std::string::npos) << all;
+  EXPECT_EQ(s.warnings.size(), 2u) << all;  // once each, though two quads use the material
   EXPECT_NE(all.find("alphaMode MASK is not rendered"), std::string::npos) << all;
   EXPECT_NE(all.find("normal textures are not rendered"), std::string::npos) << all;
+}
+
+TEST(GltfTest, MaterialsAreGltfsMetallicRoughnessModelWithTheirFactorsAndIor) {
+  GltfBuilder b;
+  const int plastic = b.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.1, 0.1, 1}}, {"metallicFactor", 0}, {"roughnessFactor", 0.25}}},
+                                  {"extensions", {{"KHR_materials_ior", {{"ior", 1.33}}}}}});
+  const int mirror_like = b.material({{"pbrMetallicRoughness", {{"metallicFactor", 1}, {"roughnessFactor", 0}}},
+                                      {"extensions", {{"KHR_materials_ior", {{"ior", 0}}}}}});
+  b.quad(plastic);
+  b.quad(mirror_like);
+  b.doc["extensionsUsed"] = {"KHR_materials_ior"};
+  b.doc["extensionsRequired"] = {"KHR_materials_ior"};
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.materials.size(), 2u);
+  EXPECT_EQ(s.materials[0].type, MaterialType::metallic_roughness);
+  EXPECT_EQ(s.materials[0].albedo, glm::vec3(0.8f, 0.1f, 0.1f));
+  EXPECT_EQ(s.materials[0].metallic, 0.0f);
+  EXPECT_EQ(s.materials[0].roughness, 0.25f);
+  EXPECT_EQ(s.materials[0].ior, 1.33f);
+  EXPECT_EQ(s.materials[1].metallic, 1.0f);
+  EXPECT_EQ(s.materials[1].roughness, 0.0f);
+  EXPECT_EQ(s.materials[1].ior, 0.0f);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  {
+    GltfBuilder bad = textured_quad();
+    bad.doc["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1.5;
+    expect_error(bad, "materials[0].pbrMetallicRoughness.metallicFactor: expected a number from 0 to 1");
+  }
+  {
+    GltfBuilder bad = textured_quad();
+    bad.doc["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 0.5;
+    expect_error(bad, "materials[0].extensions.KHR_materials_ior.ior: expected 0 or an index of refraction from 1 to 100");
+    bad.doc["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = "glass";
+    expect_error(bad, "materials[0].extensions.KHR_materials_ior.ior: expected 0 or an index of refraction from 1 to 100");
+  }
+}
+
+TEST(GltfTest, AMetallicRoughnessTextureIsLinearDataWhereTheSamePictureAsBaseColourIsSrgb) {
+  // One grey picture, 128 of 255, used as both textures: as base colour it decodes from sRGB (0.216),
+  // as metallic-roughness it is data (128 / 255), and the two are decoded once each.
+  GltfBuilder b;
+  const int picture = b.texture(test::png_bytes({1, 1, {128, 128, 128}}));
+  b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", picture}}},
+                                               {"metallicRoughnessTexture", {{"index", picture}}}}}}));
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.materials.size(), 1u);
+  const Material& m = s.materials[0];
+  ASSERT_TRUE(m.albedo_texture.present());
+  ASSERT_TRUE(m.metallic_roughness_texture.present());
+  ASSERT_NE(m.albedo_texture.texture, m.metallic_roughness_texture.texture);
+  ASSERT_EQ(s.textures.size(), 2u);
+  EXPECT_NEAR(s.textures[size_t(m.albedo_texture.texture)]->texel(0, 0).g, 0.2158f, 1e-3f);
+  EXPECT_NEAR(s.textures[size_t(m.metallic_roughness_texture.texture)]->texel(0, 0).g, 128.0f / 255.0f, 1e-3f);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+}
+
+TEST(GltfTest, TextureTransformsMapTheTextureCoordinate) {
+  // KHR_texture_transform: u' = sx u cos r + sy v sin r + ox, v' = sy v cos r - sx u sin r + oy
+  // (the rotation counter-clockwise in the picture, as the extension's sample model shows it), and
+  // its texCoord chooses the set.
+  GltfBuilder b;
+  const int picture = b.texture(test::png_bytes(test::four_colours()));
+  b.quad(b.material({{"pbrMetallicRoughness",
+                      {{"baseColorTexture", {{"index", picture},
+                                             {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0.25}},
+                                                                                        {"rotation", 1.5707963267948966},
+                                                                                        {"scale", {2, 3}}}}}}}},
+                       {"metallicRoughnessTexture", {{"index", picture}, {"texCoord", 1},
+                                                     {"extensions", {{"KHR_texture_transform", {{"texCoord", 0}}}}}}}}}}));
+  b.doc["extensionsUsed"] = {"KHR_texture_transform"};
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.materials.size(), 1u);
+  const TextureRef& t = s.materials[0].albedo_texture;
+  EXPECT_TRUE(t.transformed());
+  const glm::dvec2 mapped = t.map({0.1, 0.2});  // cos = 0, sin = 1: u' = 3 v + 0.5, v' = -2 u + 0.25
+  EXPECT_NEAR(mapped.x, 3 * 0.2 + 0.5, 1e-6);
+  EXPECT_NEAR(mapped.y, -2 * 0.1 + 0.25, 1e-6);
+  EXPECT_FALSE(s.materials[0].metallic_roughness_texture.transformed());  // only texCoord: the identity
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];  // the texCoord sets agree: 0 for both
+  {
+    GltfBuilder bad = textured_quad();
+    bad.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["scale"] = {1};
+    expect_error(bad, "baseColorTexture.extensions.KHR_texture_transform.scale: expected two numbers, got 1");
+  }
+  {
+    GltfBuilder bad = textured_quad();
+    bad.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["rotation"] = "half";
+    expect_error(bad, "KHR_texture_transform.rotation: expected a number of at most 1e6 in magnitude");
+  }
+  {
+    GltfBuilder bad = textured_quad();
+    bad.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"]["texCoord"] = -1;
+    expect_error(bad, "KHR_texture_transform.texCoord: expected a whole number of at least 0");
+  }
 }
 
 TEST(GltfTest, BrokenFilesNameTheElement) {

@@ -11,6 +11,8 @@
 
 #include "load/scene_loader.h"
 #include "support/parity_run.h"
+#include "support/temp_dir.h"
+#include "support/test_assets.h"
 
 namespace vkray::test {
 namespace {
@@ -89,6 +91,26 @@ TEST_F(FurnaceTest, AWhiteGltfMetalIsAWhiteRoughConductorOfAlphaRoughnessSquared
                  "indices": [[0, 2, 1], [0, 3, 2]]}]})";
   const Scene scene = parse_scene(json, "furnace.json");
   const double expected = ggx_albedo(alpha, 1.0);
+  for (const bool cpu : {false, true})
+    EXPECT_NEAR(image_mean(render(scene, {16, 16, 256}, {}, cpu)).g, expected, 0.01 * expected) << (cpu ? "CPU" : "GPU");
+}
+
+TEST_F(FurnaceTest, AGltfMetalTexturedToHalfRoughnessIsTheUntexturedOne) {
+  // The same furnace, the roughness now from a metallic-roughness texture: one texel of green 128
+  // (roughness 128 / 255, linear data) and blue 255 (metal), factors 1. Its channels exchanged, or
+  // the texel decoded from sRGB, the plane would reflect another albedo.
+  TempDir dir;
+  write_file(dir.path() / "plane.obj", "v -100 0 -100\nv 100 0 -100\nv 100 0 100\nv -100 0 100\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                       "f 1/1 3/3 2/2\nf 1/1 4/4 3/3\n");
+  write_file(dir.path() / "layers.png", png_bytes({1, 1, {0, 128, 255}}));
+  write_file(dir.path() / "furnace.json", R"({
+    "camera": {"position": [0, 1, -1e-4], "look_at": [0, 0, 0], "up": [0, 0, 1], "vertical_fov": 0.5},
+    "integrator": {"type": "path"},
+    "background": [1, 1, 1],
+    "materials": {"metal": {"type": "metallic_roughness", "base_color": [1, 1, 1], "metallic_roughness_texture": "layers.png"}},
+    "objects": [{"type": "mesh", "file": "plane.obj", "material": "metal"}]})");
+  const Scene scene = load_scene(dir.path() / "furnace.json");
+  const double roughness = 128.0 / 255.0, expected = ggx_albedo(roughness * roughness, 1.0);
   for (const bool cpu : {false, true})
     EXPECT_NEAR(image_mean(render(scene, {16, 16, 256}, {}, cpu)).g, expected, 0.01 * expected) << (cpu ? "CPU" : "GPU");
 }
@@ -233,6 +255,35 @@ class GltfDiffuseWithoutFresnel : public BrokenMetallicRoughness {
                                 "vec3 dielectric = s.albedo / PI + vec3(fresnel * specular);") {}
 };
 TEST_F(GltfDiffuseWithoutFresnel, IsCaught) { expect_caught("direct"); }
+
+// ---- ... in its textures (checks/metallic-roughness-textured-*.json) --------------------------------------
+class BrokenMetallicRoughnessTexture : public BrokenMaterialShader {
+ protected:
+  BrokenMetallicRoughnessTexture(const std::string& good, const std::string& bad)
+      : BrokenMaterialShader("metallic-roughness-textured", "primitives.glsl", good, bad) {}
+};
+
+class GltfTextureChannelsExchanged : public BrokenMetallicRoughnessTexture {
+ protected:
+  // glTF packs metalness in blue and roughness in green; read the other way round, the bands trade.
+  GltfTextureChannelsExchanged()
+      : BrokenMetallicRoughnessTexture("s.metallic *= layers.b;\n      s.roughness *= layers.g;",
+                                       "s.metallic *= layers.g;\n      s.roughness *= layers.b;") {}
+};
+TEST_F(GltfTextureChannelsExchanged, IsCaught) {
+  expect_caught("direct");
+  expect_caught("path");
+}
+
+class GltfRoughnessTextureIgnored : public BrokenMetallicRoughnessTexture {
+ protected:
+  // The roughnessFactor everywhere: every band as rough as the roughest.
+  GltfRoughnessTextureIgnored() : BrokenMetallicRoughnessTexture("s.roughness *= layers.g;", "s.roughness *= 1.0;") {}
+};
+TEST_F(GltfRoughnessTextureIgnored, IsCaught) {
+  expect_caught("direct");
+  expect_caught("path");
+}
 
 // ---- ... and in the rough dielectric's (checks/rough-dielectrics-*.json) --------------------------------
 class BrokenDielectric : public BrokenMaterialShader {

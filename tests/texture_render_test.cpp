@@ -118,8 +118,22 @@ TEST_F(UpsideDownTextureTest, FailsParity) {
   EXPECT_GT(r.metrics.interior_over_1, 100u);
 }
 
+// A shader that ignores KHR_texture_transform (the texture read at the primitive's own coordinate)
+// must fail parity on the Khronos model made to show it.
+class TextureTransformIgnoredTest : public BrokenShaderParityTest {
+ protected:
+  TextureTransformIgnoredTest() : BrokenShaderParityTest("texture.glsl", "if (texture_transformed(t.mode)) {", "if (false) {") {}
+};
+
+TEST_F(TextureTransformIgnoredTest, FailsParity) {
+  const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "gltf/TextureTransformTest/glTF/TextureTransformTest.gltf");
+  const ParityResult r = run(scene, {96, 96, 1});
+  EXPECT_FALSE(r.metrics.pass);
+}
+
 // Every shipped glTF sample model, as the scene it makes by itself, renders alike on both
-// renderers: their textures (PNG with a palette, a progressive JPEG), samplers and hierarchies.
+// renderers: their textures (PNG with a palette, a progressive JPEG), samplers, texture transforms,
+// materials and hierarchies.
 class ShippedModelTest : public ParityTest, public ::testing::WithParamInterface<const char*> {};
 
 TEST_P(ShippedModelTest, HoldsParity) {
@@ -132,7 +146,9 @@ INSTANTIATE_TEST_SUITE_P(Khronos, ShippedModelTest,
                          ::testing::Values("BoxTextured/glTF/BoxTextured.gltf", "BoxTextured/glTF-Binary/BoxTextured.glb",
                                            "BoxTextured/glTF-Embedded/BoxTextured.gltf", "CesiumMilkTruck/glTF/CesiumMilkTruck.gltf",
                                            "TextureSettingsTest/glTF/TextureSettingsTest.gltf",
-                                           "TextureCoordinateTest/glTF/TextureCoordinateTest.gltf", "Cameras/glTF/Cameras.gltf"),
+                                           "TextureCoordinateTest/glTF/TextureCoordinateTest.gltf", "Cameras/glTF/Cameras.gltf",
+                                           "TextureTransformTest/glTF/TextureTransformTest.gltf",
+                                           "MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb"),
                          [](const auto& p) {
                            std::string name = std::filesystem::path(p.param).parent_path().string();
                            for (char& c : name)

@@ -430,6 +430,35 @@ TEST_F(ObjMaterialTest, RepeatingCoordinatesAreMovedNearZeroWholePeriodsAtATime)
   EXPECT_NE(past.find("far.obj:4: texture coordinate"), std::string::npos) << past;
 }
 
+TEST_F(ObjMaterialTest, SceneFileMetallicRoughnessTexturesAreSrgbColourAndLinearData) {
+  // glTF's rule in a scene file: the base colour from sRGB, metallic (blue) and roughness (green) as
+  // stored. One grey picture as both: two textures.
+  write("quad.obj", kTexturedQuad);
+  write("quad.mtl", "newmtl checker\nnewmtl plain\n");
+  test::write_file(dir_ / "grey.png", test::png_bytes({1, 1, {128, 128, 128}}));
+  write("scene.json", R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "vertical_fov": 40},
+                          "materials": {"gltf": {"type": "metallic_roughness", "base_color_texture": "grey.png",
+                                                 "metallic_roughness_texture": "grey.png"}},
+                          "objects": [{"type": "mesh", "file": "quad.obj", "material": "gltf"}]})");
+  const Scene scene = load_scene(dir_ / "scene.json");
+  ASSERT_EQ(scene.materials.size(), 1u);
+  const Material& m = scene.materials[0];
+  ASSERT_TRUE(m.albedo_texture.present() && m.metallic_roughness_texture.present());
+  EXPECT_NEAR(scene.textures[size_t(m.albedo_texture.texture)]->texel(0, 0).g, 0.2158f, 1e-3f);
+  EXPECT_NEAR(scene.textures[size_t(m.metallic_roughness_texture.texture)]->texel(0, 0).b, 128.0f / 255.0f, 1e-3f);
+  const gpu::PackedLighting packed = gpu::pack_lighting(scene, {0, 1});
+  const gpu::TextureHeader h = gpu::texture_header(packed.materials[VKRAY_MATERIAL_LAYERS_TEXTURE]);
+  EXPECT_EQ(h.width, 1u);
+  EXPECT_EQ(h.first, 1u);  // after the base colour's one texel
+
+  write("scene.json", R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "vertical_fov": 40},
+                          "materials": {"gltf": {"type": "metallic_roughness", "metallic_roughness_texture": "gone.png"}},
+                          "objects": [{"type": "mesh", "file": "quad.obj", "material": "gltf"}]})");
+  const std::string gone = error_of([&] { load_scene(dir_ / "scene.json"); });
+  EXPECT_NE(gone.find("/materials/gltf/metallic_roughness_texture"), std::string::npos) << gone;
+  EXPECT_NE(gone.find("gone.png"), std::string::npos) << gone;
+}
+
 TEST_F(ObjMaterialTest, WhatIsNotRenderedIsNamedOnce) {
   write("quad.obj", kTexturedQuad);
   write("quad.mtl", "newmtl checker\nd 0.5\nmap_Bump b.png\nbump b.png\nnewmtl plain\nd 0.3\n");

@@ -11,7 +11,7 @@ namespace vkray::cpu {
 using glm::dvec2;
 using glm::dvec3;
 
-Bsdf bsdf_of(const Material& material, const dvec3& color) {
+Bsdf bsdf_of(const Material& material, const dvec3& color, double metallic, double roughness) {
   Bsdf b;
   b.type = material.type;
   b.properties = material.properties();
@@ -20,8 +20,8 @@ Bsdf bsdf_of(const Material& material, const dvec3& color) {
   b.alpha = dvec2(material.alpha);
   b.eta = dvec3(material.eta);
   b.k = dvec3(material.k);
-  b.metallic = material.metallic;
-  b.roughness = material.roughness;
+  b.metallic = metallic;
+  b.roughness = roughness;
   return b;
 }
 

@@ -28,8 +28,13 @@ struct Bsdf {
   bool has(uint32_t property) const { return (properties & property) != 0; }
 };
 
-// The BSDF of `material` where its colour, textures applied, is `color`.
-Bsdf bsdf_of(const Material& material, const glm::dvec3& color);
+// The BSDF of `material` where its colour, textures applied, is `color`, and (metallic_roughness)
+// its metallic and roughness are `metallic` and `roughness`, its texture applied.
+Bsdf bsdf_of(const Material& material, const glm::dvec3& color, double metallic, double roughness);
+// ... where nothing is textured.
+inline Bsdf bsdf_of(const Material& material, const glm::dvec3& color) {
+  return bsdf_of(material, color, material.metallic, material.roughness);
+}
 
 struct BsdfSample {
   glm::dvec3 dir;             // unit, away from the surface

@@ -51,7 +51,7 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
     const dvec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
     const dvec3 n = front ? s.shading_normal : -s.shading_normal;
     if (front) radiance += throughput * s.emission;
-    const Bsdf bsdf = bsdf_of(material, s.albedo);
+    const Bsdf bsdf = bsdf_of(material, s.albedo, s.metallic, s.roughness);
     if (!bsdf.has(VKRAY_BSDF_DELTA) && !passes_straight_on(bsdf)) {
       radiance += throughput * shade(tracer, lights, s, bsdf, -ray.dir, front, n, n_geometric, state, bounce == 0);
       break;

@@ -53,7 +53,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     const dvec3 n = front ? s.shading_normal : -s.shading_normal;
     const dvec3 x = s.position;
     const dvec3 origin = x + epsilon * n_geometric;
-    const Bsdf bsdf = bsdf_of(material, s.albedo);
+    const Bsdf bsdf = bsdf_of(material, s.albedo, s.metallic, s.roughness);
     const dvec3 wo = -ray.dir;
     if (!bsdf.has(VKRAY_BSDF_DELTA)) {
       // Next-event estimation: each term f cos times the light over its density, weighed against BSDF sampling.

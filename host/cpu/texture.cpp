@@ -40,9 +40,10 @@ double texel_coordinate(double u, int64_t size, TextureWrap mode) {
 
 }  // namespace
 
-glm::dvec3 sample_texture(const Scene& scene, const TextureRef& ref, const glm::dvec2& uv) {
+glm::dvec3 sample_texture(const Scene& scene, const TextureRef& ref, const glm::dvec2& primitive_uv) {
   const Texture& t = *scene.textures[size_t(ref.texture)];
   const int64_t w = t.width, h = t.height;
+  const glm::dvec2 uv = ref.map(primitive_uv);
   const double x = texel_coordinate(uv.x, w, ref.wrap_s), y = texel_coordinate(uv.y, h, ref.wrap_t);
   const auto at = [&](int64_t i, int64_t j) {
     return glm::dvec3(t.texel(uint32_t(wrap(i, w, ref.wrap_s)), uint32_t(wrap(j, h, ref.wrap_t))));

@@ -127,10 +127,17 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
     const Material& m = scene_.materials[tri.material];
     s.albedo = dvec3(m.albedo);
     s.emission = dvec3(m.emission);
+    s.metallic = m.metallic;
+    s.roughness = m.roughness;
     if (m.textured()) {
       const glm::dvec2 uv = (1 - hit.u - hit.v) * glm::dvec2(tri.uv[0]) + hit.u * glm::dvec2(tri.uv[1]) + hit.v * glm::dvec2(tri.uv[2]);
       if (m.albedo_texture.present()) s.albedo *= sample_texture(scene_, m.albedo_texture, uv);
       if (m.emission_texture.present()) s.emission *= sample_texture(scene_, m.emission_texture, uv);
+      if (m.metallic_roughness_texture.present()) {  // metalness in blue, roughness in green
+        const dvec3 layers = sample_texture(scene_, m.metallic_roughness_texture, uv);
+        s.metallic *= layers.b;
+        s.roughness *= layers.g;
+      }
     }
   } else {
     const Sphere& sphere = scene_.spheres[size_t(hit.primitive) - scene_.triangles.size()];
@@ -138,8 +145,11 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
     if (sphere.inward) s.geometric_normal = -s.geometric_normal;
     s.shading_normal = s.geometric_normal;
     s.material = sphere.material;
-    s.albedo = dvec3(scene_.materials[sphere.material].albedo);
-    s.emission = dvec3(scene_.materials[sphere.material].emission);
+    const Material& m = scene_.materials[sphere.material];
+    s.albedo = dvec3(m.albedo);
+    s.emission = dvec3(m.emission);
+    s.metallic = m.metallic;
+    s.roughness = m.roughness;
   }
   return s;
 }

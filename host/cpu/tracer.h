@@ -36,6 +36,8 @@ struct SurfacePoint {
   uint32_t material = 0;
   dvec3 albedo{0.0};    // the material's albedo (or reflectance), its texture applied
   dvec3 emission{0.0};  // the material's emission, its texture applied
+  double metallic = 1;   // metallic_roughness: the material's metallic and roughness, its texture applied
+  double roughness = 1;
 };
 
 class Tracer {

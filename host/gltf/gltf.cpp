@@ -28,7 +28,8 @@ using glm::dmat4;
 using glm::dvec3;
 
 // Extensions whose content vkray reads; a file that requires any other is refused.
-const std::set<std::string> kReadExtensions = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+const std::set<std::string> kReadExtensions = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior",
+                                               "KHR_texture_transform"};
 
 std::string element(const char* array, size_t index) { return std::string(array) + "[" + std::to_string(index) + "]"; }
 
@@ -162,8 +163,8 @@ class GltfReader {
   void add_mesh(size_t mesh_index, const dmat4& world);
   void add_primitive(const tinygltf::Primitive& p, const std::string& where, const dmat4& world);
   uint32_t material(int index, const std::string& where);
-  TextureRef texture(const tinygltf::TextureInfo& info, const std::string& where);
-  int32_t image_texture(int image, const std::string& where);
+  TextureRef texture(const tinygltf::TextureInfo& info, const std::string& where, bool srgb);
+  int32_t image_texture(int image, const std::string& where, bool srgb);
   void add_camera(size_t node, const dmat4& world);
   void add_light(size_t node, const dmat4& world);
 
@@ -174,11 +175,22 @@ class GltfReader {
   std::set<std::string> warned_;
   std::map<int, uint32_t> materials_;     // glTF material (-1: the default) -> scene_.materials
   std::map<int, int> texcoord_sets_;      // glTF material -> the TEXCOORD_n its textures use
-  std::map<int, int32_t> image_textures_;  // glTF image -> scene_.textures
-  std::map<std::string, int32_t> sources_;  // where a picture's bytes are ("view 3", "file /x/y.png") -> scene_.textures
+  // A picture is decoded once for each way it is read: as sRGB colour, or as linear data.
+  std::map<std::pair<int, bool>, int32_t> image_textures_;  // (glTF image, sRGB) -> scene_.textures
+  std::map<std::pair<std::string, bool>, int32_t> sources_;  // (where its bytes are: "view 3", "file /x/y.png"; sRGB) -> scene_.textures
   uint64_t texels_ = 0;                     // in scene_.textures so far
   bool camera_found_ = false;
 };
+
+// The texture coordinate set a texture reads: KHR_texture_transform's texCoord overrides the
+// textureInfo's where it gives one (GltfReader::texture checks that it is a whole number).
+int texcoord_of(const tinygltf::TextureInfo& info) {
+  if (const auto ext = info.extensions.find("KHR_texture_transform"); ext != info.extensions.end()) {
+    const tinygltf::Value& set = ext->second.Get("texCoord");
+    if (set.IsInt()) return set.GetNumberAsInt();
+  }
+  return info.texCoord;
+}
 
 bool GltfReader::check_glb(std::string_view bytes) const {
   // The 12-byte header, then chunks of (length, type, data): JSON first, BIN optionally second.
@@ -496,7 +508,8 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
 uint32_t GltfReader::material(int index, const std::string& where) {
   if (const auto found = materials_.find(index); found != materials_.end()) return found->second;
   Material m;
-  if (index < 0) {  // glTF's default material: white, fully rough
+  m.type = MaterialType::metallic_roughness;  // glTF's own, with its defaults (Material's too): metallic 1, roughness 1
+  if (index < 0) {  // glTF's default material: white, metallic, fully rough
     m.name = file_.filename().string() + ": default material";
     m.albedo = glm::vec3(1.0f);
   } else {
@@ -514,6 +527,20 @@ uint32_t GltfReader::material(int index, const std::string& where) {
     };
     const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
     m.albedo = colour(pbr.baseColorFactor, 4, "pbrMetallicRoughness.baseColorFactor", 1.0);
+    const auto factor = [&](double value, const std::string& key) {
+      if (!(value >= 0.0 && value <= 1.0)) fail(name + "." + key, "expected a number from 0 to 1, got " + brief(nlohmann::json(value)));
+      return float(value);
+    };
+    m.metallic = factor(pbr.metallicFactor, "pbrMetallicRoughness.metallicFactor");
+    m.roughness = factor(pbr.roughnessFactor, "pbrMetallicRoughness.roughnessFactor");
+    if (const auto ior = g.extensions.find("KHR_materials_ior"); ior != g.extensions.end()) {
+      const tinygltf::Value& v = ior->second.Get("ior");
+      const double value = v.IsNumber() ? v.GetNumberAsDouble() : v.Type() == tinygltf::NULL_TYPE ? 1.5 : std::nan("");
+      // 1 and more, or exactly 0 (the extension's schema): F0 = ((ior - 1) / (ior + 1))^2 is then 1.
+      if (!(value == 0.0 || (value >= 1.0 && value <= double(kMaxIor))))
+        fail(name + ".extensions.KHR_materials_ior.ior", "expected 0 or an index of refraction from 1 to 100");
+      m.ior = float(value);
+    }
     m.emission = colour(g.emissiveFactor, 3, "emissiveFactor", FLT_MAX);
     if (const auto strength = g.extensions.find("KHR_materials_emissive_strength"); strength != g.extensions.end()) {
       const tinygltf::Value& v = strength->second.Get("emissiveStrength");
@@ -527,19 +554,23 @@ uint32_t GltfReader::material(int index, const std::string& where) {
     }
     int set = 0;
     if (pbr.baseColorTexture.index >= 0) {
-      m.albedo_texture = texture(pbr.baseColorTexture, name + ".pbrMetallicRoughness.baseColorTexture");
-      set = pbr.baseColorTexture.texCoord;
+      m.albedo_texture = texture(pbr.baseColorTexture, name + ".pbrMetallicRoughness.baseColorTexture", true);
+      set = texcoord_of(pbr.baseColorTexture);
     }
     if (g.emissiveTexture.index >= 0 && m.emission != glm::vec3(0.0f)) {
-      m.emission_texture = texture(g.emissiveTexture, name + ".emissiveTexture");
-      if (m.albedo_texture.present() && g.emissiveTexture.texCoord != set)
+      m.emission_texture = texture(g.emissiveTexture, name + ".emissiveTexture", true);
+      if (m.albedo_texture.present() && texcoord_of(g.emissiveTexture) != set)
         warn_once("texcoord sets", name, "the emissive texture's texCoord differs from the base colour's: both use TEXCOORD_" + std::to_string(set));
-      if (!m.albedo_texture.present()) set = g.emissiveTexture.texCoord;
+      if (!m.albedo_texture.present()) set = texcoord_of(g.emissiveTexture);
+    }
+    if (pbr.metallicRoughnessTexture.index >= 0) {  // data, not colour: linear
+      m.metallic_roughness_texture = texture(pbr.metallicRoughnessTexture, name + ".pbrMetallicRoughness.metallicRoughnessTexture", false);
+      if ((m.albedo_texture.present() || m.emission_texture.present()) && texcoord_of(pbr.metallicRoughnessTexture) != set)
+        warn_once("texcoord sets", name, "the metallicRoughnessTexture's texCoord differs from the base colour's: both use TEXCOORD_" + std::to_string(set));
+      if (!m.albedo_texture.present() && !m.emission_texture.present()) set = texcoord_of(pbr.metallicRoughnessTexture);
     }
     if (set < 0 || set > 7) fail(name, "texCoord " + std::to_string(set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
     texcoord_sets_[index] = set;
-    if (pbr.metallicFactor > 0.0 || pbr.metallicRoughnessTexture.index >= 0 || pbr.roughnessFactor < 1.0)
-      warn_once("metallic-roughness", name, "metalness and roughness are not rendered: surfaces are diffuse in their base colour");
     if (g.normalTexture.index >= 0) warn_once("normalTexture", name, "normal textures are not rendered");
     if (g.occlusionTexture.index >= 0) warn_once("occlusionTexture", name, "occlusion textures are not rendered (light transport computes occlusion)");
     if (g.alphaMode == "MASK" || g.alphaMode == "BLEND")
@@ -551,11 +582,9 @@ uint32_t GltfReader::material(int index, const std::string& where) {
   return at;
 }
 
-TextureRef GltfReader::texture(const tinygltf::TextureInfo& info, const std::string& where) {
+TextureRef GltfReader::texture(const tinygltf::TextureInfo& info, const std::string& where, bool srgb) {
   if (size_t(info.index) >= model_.textures.size())
     fail(where, "textures[" + std::to_string(info.index) + "] does not exist (the file has " + std::to_string(model_.textures.size()) + ")");
-  if (info.extensions.count("KHR_texture_transform"))
-    warn_once("KHR_texture_transform", where, "KHR_texture_transform is not rendered: the texture is placed untransformed");
   const tinygltf::Texture& t = model_.textures[size_t(info.index)];
   const std::string name = element("textures", size_t(info.index));
   TextureRef ref;
@@ -563,7 +592,35 @@ TextureRef GltfReader::texture(const tinygltf::TextureInfo& info, const std::str
     warn_once("no source", name, "a texture with no PNG or JPEG source (another extension's format?) is not rendered");
     return ref;
   }
-  ref.texture = image_texture(t.source, name + ".source");
+  ref.texture = image_texture(t.source, name + ".source", srgb);
+  if (const auto ext = info.extensions.find("KHR_texture_transform"); ext != info.extensions.end()) {
+    // The extension's u' = T R S (u, v, 1), rotating by `rotation` counter-clockwise in the picture
+    // (whose v runs down): u' = sx u cos + sy v sin + ox, v' = sy v cos - sx u sin + oy. Its GLSL
+    // listing reads this way when its mat3 arguments are taken row by row, as its sample model
+    // (TextureTransformTest) and the implementations it names do.
+    const std::string at = where + ".extensions.KHR_texture_transform";
+    const auto number = [&](const tinygltf::Value& v, const std::string& key) {
+      const double x = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+      if (!(std::abs(x) <= 1e6)) fail(at + "." + key, "expected a number of at most 1e6 in magnitude");
+      return x;
+    };
+    const auto pair = [&](const char* key, double fallback) {
+      const tinygltf::Value& v = ext->second.Get(key);
+      if (!v.IsArray() && v.Type() != tinygltf::NULL_TYPE) fail(at + "." + key, "expected two numbers");
+      if (!v.IsArray()) return glm::dvec2(fallback);
+      if (v.ArrayLen() != 2) fail(at + "." + key, "expected two numbers, got " + std::to_string(v.ArrayLen()));
+      return glm::dvec2(number(v.Get(0), std::string(key) + "[0]"), number(v.Get(1), std::string(key) + "[1]"));
+    };
+    const glm::dvec2 offset = pair("offset", 0.0), scale = pair("scale", 1.0);
+    const tinygltf::Value& r = ext->second.Get("rotation");
+    const double rotation = r.Type() == tinygltf::NULL_TYPE ? 0.0 : number(r, "rotation");
+    const tinygltf::Value& set = ext->second.Get("texCoord");
+    if (set.Type() != tinygltf::NULL_TYPE && !(set.IsInt() && set.GetNumberAsInt() >= 0))
+      fail(at + ".texCoord", "expected a whole number of at least 0");
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    ref.to_u = glm::vec3(float(c * scale.x), float(s * scale.y), float(offset.x));
+    ref.to_v = glm::vec3(float(-s * scale.x), float(c * scale.y), float(offset.y));
+  }
   if (t.sampler >= 0) {
     if (size_t(t.sampler) >= model_.samplers.size())
       fail(name + ".sampler", "samplers[" + std::to_string(t.sampler) + "] does not exist (the file has " + std::to_string(model_.samplers.size()) + ")");
@@ -584,8 +641,8 @@ TextureRef GltfReader::texture(const tinygltf::TextureInfo& info, const std::str
   return ref;
 }
 
-int32_t GltfReader::image_texture(int image, const std::string& where) {
-  if (const auto found = image_textures_.find(image); found != image_textures_.end()) return found->second;
+int32_t GltfReader::image_texture(int image, const std::string& where, bool srgb) {
+  if (const auto found = image_textures_.find({image, srgb}); found != image_textures_.end()) return found->second;
   if (size_t(image) >= model_.images.size())
     fail(where, "images[" + std::to_string(image) + "] does not exist (the file has " + std::to_string(model_.images.size()) + ")");
   const tinygltf::Image& img = model_.images[size_t(image)];
@@ -597,7 +654,8 @@ int32_t GltfReader::image_texture(int image, const std::string& where) {
   const UriTarget target = by_uri ? resolve_uri(img.uri, file_, element("images", size_t(image)) + ".uri") : UriTarget{};
   const std::string source = img.bufferView >= 0 ? "view " + std::to_string(img.bufferView)
                            : by_uri && !target.data() ? "file " + target.file.string() : "";
-  if (const auto found = sources_.find(source); !source.empty() && found != sources_.end()) return image_textures_[image] = found->second;
+  if (const auto found = sources_.find({source, srgb}); !source.empty() && found != sources_.end())
+    return image_textures_[{image, srgb}] = found->second;
   std::string name = file_.string() + ": " + element("images", size_t(image));
   std::string_view bytes(reinterpret_cast<const char*>(img.image.data()), img.image.size());
   std::string external;
@@ -622,11 +680,11 @@ int32_t GltfReader::image_texture(int image, const std::string& where) {
                      " picture would bring the scene's textures past " + std::to_string(limits_.max_texels >> 20) +
                      "M texels, vkray's limit (docs/limits.md)");
   texels_ += texels;
-  auto texture = std::make_shared<const Texture>(make_texture(decode_picture(bytes, name), name, true));
+  auto texture = std::make_shared<const Texture>(make_texture(decode_picture(bytes, name), name, srgb));
   const auto index = int32_t(scene_.textures.size());
   scene_.textures.push_back(std::move(texture));
-  image_textures_[image] = index;
-  if (!source.empty()) sources_[source] = index;
+  image_textures_[{image, srgb}] = index;
+  if (!source.empty()) sources_[{source, srgb}] = index;
   return index;
 }
 

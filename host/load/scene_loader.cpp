@@ -24,9 +24,11 @@ void recentre_texture_coordinates(Scene& scene) {
   for (Triangle& t : scene.triangles) {
     const Material& m = scene.materials[t.material];
     if (!m.textured()) continue;
+    // A transformed texture (KHR_texture_transform) maps a whole period of the coordinate to another
+    // amount of its own: such coordinates stay where they are.
     const auto repeats = [&](bool s) {
-      for (const TextureRef* ref : {&m.albedo_texture, &m.emission_texture})
-        if (ref->present() && (s ? ref->wrap_s : ref->wrap_t) == TextureWrap::clamp_to_edge) return false;
+      for (const TextureRef* ref : m.textures())
+        if (ref->present() && ((s ? ref->wrap_s : ref->wrap_t) == TextureWrap::clamp_to_edge || ref->transformed())) return false;
       return true;
     };
     for (int axis = 0; axis < 2; ++axis) {

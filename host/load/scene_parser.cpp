@@ -16,9 +16,6 @@ namespace {
 // direction (F * H, x, y) is normalized: F * H (at most 1.6e10) squared stays far inside a float.
 constexpr float kMaxFocalLength = 1e6f;
 
-// The largest index of refraction: past every real material (diamond is 2.4), so that a typo shows.
-constexpr float kMaxIor = 100.0f;
-
 // The smoothest GGX surface (shared/materials.h says why); smoother than that is a mirror.
 constexpr float kMinAlpha = VKRAY_MIN_GGX_ALPHA;
 
@@ -224,8 +221,14 @@ void SceneParser::parse_materials(const Value& v) {
         if (m.has("int_ior")) material.ior = index_of_refraction(m["int_ior"]);
         break;
       case MaterialType::metallic_roughness:  // glTF 2.0's, with its names and defaults
-        check_keys(m, {"type", "base_color", "metallic", "roughness", "ior", "emission"});
+        check_keys(m, {"type", "base_color", "metallic", "roughness", "ior", "emission", "base_color_texture",
+                       "metallic_roughness_texture"});
         material.albedo = m.has("base_color") ? reflectance(m["base_color"]) : glm::vec3(1.0f);
+        // Pictures beside the scene file, read where a mesh gives texture coordinates: the base colour
+        // as sRGB; metallic (blue) and roughness (green) as linear data, as glTF's textures are.
+        if (m.has("base_color_texture")) material.albedo_texture.texture = texture_file(m["base_color_texture"], file_of(m["base_color_texture"]), true);
+        if (m.has("metallic_roughness_texture"))
+          material.metallic_roughness_texture.texture = texture_file(m["metallic_roughness_texture"], file_of(m["metallic_roughness_texture"]), false);
         if (m.has("metallic")) material.metallic = unit_interval(m["metallic"]);
         if (m.has("roughness")) material.roughness = unit_interval(m["roughness"]);
         if (m.has("ior")) {
@@ -410,7 +413,7 @@ void SceneParser::parse_object(const Value& v) {
   } else if (type == "gltf") {
     check_keys(v, {"type", "file", "transform"});
     const Value file_value = require(v, "file");
-    add_gltf(&file_value, (file_.parent_path() / string(file_value)).lexically_normal(), transform);
+    add_gltf(&file_value, file_of(file_value), transform);
   } else {
     fail(type_value, "unknown object type \"" + printable(type) + "\" (expected \"sphere\", \"triangles\", \"mesh\" or \"gltf\")");
   }

@@ -145,6 +145,8 @@ class SceneParser {
   void reference(const std::filesystem::path& file);
   // The index in Scene::textures of a texture file, read the first time it is named.
   int32_t texture_file(const Value& where, const std::filesystem::path& file, bool srgb);
+  // A file a string of the scene file names, relative to the scene file's folder.
+  std::filesystem::path file_of(const Value& name) const;
   // The scene materials made from the .mtl materials a mesh's faces name, in Mesh::material_names order.
   std::vector<uint32_t> mesh_materials(const Value& where, const std::filesystem::path& mesh_file, const Mesh& mesh);
   // Appends triangles, leaving out zero-area ones (they have no normal and are never hit).

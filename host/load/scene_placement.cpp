@@ -39,7 +39,7 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
     entry.material_offset = uint32_t(scene_.materials.size());
     const auto texture_offset = int32_t(scene_.textures.size());
     for (Material m : entry.gltf.materials) {
-      for (TextureRef* ref : {&m.albedo_texture, &m.emission_texture})
+      for (TextureRef* ref : m.textures())
         if (ref->present()) ref->texture += texture_offset;
       scene_.materials.push_back(std::move(m));
     }
@@ -150,6 +150,8 @@ int32_t SceneParser::texture_file(const Value& where, const std::filesystem::pat
   return index;
 }
 
+std::filesystem::path SceneParser::file_of(const Value& name) const { return (file_.parent_path() / string(name)).lexically_normal(); }
+
 std::vector<uint32_t> SceneParser::mesh_materials(const Value& where, const std::filesystem::path& mesh_file, const Mesh& mesh) {
   // Every library the file names, read now; a later definition of a name replaces an earlier one.
   std::map<std::string, std::pair<MtlMaterial, std::filesystem::path>> defined;
@@ -205,7 +207,7 @@ std::vector<uint32_t> SceneParser::mesh_materials(const Value& where, const std:
 
 void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
   const Value file_value = require(v, "file");
-  const std::filesystem::path file = (file_.parent_path() / string(file_value)).lexically_normal();
+  const std::filesystem::path file = file_of(file_value);
   bool smooth = false;
   if (v.has("smooth")) {
     if (!v["smooth"].j.is_boolean()) fail(v["smooth"], std::string("expected true or false, got ") + v["smooth"].j.type_name());

@@ -284,11 +284,17 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
   const EmitterTable table = build_emitter_table(scene);
   packed.materials.resize(scene.materials.size() * VKRAY_TEXELS_PER_MATERIAL);
   const std::vector<uint32_t> offsets = texture_offsets(scene);
-  const auto header = [&](const TextureRef& ref) {
-    if (!ref.present()) return glm::vec4(0.0f);  // width 0: none
+  // A texture slot: the header, then the transform's two rows (shared/materials.h).
+  const auto texture_slot = [&](glm::vec4* texels, const TextureRef& ref) {
+    if (!ref.present()) {  // width 0: none
+      texels[0] = texels[1] = texels[2] = glm::vec4(0.0f);
+      return;
+    }
     const Texture& t = *scene.textures[size_t(ref.texture)];
-    return texture_texel(offsets[size_t(ref.texture)], t.width, t.height, uint32_t(ref.wrap_s), uint32_t(ref.wrap_t),
-                         uint32_t(ref.filter));
+    texels[0] = texture_texel(offsets[size_t(ref.texture)], t.width, t.height, uint32_t(ref.wrap_s), uint32_t(ref.wrap_t),
+                              uint32_t(ref.filter), ref.transformed() ? 1u : 0u);
+    texels[1] = glm::vec4(ref.to_u, 0.0f);
+    texels[2] = glm::vec4(ref.to_v, 0.0f);
   };
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
@@ -301,8 +307,9 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     texels[VKRAY_MATERIAL_ETA] = values.eta;
     texels[VKRAY_MATERIAL_K] = values.k;
     texels[VKRAY_MATERIAL_LAYERS] = values.layers;
-    texels[VKRAY_MATERIAL_ALBEDO_TEXTURE] = header(m.albedo_texture);
-    texels[VKRAY_MATERIAL_EMISSION_TEXTURE] = header(m.emission_texture);
+    texture_slot(texels + VKRAY_MATERIAL_ALBEDO_TEXTURE, m.albedo_texture);
+    texture_slot(texels + VKRAY_MATERIAL_EMISSION_TEXTURE, m.emission_texture);
+    texture_slot(texels + VKRAY_MATERIAL_LAYERS_TEXTURE, m.metallic_roughness_texture);
     // In double on the host, then one rounding: no 1 / total power in float that could overflow.
     texels[VKRAY_MATERIAL_LIGHT] = glm::vec4(float(table.density[i]), 0.0f, 0.0f, 0.0f);
   }

@@ -74,6 +74,10 @@ enum class MaterialType : uint32_t {
 std::string_view material_type_name(MaterialType type);
 std::optional<MaterialType> material_type_named(std::string_view name);
 
+// The largest index of refraction (and absorption coefficient) a material takes: past every real
+// material (diamond's index is 2.4, metals' absorption about 10), so that a typo shows.
+constexpr float kMaxIor = 100.0f;
+
 struct Material {
   std::string name;
   MaterialType type = MaterialType::diffuse;
@@ -93,12 +97,21 @@ struct Material {
   float metallic = 1.0f;
   float roughness = 1.0f;
   // Textures that multiply albedo (or reflectance) and emission where a triangle has texture
-  // coordinates (glTF's baseColorTexture and emissiveTexture, an .mtl file's map_Kd).
+  // coordinates (glTF's baseColorTexture and emissiveTexture, an .mtl file's map_Kd), and
+  // metallic_roughness's metallic (by its blue) and roughness (by its green), a linear texture
+  // (glTF's metallicRoughnessTexture).
   TextureRef albedo_texture;
   TextureRef emission_texture;
+  TextureRef metallic_roughness_texture;
 
   bool emissive() const { return emission != glm::vec3(0.0f); }
-  bool textured() const { return albedo_texture.present() || emission_texture.present(); }
+  // Every texture reference, for code that treats them alike.
+  std::array<TextureRef*, 3> textures() { return {&albedo_texture, &emission_texture, &metallic_roughness_texture}; }
+  std::array<const TextureRef*, 3> textures() const { return {&albedo_texture, &emission_texture, &metallic_roughness_texture}; }
+  bool textured() const {
+    const auto refs = textures();
+    return std::any_of(refs.begin(), refs.end(), [](const TextureRef* t) { return t->present(); });
+  }
   // Its properties (VKRAY_BSDF_* in shaders/shared/materials.h): code outside the BSDFs asks these.
   uint32_t properties() const { return gpu::material_properties(uint32_t(type)); }
   bool has(uint32_t property) const { return (properties() & property) != 0; }

@@ -46,8 +46,17 @@ struct TextureRef {
   TextureWrap wrap_s = TextureWrap::repeat;  // along u (the picture's rows)
   TextureWrap wrap_t = TextureWrap::repeat;  // along v (its columns)
   TextureFilter filter = TextureFilter::linear;
+  // The affine map from a primitive's texture coordinate (u, v) to the texture's: u' = dot(to_u,
+  // (u, v, 1)), v' = dot(to_v, (u, v, 1)) (glTF's KHR_texture_transform); the identity by default.
+  glm::vec3 to_u{1.0f, 0.0f, 0.0f};
+  glm::vec3 to_v{0.0f, 1.0f, 0.0f};
 
   bool present() const { return texture >= 0; }
+  bool transformed() const { return to_u != glm::vec3(1.0f, 0.0f, 0.0f) || to_v != glm::vec3(0.0f, 1.0f, 0.0f); }
+  // The texture's coordinate at the primitive's `uv`.
+  glm::dvec2 map(const glm::dvec2& uv) const {
+    return {glm::dot(glm::dvec3(to_u), glm::dvec3(uv, 1.0)), glm::dot(glm::dvec3(to_v), glm::dvec3(uv, 1.0))};
+  }
   bool operator==(const TextureRef&) const = default;
 };
 

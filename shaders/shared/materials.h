@@ -74,19 +74,27 @@ struct MaterialValues {
 //   VKRAY_MATERIAL_ETA:               (eta, alpha_u)          read only by GLOSSY materials
 //   VKRAY_MATERIAL_K:                 (k, alpha_v)            read only by GLOSSY materials
 //   VKRAY_MATERIAL_LAYERS:            (metallic, roughness, 0, 0)  read only by GLOSSY materials
-//   VKRAY_MATERIAL_ALBEDO_TEXTURE:    the texture that multiplies the colour (texture_texel)
-//   VKRAY_MATERIAL_EMISSION_TEXTURE:  the texture that multiplies the emission
 //   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
 //                                     an emitter of this material, 0, 0, 0): scene/emitters.h
-#define VKRAY_TEXELS_PER_MATERIAL 8
+// and three texture slots of VKRAY_TEXELS_PER_TEXTURE_SLOT texels each: the texture's header
+// (texture_texel in shared/scene_layout.h), then the two rows of the affine map from a primitive's
+// texture coordinate to the texture's (glTF's KHR_texture_transform), read only where the header says
+// the texture is transformed:
+//   VKRAY_MATERIAL_ALBEDO_TEXTURE:    the texture that multiplies the colour
+//   VKRAY_MATERIAL_EMISSION_TEXTURE:  the texture that multiplies the emission
+//   VKRAY_MATERIAL_LAYERS_TEXTURE:    metallic_roughness: the texture whose blue multiplies metallic and
+//                                     whose green multiplies roughness (glTF's metallicRoughnessTexture)
+#define VKRAY_TEXELS_PER_MATERIAL 15
+#define VKRAY_TEXELS_PER_TEXTURE_SLOT 3
 #define VKRAY_MATERIAL_COLOR 0
 #define VKRAY_MATERIAL_EMISSION 1
 #define VKRAY_MATERIAL_ETA 2
 #define VKRAY_MATERIAL_K 3
 #define VKRAY_MATERIAL_LAYERS 4
-#define VKRAY_MATERIAL_ALBEDO_TEXTURE 5
-#define VKRAY_MATERIAL_EMISSION_TEXTURE 6
-#define VKRAY_MATERIAL_LIGHT 7
+#define VKRAY_MATERIAL_LIGHT 5
+#define VKRAY_MATERIAL_ALBEDO_TEXTURE 6
+#define VKRAY_MATERIAL_EMISSION_TEXTURE 9
+#define VKRAY_MATERIAL_LAYERS_TEXTURE 12
 #define VKRAY_MATERIAL_PROPERTY_SHIFT 8u
 
 // The first texel of material `index`.

@@ -62,8 +62,9 @@ VKRAY_INLINE uint primitive_material(uint flags) { return flags & VKRAY_PRIM_MAT
 
 // ---- Textures: RGBA16F texels in one buffer, each texture's rows one after another ---------------------
 // A material names a texture by one texel, the bits of four uints: (its first texel in the buffer,
-// width, height, mode); width 0: no texture. mode = wrap_s | wrap_t << 2 | filter << 4, with the
-// values of vkray::TextureWrap and TextureFilter, which are glTF's sampler modes.
+// width, height, mode); width 0: no texture. mode = wrap_s | wrap_t << 2 | filter << 4 |
+// transformed << 5, with the values of vkray::TextureWrap and TextureFilter, which are glTF's sampler
+// modes; transformed: the two texels after it map the texture coordinate (shared/materials.h).
 #define VKRAY_WRAP_REPEAT 0u
 #define VKRAY_WRAP_CLAMP_TO_EDGE 1u
 #define VKRAY_WRAP_MIRRORED_REPEAT 2u
@@ -77,9 +78,9 @@ struct TextureHeader {
   uint mode;
 };
 
-VKRAY_INLINE vec4 texture_texel(uint first, uint width, uint height, uint wrap_s, uint wrap_t, uint filter_mode) {
+VKRAY_INLINE vec4 texture_texel(uint first, uint width, uint height, uint wrap_s, uint wrap_t, uint filter_mode, uint transformed) {
   return vec4(uintBitsToFloat(first), uintBitsToFloat(width), uintBitsToFloat(height),
-              uintBitsToFloat(wrap_s | (wrap_t << 2u) | (filter_mode << 4u)));
+              uintBitsToFloat(wrap_s | (wrap_t << 2u) | (filter_mode << 4u) | (transformed << 5u)));
 }
 
 VKRAY_INLINE TextureHeader texture_header(vec4 t) {
@@ -94,6 +95,7 @@ VKRAY_INLINE TextureHeader texture_header(vec4 t) {
 VKRAY_INLINE uint texture_wrap_s(uint mode) { return mode & 3u; }
 VKRAY_INLINE uint texture_wrap_t(uint mode) { return (mode >> 2u) & 3u; }
 VKRAY_INLINE uint texture_filter(uint mode) { return (mode >> 4u) & 1u; }
+VKRAY_INLINE bool texture_transformed(uint mode) { return ((mode >> 5u) & 1u) != 0u; }
 
 // ---- Emissive primitives: the area lights, one RGBA32F texel each ------------------------------------
 // An alias table (Walker 1977) over the primitives whose material emits, each weighted by its power
