@@ -10,10 +10,16 @@
 // Each step fetches everything it needs at once, before any math: on llvmpipe a texel fetch is a
 // call that spills the caller's vector registers, and adjacent calls share one spill.
 
+// Whether a camera ray that hits the triangle (a, b, c) meets the back of a single-sided one, and
+// so passes through it (Material::double_sided): the side away from its winding's normal.
+bool culled(Ray ray, vec4 a, vec4 b, vec4 c) {
+  return (primitive_flags(a) & VKRAY_PRIM_SINGLE_SIDED) != 0u && dot(ray.dir, triangle_normal(a.xyz, b.xyz, c.xyz)) > 0.0;
+}
+
 // Tests the primitives of a leaf against the ray, keeping the closest hit (ties go to the primitive
 // that comes first in the scene, VKRAY_TIE; hit_index is the best hit's place in the scene).
-// Returns true when any_hit and something was hit.
-bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max, bool any_hit, inout Hit hit,
+// Returns true when any_hit and something was hit. cull_back: the ray is a camera ray (culled()).
+bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max, bool any_hit, bool cull_back, inout Hit hit,
                     inout uint hit_index) {
   uint first = leaf_first(link);
   uint end = first + leaf_count(link);
@@ -25,6 +31,7 @@ bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max
     // Anything up to a tie with the best hit so far is still a candidate.
     float limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
     float t = intersect_primitive(ray, shear, a, b, c, t_min, limit);
+    if (SCENE_HAS_SINGLE_SIDED && cull_back && t > 0.0 && culled(ray, a, b, c)) t = -1.0;
     if (t > 0.0) {
       uint index = primitive_scene_index(b);
       if (any_hit) {
@@ -111,14 +118,15 @@ Children enter_node(Ray ray, vec3 inv_dir, bvec3 backward, uint node, float t_mi
   return Children(vec4(k0, k1, k2, k3), uvec4(l0, l1, l2, l3));
 }
 
-// Closest hit in (t_min, t_max); with any_hit, the first hit found (for shadow rays).
-Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
+// Closest hit in (t_min, t_max); with any_hit, the first hit found (for shadow rays). cull_back: a
+// camera ray, which passes the back faces of single-sided triangles.
+Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back) {
   Hit hit = Hit(t_max, NO_HIT);
   uint hit_index = 0u;
   if (frame.primitive_count == 0u) return hit;
   RayShear shear = ray_shear(ray.dir);
 #ifdef VKRAY_INLINE_SCENE
-  test_inline_primitives(ray, shear, t_min, t_max, any_hit, hit);
+  test_inline_primitives(ray, shear, t_min, t_max, any_hit, SCENE_HAS_SINGLE_SIDED && cull_back, hit);
   return hit;
 #endif
   vec3 inv_dir = safe_inverse(ray.dir);
@@ -138,7 +146,7 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   for (;;) {
     bool pop = true;
     if (is_leaf(node)) {
-      if (intersect_leaf(ray, shear, node, t_min, t_max, any_hit, hit, hit_index)) return hit;
+      if (intersect_leaf(ray, shear, node, t_min, t_max, any_hit, cull_back, hit, hit_index)) return hit;
     } else {
       float t_limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
       Children c = enter_node(ray, inv_dir, backward, node, t_min, t_limit);
@@ -162,8 +170,9 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit) {
   return hit;
 }
 
-Hit trace_closest(Ray ray, float t_min, float t_max) { return traverse(ray, t_min, t_max, false); }
+// The closest hit of a ray; camera_ray: the ray leaves the camera (single-sided back faces pass it).
+Hit trace_closest(Ray ray, float t_min, float t_max, bool camera_ray) { return traverse(ray, t_min, t_max, false, camera_ray); }
 
-bool trace_any(Ray ray, float t_min, float t_max) { return traverse(ray, t_min, t_max, true).prim != NO_HIT; }
+bool trace_any(Ray ray, float t_min, float t_max) { return traverse(ray, t_min, t_max, true, false).prim != NO_HIT; }
 
 #endif

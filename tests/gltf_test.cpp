@@ -214,7 +214,7 @@ TEST(GltfTest, MaterialsKeepTheirColourAndEmissionAndNameWhatIsNotRendered) {
 TEST(GltfTest, MaterialsAreGltfsMetallicRoughnessModelWithTheirFactorsAndIor) {
   GltfBuilder b;
   const int plastic = b.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.1, 0.1, 1}}, {"metallicFactor", 0}, {"roughnessFactor", 0.25}}},
-                                  {"extensions", {{"KHR_materials_ior", {{"ior", 1.33}}}}}});
+                                  {"extensions", {{"KHR_materials_ior", {{"ior", 1.33}}}}}, {"doubleSided", true}});
   const int mirror_like = b.material({{"pbrMetallicRoughness", {{"metallicFactor", 1}, {"roughnessFactor", 0}}},
                                       {"extensions", {{"KHR_materials_ior", {{"ior", 0}}}}}});
   b.quad(plastic);
@@ -231,6 +231,8 @@ TEST(GltfTest, MaterialsAreGltfsMetallicRoughnessModelWithTheirFactorsAndIor) {
   EXPECT_EQ(s.materials[1].metallic, 1.0f);
   EXPECT_EQ(s.materials[1].roughness, 0.0f);
   EXPECT_EQ(s.materials[1].ior, 0.0f);
+  EXPECT_TRUE(s.materials[0].double_sided);
+  EXPECT_FALSE(s.materials[1].double_sided);  // glTF's default: single-sided
   EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
   {
     GltfBuilder bad = textured_quad();

@@ -115,6 +115,47 @@ TEST_F(FurnaceTest, AGltfMetalTexturedToHalfRoughnessIsTheUntexturedOne) {
     EXPECT_NEAR(image_mean(render(scene, {16, 16, 256}, {}, cpu)).g, expected, 0.01 * expected) << (cpu ? "CPU" : "GPU");
 }
 
+// ---- Single-sided materials: camera rays pass their back faces, shadow rays do not -------------------------
+
+class SingleSidedTest : public GpuTest {};
+
+TEST_F(SingleSidedTest, CameraRaysPassTheBackFaceWhichStillCastsItsShadow) {
+  // A glTF quad in z = 0 facing +z, seen from behind by a camera at z = -5, with a point light beside
+  // the camera and a white wall at z = 3 behind the quad. Single-sided, the quad is not seen and the
+  // wall's middle lies in its shadow: black. Double-sided, the camera sees the quad's lit back face.
+  TempDir dir;
+  for (const bool double_sided : {false, true}) {
+    GltfBuilder b;
+    b.quad(b.material({{"pbrMetallicRoughness", {{"metallicFactor", 0}}}, {"doubleSided", double_sided}}));
+    write_file(dir.path() / "quad.gltf", b.gltf());
+    write_file(dir.path() / "scene.json", R"({
+      "camera": {"position": [0, 0, -5], "look_at": [0, 0, 0], "vertical_fov": 10},
+      "lights": [{"type": "point", "position": [0, 0.05, -3], "intensity": [20, 20, 20]}],
+      "materials": {"wall": {"albedo": [1, 1, 1]}},
+      "objects": [{"type": "gltf", "file": "quad.gltf"},
+                  {"type": "triangles", "material": "wall", "positions": [[-9, -9, 3], [9, -9, 3], [9, 9, 3], [-9, 9, 3]],
+                   "indices": [[0, 1, 2], [0, 2, 3]]}]})");
+    Scene scene = load_scene(dir.path() / "scene.json");
+    for (const Integrator::Type type : {Integrator::Type::direct, Integrator::Type::path}) {
+      scene.integrator.type = type;
+      scene.integrator.max_depth = 2;  // paths: the light a first hit receives directly, as the direct model
+      for (const int renderer : {0, 1, 2}) {  // GPU through the BVH, GPU compiled in, CPU
+        RenderOptions options;
+        options.inline_scene = renderer == 1 ? InlineScene::always : InlineScene::never;
+        const Image image = render(scene, {9, 9, 4}, options, renderer == 2);
+        const float middle = image.at(4, 4).g;
+        const std::string what = std::string(double_sided ? "double" : "single") + "-sided, " +
+                                 (type == Integrator::Type::path ? "paths, " : "direct, ") +
+                                 (renderer == 0 ? "GPU (BVH)" : renderer == 1 ? "GPU (compiled in)" : "CPU");
+        if (double_sided)
+          EXPECT_GT(middle, 0.01f) << what;  // the quad's back, lit by the light behind the camera
+        else
+          EXPECT_EQ(middle, 0.0f) << what;  // the wall, in the quad's shadow
+      }
+    }
+  }
+}
+
 TEST_F(FurnaceTest, TheQuadratureKeepsEverythingForASmoothSurface) {
   // The test's own integral: alpha -> 0 reflects everything at normal incidence.
   EXPECT_NEAR(ggx_albedo(0.02, 1.0), 1.0, 2e-3);

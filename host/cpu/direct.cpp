@@ -37,7 +37,8 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
   Ray ray = camera_ray;
   dvec3 radiance(0.0), throughput(1.0);
   for (uint32_t bounce = 0; bounce <= VKRAY_SPECULAR_BOUNCES; ++bounce) {
-    const Hit hit = tracer.closest(ray, epsilon, std::numeric_limits<double>::infinity());
+    const double far = std::numeric_limits<double>::infinity();
+    const Hit hit = bounce == 0 ? tracer.camera_hit(ray, epsilon, far) : tracer.closest(ray, epsilon, far);
     if (bounce == 0) mix(state.signature, uint64_t(int64_t(hit.primitive)));
     if (hit.primitive < 0) {
       radiance += throughput * dvec3(scene.background);

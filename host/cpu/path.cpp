@@ -32,7 +32,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
   // max_depth -1 is no limit; a path of max_depth vertices ends.
   const uint32_t max_depth = uint32_t(scene.integrator.max_depth);
   for (uint32_t depth = 0;;) {
-    const Hit hit = tracer.closest(ray, epsilon, kFar);
+    const Hit hit = depth == 0 ? tracer.camera_hit(ray, epsilon, kFar) : tracer.closest(ray, epsilon, kFar);
     if (depth == 0) mix(state.signature, uint64_t(int64_t(hit.primitive)));
     if (hit.primitive < 0) {
       radiance += throughput * background * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, kBackgroundPdf));

@@ -64,35 +64,42 @@ double intersect_sphere(const Ray& ray, const Sphere& s, double t_min, double t_
 }
 }  // namespace
 
-Hit Tracer::closest(const Ray& ray, double t_min, double t_max, bool any_hit) const {
+Hit Tracer::find(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray) const {
   Hit best{t_max, -1};
   const size_t count = scene_.triangles.size() + scene_.spheres.size();
   if (!bvh_) {
-    for (size_t p = 0; p < count && !(any_hit && best.primitive >= 0); ++p) test(ray, p, t_min, t_max, best);
+    for (size_t p = 0; p < count && !(any_hit && best.primitive >= 0); ++p) test(ray, p, t_min, t_max, camera_ray, best);
     return best;
   }
   if (bvh_->nodes.empty()) return best;
   // 1 / d with zero components replaced by tiny ones, so a slab test never computes 0 * inf.
   dvec3 inv;
   for (int a = 0; a < 3; ++a) inv[a] = (ray.dir[a] < 0 ? -1.0 : 1.0) / std::max(std::abs(ray.dir[a]), 1e-300);
-  visit(0, ray, inv, t_min, t_max, any_hit, best);
+  visit(0, ray, inv, t_min, t_max, any_hit, camera_ray, best);
   return best;
 }
 
-
-// with it and comes first in the scene.
-void Tracer::test(const Ray& ray, size_t p, double t_min, double t_max, Hit& best) const {
+// Tests primitive p, which becomes the best hit when it is closer than the best so far by more
+// than VKRAY_TIE, or ties with it and comes first in the scene.
+void Tracer::test(const Ray& ray, size_t p, double t_min, double t_max, bool camera_ray, Hit& best) const {
   Hit candidate{-1, int(p)};
-  if (p < scene_.triangles.size())
-    candidate.t = intersect_triangle(ray, scene_.triangles[p], t_min, limit(best, t_max), candidate.u, candidate.v);
-  else
+  if (p < scene_.triangles.size()) {
+    const Triangle& tri = scene_.triangles[p];
+    candidate.t = intersect_triangle(ray, tri, t_min, limit(best, t_max), candidate.u, candidate.v);
+    // A camera ray passes the back face of a single-sided triangle: the side away from its winding's normal.
+    if (camera_ray && candidate.t >= 0 && !scene_.materials[tri.material].double_sided &&
+        glm::dot(ray.dir, glm::cross(dvec3(tri.v[1]) - dvec3(tri.v[0]), dvec3(tri.v[2]) - dvec3(tri.v[0]))) > 0)
+      return;
+  } else {
     candidate.t = intersect_sphere(ray, scene_.spheres[p - scene_.triangles.size()], t_min, limit(best, t_max));
+  }
   if (candidate.t < 0) return;
   if (best.primitive < 0 || candidate.t < best.t * (1 - VKRAY_TIE) || candidate.primitive < best.primitive) best = candidate;
 }
 
 // Recursive descent, nearer child first. Returns true to stop (any_hit found one).
-bool Tracer::visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, Hit& best) const {
+bool Tracer::visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, bool camera_ray,
+                   Hit& best) const {
   const BvhNode& n = bvh_->nodes[node];
   double t_enter[2];
   const bool hit[2] = {enters(n.child[0], ray, inv, t_min, limit(best, t_max), t_enter[0]),
@@ -103,10 +110,10 @@ bool Tracer::visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min
     const uint32_t link = n.link[c];
     if (is_leaf(link)) {
       for (uint32_t slot = leaf_first(link); slot < leaf_first(link) + leaf_count(link); ++slot) {
-        test(ray, bvh_->order[slot], t_min, t_max, best);
+        test(ray, bvh_->order[slot], t_min, t_max, camera_ray, best);
         if (any_hit && best.primitive >= 0) return true;
       }
-    } else if (visit(link, ray, inv, t_min, t_max, any_hit, best)) {
+    } else if (visit(link, ray, inv, t_min, t_max, any_hit, camera_ray, best)) {
       return true;
     }
   }

@@ -46,7 +46,10 @@ class Tracer {
   Tracer(const Scene& scene, const Bvh* bvh) : scene_(scene), bvh_(bvh), epsilon_(scene.epsilon()) {}
 
   // Closest intersection with t in (t_min, t_max); with any_hit, the first one found.
-  Hit closest(const Ray& ray, double t_min, double t_max, bool any_hit = false) const;
+  Hit closest(const Ray& ray, double t_min, double t_max, bool any_hit = false) const { return find(ray, t_min, t_max, any_hit, false); }
+  // The closest hit of a ray from the camera, which passes the back faces of single-sided
+  // triangles (Material::double_sided).
+  Hit camera_hit(const Ray& ray, double t_min, double t_max) const { return find(ray, t_min, t_max, false, true); }
   // Whether anything lies on the ray with t in (t_min, t_max).
   bool occluded(const Ray& ray, double t_min, double t_max) const { return closest(ray, t_min, t_max, true).primitive >= 0; }
 
@@ -57,8 +60,10 @@ class Tracer {
   double epsilon() const { return epsilon_; }
 
  private:
-  void test(const Ray& ray, size_t p, double t_min, double t_max, Hit& best) const;
-  bool visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, Hit& best) const;
+  Hit find(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray) const;
+  void test(const Ray& ray, size_t p, double t_min, double t_max, bool camera_ray, Hit& best) const;
+  bool visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, bool camera_ray,
+             Hit& best) const;
 
   const Scene& scene_;
   const Bvh* bvh_;

@@ -527,6 +527,7 @@ uint32_t GltfReader::material(int index, const std::string& where) {
     };
     const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
     m.albedo = colour(pbr.baseColorFactor, 4, "pbrMetallicRoughness.baseColorFactor", 1.0);
+    m.double_sided = g.doubleSided;
     const auto factor = [&](double value, const std::string& key) {
       if (!(value >= 0.0 && value <= 1.0)) fail(name + "." + key, "expected a number from 0 to 1, got " + brief(nlohmann::json(value)));
       return float(value);

@@ -44,7 +44,8 @@ std::string inline_scene_glsl(const PackedGeometry& packed) {
   // Calls with only `in` parameters of plain types, and the best hit in locals: glslang copies
   // every struct and `inout` argument through temporaries, which both it and the driver's compiler
   // then spend time on (for the Cornell box's 30 triangles 0.1 s more than this).
-  out += "void test_inline_primitives(Ray ray, RayShear shear, float t_min, float t_max, bool any_hit, inout Hit hit) {\n";
+  out += "void test_inline_primitives(Ray ray, RayShear shear, float t_min, float t_max, bool any_hit, bool cull_back,\n"
+         "                            inout Hit hit) {\n";
   out += "  vec3 o = ray.origin, s = shear.s;\n  ivec3 k = shear.k;\n";
   out += "  float best_t = hit.t, bound = t_max, t;\n  uint best = hit.prim;\n";
   // Each distinct vertex is sheared once (triangles of a mesh or a box share them), the triangles
@@ -65,6 +66,11 @@ std::string inline_scene_glsl(const PackedGeometry& packed) {
     } else {
       const std::string a = vertex(t[0]), b = vertex(t[1]), c = vertex(t[2]);
       out += "  t = sheared_triangle(" + a + ", " + b + ", " + c + ", t_min, bound);\n";
+      // The back of a single-sided triangle passes a camera ray (traversal.glsl's culled()); its
+      // normal is the same triangle_normal of the same coordinates.
+      if (primitive_flags(t[0]) & VKRAY_PRIM_SINGLE_SIDED)
+        out += "  if (cull_back && t > 0.0 && dot(ray.dir, triangle_normal(" + vec3_literal(t[0]) + ", " + vec3_literal(t[1]) + ", " +
+               vec3_literal(t[2]) + ")) > 0.0) t = -1.0;\n";
     }
     // In the scene's order, intersect_leaf's tie rule is: closer than the best by more than VKRAY_TIE.
     out += "  if (t > 0.0) { best_t = t; best = " + std::to_string(p) +

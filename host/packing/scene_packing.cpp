@@ -226,7 +226,9 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
       PrimitiveTexels texels;
       if (p < triangle_count) {
         const Triangle& t = scene.triangles[p];
-        texels = triangle_texels(t.v[0], t.v[1], t.v[2], t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u), p, t.object);
+        const uint32_t flags = t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u) |
+                               (scene.materials[t.material].double_sided ? 0u : VKRAY_PRIM_SINGLE_SIDED);
+        texels = triangle_texels(t.v[0], t.v[1], t.v[2], flags, p, t.object);
         if (t.smooth)
           for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
         if (textured) {

@@ -55,7 +55,7 @@ bool same_bits(const Sphere& a, const Sphere& b) {
 }  // namespace
 
 bool same_geometry(const Scene& a, const Scene& b) {
-  // Materials are compared by index (a primitive's flags hold it), not by value.
+  // Materials are compared by index (a primitive's flags hold it), not by value, but for their sides.
   const auto same = [](const auto& x, const auto& y) { return same_bits(x, y); };
   const auto same_texture = [](const std::shared_ptr<const Texture>& x, const std::shared_ptr<const Texture>& y) {
     return x == y || (x->width == y->width && x->height == y->height && x->texels == y->texels);
@@ -64,7 +64,13 @@ bool same_geometry(const Scene& a, const Scene& b) {
   const auto textured = [](const Scene& s) {
     return std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.textured(); });
   };
-  return a.materials.size() == b.materials.size() && textured(a) == textured(b) &&
+  // A primitive's flags also say whether its material is single-sided.
+  const auto same_sidedness = [&] {
+    for (size_t i = 0; i < a.materials.size(); ++i)
+      if (a.materials[i].double_sided != b.materials[i].double_sided) return false;
+    return true;
+  };
+  return a.materials.size() == b.materials.size() && textured(a) == textured(b) && same_sidedness() &&
          std::equal(a.textures.begin(), a.textures.end(), b.textures.begin(), b.textures.end(), same_texture) &&
          std::equal(a.triangles.begin(), a.triangles.end(), b.triangles.begin(), b.triangles.end(), same) &&
          std::equal(a.spheres.begin(), a.spheres.end(), b.spheres.begin(), b.spheres.end(), same);

@@ -103,6 +103,10 @@ struct Material {
   TextureRef albedo_texture;
   TextureRef emission_texture;
   TextureRef metallic_roughness_texture;
+  // false: single-sided (glTF's doubleSided false): camera rays, and so the first-hit passes, pass
+  // through its triangles' back faces (the side away from their winding's normal); every other ray
+  // meets both sides.
+  bool double_sided = true;
 
   bool emissive() const { return emission != glm::vec3(0.0f); }
   // Every texture reference, for code that treats them alike.

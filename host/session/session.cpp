@@ -167,6 +167,7 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   for (const Material& m : s.materials) variant.materials |= 1u << uint32_t(m.type);
   variant.aovs = options.aovs;
   variant.textures = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.textured(); });
+  variant.single_sided = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return !m.double_sided; });
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))
     variant.inline_scene = scene.inline_scene();
   return variant;

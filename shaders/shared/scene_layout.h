@@ -12,13 +12,16 @@ VKRAY_SHARED_BEGIN
 // ---- Primitives: VKRAY_TEXELS_PER_PRIMITIVE RGBA32F texels each, in BVH leaf order ---------------------
 // A triangle is its vertices rather than its edges (every triangle sharing a vertex must see bitwise
 // the same coordinates for the watertight test); a sphere is its centre and radius. Each carries its
-// flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH | VKRAY_PRIM_INWARD), its place in the scene, which
-// decides ties (VKRAY_TIE), and the object it belongs to (the `object` pass), as the bits of floats.
+// flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH | VKRAY_PRIM_INWARD | VKRAY_PRIM_SINGLE_SIDED),
+// its place in the scene, which decides ties (VKRAY_TIE), and the object it belongs to (the `object`
+// pass), as the bits of floats.
 #define VKRAY_TEXELS_PER_PRIMITIVE 3
 #define VKRAY_PRIM_SPHERE 0x80000000u
 #define VKRAY_PRIM_SMOOTH 0x40000000u  // a triangle with vertex normals in the normals buffer
 #define VKRAY_PRIM_INWARD 0x20000000u  // a sphere whose normal points to its centre ("flip_normals")
-#define VKRAY_PRIM_MATERIAL_MASK 0x1fffffffu
+// A triangle of a single-sided material (glTF's doubleSided false): camera rays pass its back face.
+#define VKRAY_PRIM_SINGLE_SIDED 0x10000000u
+#define VKRAY_PRIM_MATERIAL_MASK 0x0fffffffu
 
 struct PrimitiveTexels {
   vec4 a;  // triangle: (v0, flags);          sphere: (centre, flags)

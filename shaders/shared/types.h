@@ -46,6 +46,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_AOVS 5
 // false when no material has a texture: no texture coordinates and no texture code.
 #define VKRAY_SPEC_TEXTURES 6
+// false when every material is two-sided: camera rays meet back faces like any other ray.
+#define VKRAY_SPEC_SINGLE_SIDED 7
 // And one per material type, id VKRAY_SPEC_MATERIALS + its number (shared/materials.h): whether the
 // scene has a material of that type (gpu::ShaderVariant::materials, a bit each); the BSDF code of
 // the others is left out. Declared as SCENE_HAS_<name> (SCENE_HAS_roughconductor).
@@ -57,7 +59,8 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_EMITTERS, SCENE_HAS_EMITTERS, emitters, false) \
   X(VKRAY_SPEC_NON_DIFFUSE, SCENE_HAS_NON_DIFFUSE, non_diffuse, false) \
   X(VKRAY_SPEC_AOVS, FIRST_HIT_PASSES, aovs, false)           \
-  X(VKRAY_SPEC_TEXTURES, SCENE_HAS_TEXTURES, textures, false)
+  X(VKRAY_SPEC_TEXTURES, SCENE_HAS_TEXTURES, textures, false) \
+  X(VKRAY_SPEC_SINGLE_SIDED, SCENE_HAS_SINGLE_SIDED, single_sided, false)
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
