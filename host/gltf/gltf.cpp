@@ -509,9 +509,10 @@ uint32_t GltfReader::material(int index, const std::string& where) {
   if (const auto found = materials_.find(index); found != materials_.end()) return found->second;
   Material m;
   m.type = MaterialType::metallic_roughness;  // glTF's own, with its defaults (Material's too): metallic 1, roughness 1
-  if (index < 0) {  // glTF's default material: white, metallic, fully rough
+  if (index < 0) {  // glTF's default material: white, metallic, fully rough, single-sided
     m.name = file_.filename().string() + ": default material";
     m.albedo = glm::vec3(1.0f);
+    m.double_sided = false;
   } else {
     if (size_t(index) >= model_.materials.size())
       fail(where, "materials[" + std::to_string(index) + "] does not exist (the file has " + std::to_string(model_.materials.size()) + ")");
@@ -567,7 +568,7 @@ uint32_t GltfReader::material(int index, const std::string& where) {
     if (pbr.metallicRoughnessTexture.index >= 0) {  // data, not colour: linear
       m.metallic_roughness_texture = texture(pbr.metallicRoughnessTexture, name + ".pbrMetallicRoughness.metallicRoughnessTexture", false);
       if ((m.albedo_texture.present() || m.emission_texture.present()) && texcoord_of(pbr.metallicRoughnessTexture) != set)
-        warn_once("texcoord sets", name, "the metallicRoughnessTexture's texCoord differs from the base colour's: both use TEXCOORD_" + std::to_string(set));
+        warn_once("texcoord sets", name, "the metallicRoughnessTexture's texCoord differs from the other textures': all use TEXCOORD_" + std::to_string(set));
       if (!m.albedo_texture.present() && !m.emission_texture.present()) set = texcoord_of(pbr.metallicRoughnessTexture);
     }
     if (set < 0 || set > 7) fail(name, "texCoord " + std::to_string(set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");

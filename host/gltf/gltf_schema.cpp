@@ -1,6 +1,7 @@
 #include "gltf/gltf_schema.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -282,6 +283,20 @@ void SchemaCheck::texture_info(const json& o, const std::string& at, const char*
   index_key(*info, where, "index", "textures", true);
   whole_key(*info, where, "texCoord", 0, kMaxInt);
   if (extra_number) number_key(*info, where, extra_number);
+  // The reader takes a whole number past 32 bits round to another (tinygltf's int): such values are
+  // refused here, before it, as every number of the extension is bounded by 1e6 anyway.
+  if (info->contains("extensions") && (*info)["extensions"].contains("KHR_texture_transform")) {
+    const json& t = (*info)["extensions"]["KHR_texture_transform"];
+    const std::string t_at = path(where, "extensions.KHR_texture_transform");
+    numbers_key(t, t_at, "offset", 2, 2);
+    numbers_key(t, t_at, "scale", 2, 2);
+    number_key(t, t_at, "rotation");
+    whole_key(t, t_at, "texCoord", 0, kMaxInt);
+    for (const char* name : {"offset", "scale", "rotation"})
+      if (const json* v = find(t, t_at, name))
+        for (const json& x : v->is_array() ? *v : json::array({*v}))
+          expect(std::abs(x.get<double>()) <= 1e6, x, path(t_at, name), "a number of at most 1e6 in magnitude");
+  }
 }
 
 void SchemaCheck::material(const json& m, const std::string& at) const {
@@ -303,6 +318,12 @@ void SchemaCheck::material(const json& m, const std::string& at) const {
   bool_key(m, at, "doubleSided");
   if (m.contains("extensions") && m["extensions"].contains("KHR_materials_emissive_strength"))
     number_key(m["extensions"]["KHR_materials_emissive_strength"], path(at, "extensions.KHR_materials_emissive_strength"), "emissiveStrength");
+  if (m.contains("extensions") && m["extensions"].contains("KHR_materials_ior")) {
+    const json& e = m["extensions"]["KHR_materials_ior"];
+    const std::string e_at = path(at, "extensions.KHR_materials_ior");
+    number_key(e, e_at, "ior");
+    if (const json* v = find(e, e_at, "ior")) expect(std::abs(v->get<double>()) <= 1e6, *v, path(e_at, "ior"), "an index of refraction");
+  }
 }
 
 void SchemaCheck::mesh(const json& m, const std::string& at) const {
