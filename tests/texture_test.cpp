@@ -1,6 +1,7 @@
 // Textures: PNG and JPEG decoding with its limits, every encoding of a sample decoding to the same
 // colour, the sRGB decode, the CPU reference's filtering and wrap modes, textures from an OBJ file's
 // .mtl, and how they are packed for the shader.
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <memory>
@@ -13,6 +14,7 @@
 
 #include "base/errors.h"
 #include "cpu/texture.h"
+#include "gltf/gltf.h"
 #include "image/decode.h"
 #include "image/image.h"
 #include "packing/scene_packing.h"
@@ -457,6 +459,31 @@ TEST_F(ObjMaterialTest, SceneFileMetallicRoughnessTexturesAreSrgbColourAndLinear
   const std::string gone = error_of([&] { load_scene(dir_ / "scene.json"); });
   EXPECT_NE(gone.find("/materials/gltf/metallic_roughness_texture"), std::string::npos) << gone;
   EXPECT_NE(gone.find("gone.png"), std::string::npos) << gone;
+}
+
+TEST(TextureTransformTest, ATransformAllOfAMaterialsTexturesShareIsAppliedToItsCoordinates) {
+  // u' = sx u cos r + sy v sin r + ox, v' = sy v cos r - sx u sin r + oy, here with r = 90 degrees:
+  // u' = 3 v + 0.5, v' = -2 u + 0.25, then recentred by whole periods of 2 as any coordinates are.
+  test::TempDir dir;
+  test::GltfBuilder b;
+  const int picture = b.texture(test::png_bytes(four_colours()));
+  const nlohmann::json transform = {{"KHR_texture_transform", {{"offset", {0.5, 0.25}}, {"rotation", 1.5707963267948966}, {"scale", {2, 3}}}}};
+  b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", picture}, {"extensions", transform}}},
+                                               {"metallicRoughnessTexture", {{"index", picture}, {"extensions", transform}}}}}}));
+  test::write_file(dir / "quad.gltf", b.gltf());
+  const Scene scene = load_scene(dir / "quad.gltf");
+  ASSERT_EQ(scene.materials.size(), 1u);
+  EXPECT_FALSE(scene.materials[0].albedo_texture.transformed());
+  EXPECT_FALSE(scene.materials[0].metallic_roughness_texture.transformed());
+  ASSERT_EQ(scene.triangles.size(), 2u);
+  const GltfScene raw = parse_gltf(b.gltf(), dir / "raw.gltf");  // the coordinates as the file gives them
+  for (size_t t = 0; t < 2; ++t)
+    for (size_t k = 0; k < 3; ++k) {
+      const glm::vec2 uv = raw.triangles[t].uv[k], mapped = scene.triangles[t].uv[k];
+      const double u = 3.0 * uv.y + 0.5, v = -2.0 * uv.x + 0.25;
+      EXPECT_NEAR(std::remainder(mapped.x - u, 2.0), 0.0, 1e-6) << t << " " << k;
+      EXPECT_NEAR(std::remainder(mapped.y - v, 2.0), 0.0, 1e-6) << t << " " << k;
+    }
 }
 
 TEST_F(ObjMaterialTest, WhatIsNotRenderedIsNamedOnce) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <vector>
 
 #include <glm/gtc/constants.hpp>
 
@@ -16,6 +18,31 @@
 namespace vkray {
 namespace {
 
+// Applies the transform (KHR_texture_transform) that all the textures of a material share to its
+// triangles' texture coordinates, once, in double rounded to float: both renderers then read the
+// same mapped coordinates, which recentre_texture_coordinates can move like any others. Textures
+// with transforms of their own keep them (and their triangles' coordinates stay where they are).
+void apply_shared_texture_transforms(Scene& scene) {
+  std::vector<std::optional<TextureRef>> shared(scene.materials.size());  // the transform to apply, held by a ref
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    const TextureRef* first = nullptr;
+    bool same = true;
+    for (const TextureRef* ref : m.textures()) {
+      if (!ref->present()) continue;
+      if (!first) first = ref;
+      same = same && ref->to_u == first->to_u && ref->to_v == first->to_v;
+    }
+    if (first && same && first->transformed()) shared[i] = *first;
+  }
+  for (Triangle& t : scene.triangles)
+    if (shared[t.material])
+      for (glm::vec2& uv : t.uv) uv = glm::vec2(shared[t.material]->map(glm::dvec2(uv)));
+  for (size_t i = 0; i < scene.materials.size(); ++i)
+    if (shared[i])
+      for (TextureRef* ref : scene.materials[i].textures()) ref->to_u = glm::vec3(1, 0, 0), ref->to_v = glm::vec3(0, 1, 0);
+}
+
 // Moves each textured triangle's texture coordinates by a whole number of periods toward [0, 2)
 // along each axis its textures repeat (an even number, so that a mirrored repeat reads the same):
 // exact in float, and the texture reads the same, but both renderers then interpolate small
@@ -24,8 +51,8 @@ void recentre_texture_coordinates(Scene& scene) {
   for (Triangle& t : scene.triangles) {
     const Material& m = scene.materials[t.material];
     if (!m.textured()) continue;
-    // A transformed texture (KHR_texture_transform) maps a whole period of the coordinate to another
-    // amount of its own: such coordinates stay where they are.
+    // A texture still transformed (its material's textures have different transforms) maps a whole
+    // period of the coordinate to another amount of its own: such coordinates stay where they are.
     const auto repeats = [&](bool s) {
       for (const TextureRef* ref : m.textures())
         if (ref->present() && ((s ? ref->wrap_s : ref->wrap_t) == TextureWrap::clamp_to_edge || ref->transformed())) return false;
@@ -40,9 +67,10 @@ void recentre_texture_coordinates(Scene& scene) {
   }
 }
 
-// What every scene goes through last, whatever its file type: its texture coordinates recentred,
-// and the checks that need the whole scene.
+// What every scene goes through last, whatever its file type: its texture coordinates mapped by
+// shared transforms and recentred, and the checks that need the whole scene.
 void finish_scene(Scene& scene) {
+  apply_shared_texture_transforms(scene);
   recentre_texture_coordinates(scene);
   check_float_range(scene);
 }
