@@ -35,8 +35,9 @@ Scene textured_quad(const nlohmann::json& sampler, bool path, bool emissive = fa
 }
 
 // A quad whose base colour and emission textures have transforms of their own (KHR_texture_transform),
-// which the shaders apply: a material whose textures share one has it applied to its coordinates
-// on the host instead (scene_loader.cpp).
+// which the shaders apply (a material whose textures share one has it applied to its coordinates
+// on the host instead, scene_loader.cpp), over a white floor that its textured emission lights
+// through light sampling.
 Scene transformed_textures_quad(bool path) {
   GltfBuilder b;
   const int texture = b.texture(png_bytes(four_colours()), {{"magFilter", 9728}});
@@ -44,23 +45,27 @@ Scene transformed_textures_quad(bool path) {
   const nlohmann::json moved = {{"KHR_texture_transform", {{"offset", {0.5, 0.0}}}}};
   b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", texture}, {"extensions", turned}}}, {"metallicFactor", 0}}},
                      {"emissiveTexture", {{"index", texture}, {"extensions", moved}}},
-                     {"emissiveFactor", {0.3, 0.3, 0.3}}}));
-  b.doc["extensionsUsed"] = {"KHR_texture_transform"};
+                     {"emissiveFactor", {1, 1, 1}},
+                     {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 3}}}}}}));
+  b.doc["extensionsUsed"] = {"KHR_texture_transform", "KHR_materials_emissive_strength"};
   TempDir dir;
   write_file(dir / "quad.glb", b.glb());
   const std::string integrator = path ? R"({"type": "path", "max_depth": 3})" : R"({"type": "direct"})";
-  write_file(dir / "scene.json", R"({"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "vertical_fov": 40},
-    "integrator": )" + integrator + R"(, "background": [0.5, 0.5, 0.5],
-    "lights": [{"type": "point", "position": [0, 0, 3], "intensity": [9, 9, 9]}],
-    "objects": [{"type": "gltf", "file": "quad.glb"}]})");
+  write_file(dir / "scene.json", R"({"camera": {"position": [0, 1.5, 4], "look_at": [0, -0.4, 0], "vertical_fov": 45},
+    "integrator": )" + integrator + R"(, "background": [0.2, 0.2, 0.2],
+    "lights": [{"type": "point", "position": [0, 0, 3], "intensity": [4, 4, 4]}],
+    "materials": {"floor": {"albedo": [0.8, 0.8, 0.8]}},
+    "objects": [{"type": "gltf", "file": "quad.glb"},
+                {"type": "triangles", "material": "floor", "positions": [[-3, -1.2, -2], [3, -1.2, -2], [3, -1.2, 4], [-3, -1.2, 4]],
+                 "indices": [[0, 2, 1], [0, 3, 2]]}]})");
   return load_scene(dir / "scene.json");
 }
 
 TEST(TextureTransformTest, TexturesWithTransformsOfTheirOwnKeepThem) {
   const Scene scene = transformed_textures_quad(false);
-  ASSERT_EQ(scene.materials.size(), 1u);
-  EXPECT_TRUE(scene.materials[0].albedo_texture.transformed());
-  EXPECT_TRUE(scene.materials[0].emission_texture.transformed());
+  ASSERT_EQ(scene.materials.size(), 2u);  // the floor's, then the quad's
+  EXPECT_TRUE(scene.materials[1].albedo_texture.transformed());
+  EXPECT_TRUE(scene.materials[1].emission_texture.transformed());
 }
 
 class TextureTransformParityTest : public ParityTest, public ::testing::WithParamInterface<bool> {};
