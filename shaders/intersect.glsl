@@ -100,17 +100,20 @@ vec2 triangle_barycentrics(vec3 p, vec3 v0, vec3 v1, vec3 v2) {
   return vec2((d22 * d1 - d12 * d2) * inv, (d11 * d2 - d12 * d1) * inv);
 }
 
-// The unit normal of a triangle, (v1 - v0) x (v2 - v0) normalized. The edges are brought to a size of
-// about 1 first, as above: for edges of 6e-10 the squared length of the cross product is near the
-// smallest normal float, and a device that flushes subnormals to zero (NVIDIA's does) then normalizes
-// by too short a length; for edges of 1e-12 it is 0 on every device (a NaN normal), and for 1e13 it
-// overflows (a zero normal).
-vec3 triangle_normal(vec3 v0, vec3 v1, vec3 v2) {
+// The direction of a triangle's normal, (v1 - v0) x (v2 - v0) times a positive number: the edges are
+// brought to a size of about 1 first, as above. For edges of 6e-10 the squared length of the plain
+// cross product is near the smallest normal float, and a device that flushes subnormals to zero
+// (NVIDIA's does) then normalizes by too short a length; for edges of 1e-12 it is 0 on every device
+// (a NaN normal), and for 1e13 it overflows (a zero normal).
+vec3 triangle_normal_direction(vec3 v0, vec3 v1, vec3 v2) {
   vec3 e1 = v1 - v0, e2 = v2 - v0;
   vec3 largest = max(abs(e1), abs(e2));
   float scale = 1.0 / max(largest.x, max(largest.y, largest.z));
-  return normalize(cross(e1 * scale, e2 * scale));
+  return cross(e1 * scale, e2 * scale);
 }
+
+// The unit normal of a triangle.
+vec3 triangle_normal(vec3 v0, vec3 v1, vec3 v2) { return normalize(triangle_normal_direction(v0, v1, v2)); }
 
 // ---- Ray-box ------------------------------------------------------------------------------------------
 // 1 / d, with zero components replaced by a tiny number of the same sign, so that no slab test can

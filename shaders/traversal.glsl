@@ -13,7 +13,8 @@
 // Whether a camera ray that hits the triangle (a, b, c) meets the back of a single-sided one, and
 // so passes through it (Material::double_sided): the side away from its winding's normal.
 bool culled(Ray ray, vec4 a, vec4 b, vec4 c) {
-  return (primitive_flags(a) & VKRAY_PRIM_SINGLE_SIDED) != 0u && dot(ray.dir, triangle_normal(a.xyz, b.xyz, c.xyz)) > 0.0;
+  return (primitive_flags(a) & VKRAY_PRIM_SINGLE_SIDED) != 0u &&
+         dot(ray.dir, triangle_normal_direction(a.xyz, b.xyz, c.xyz)) > 0.0;
 }
 
 // Tests the primitives of a leaf against the ray, keeping the closest hit (ties go to the primitive

@@ -66,10 +66,10 @@ std::string inline_scene_glsl(const PackedGeometry& packed) {
     } else {
       const std::string a = vertex(t[0]), b = vertex(t[1]), c = vertex(t[2]);
       out += "  t = sheared_triangle(" + a + ", " + b + ", " + c + ", t_min, bound);\n";
-      // The back of a single-sided triangle passes a camera ray (traversal.glsl's culled()); its
-      // normal is the same triangle_normal of the same coordinates.
+      // The back of a single-sided triangle passes a camera ray (traversal.glsl's culled()), with the
+      // same triangle_normal_direction of the same coordinates.
       if (primitive_flags(t[0]) & VKRAY_PRIM_SINGLE_SIDED)
-        out += "  if (cull_back && t > 0.0 && dot(ray.dir, triangle_normal(" + vec3_literal(t[0]) + ", " + vec3_literal(t[1]) + ", " +
+        out += "  if (cull_back && t > 0.0 && dot(ray.dir, triangle_normal_direction(" + vec3_literal(t[0]) + ", " + vec3_literal(t[1]) + ", " +
                vec3_literal(t[2]) + ")) > 0.0) t = -1.0;\n";
     }
     // In the scene's order, intersect_leaf's tie rule is: closer than the best by more than VKRAY_TIE.
