@@ -191,7 +191,8 @@ TEST(GltfTest, MaterialsKeepTheirColourAndEmissionAndNameWhatIsNotRendered) {
                                {"emissiveTexture", {{"index", texture}}},
                                {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}}}}});
   const int metal = b.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.3, 0.4, 0.5}}, {"metallicFactor", 1}}},
-                                {"alphaMode", "MASK"}, {"normalTexture", {{"index", texture}}}});
+                                {"alphaMode", "MASK"}, {"normalTexture", {{"index", texture}, {"scale", -0.5}}},
+                                {"occlusionTexture", {{"index", texture}}}});
   b.quad(lamp);
   b.quad(metal);
   b.quad(metal);
@@ -203,12 +204,14 @@ TEST(GltfTest, MaterialsKeepTheirColourAndEmissionAndNameWhatIsNotRendered) {
   EXPECT_EQ(s.materials[1].type, MaterialType::metallic_roughness);
   EXPECT_EQ(s.materials[1].metallic, 1.0f);
   EXPECT_EQ(s.materials[1].roughness, 1.0f);  // glTF's default
+  EXPECT_TRUE(s.materials[1].normal_texture.present());
+  EXPECT_EQ(s.materials[1].normal_scale, -0.5f);
   EXPECT_EQ(s.triangles.size(), 6u);
   std::string all;
   for (const auto& w : s.warnings) all += w + "\n";
   EXPECT_EQ(s.warnings.size(), 2u) << all;  // once each, though two quads use the material
   EXPECT_NE(all.find("alphaMode MASK is not rendered"), std::string::npos) << all;
-  EXPECT_NE(all.find("normal textures are not rendered"), std::string::npos) << all;
+  EXPECT_NE(all.find("occlusion textures are not rendered"), std::string::npos) << all;
 }
 
 TEST(GltfTest, MaterialsAreGltfsMetallicRoughnessModelWithTheirFactorsAndIor) {

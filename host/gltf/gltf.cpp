@@ -423,7 +423,13 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
     else
       warn_once("no " + uv_name, where + ".attributes", "no " + uv_name + " for its material's texture: every point takes the texture's value at (0, 0)");
   }
-  for (const auto* a : {normals ? &*normals : nullptr, uvs ? &*uvs : nullptr})
+  // Tangents where the material has a normal map and the primitive has normals (without them, glTF
+  // says a file's tangents are ignored); MikkTSpace's otherwise (load/scene_loader.cpp).
+  std::optional<AccessorView> tangents;
+  if (normals && scene_.materials[mat].normal_texture.present())
+    if (const auto at = p.attributes.find("TANGENT"); at != p.attributes.end())
+      tangents = accessor(at->second, where + ".attributes.TANGENT", {TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  for (const auto* a : {normals ? &*normals : nullptr, uvs ? &*uvs : nullptr, tangents ? &*tangents : nullptr})
     if (a && a->count != vertices)
       fail(where + ".attributes", "an attribute has " + std::to_string(a->count) + " elements, POSITION has " + std::to_string(vertices));
 
@@ -474,6 +480,17 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
     const double length = glm::length(n);
     return length > 0 && std::isfinite(length) ? glm::vec3(n / length) : glm::vec3(0.0f);
   };
+  // A tangent is a direction along the surface: it turns as positions do, and a transform that mirrors
+  // the mesh turns the bitangent's sign around with its winding. Unit, or zero where the file's is.
+  const auto tangent = [&](uint32_t v) {
+    const glm::dvec4 t(tangents->get(v, 0), tangents->get(v, 1), tangents->get(v, 2), tangents->get(v, 3));
+    if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z) || !std::isfinite(t.w))
+      fail(where + ".attributes.TANGENT", "tangent " + std::to_string(v) + " is not finite");
+    const dvec3 d = linear * dvec3(t);
+    const double length = glm::length(d);
+    const float sign = (t.w < 0) != mirrored ? -1.0f : 1.0f;
+    return length > 0 && std::isfinite(length) ? glm::vec4(glm::vec3(d / length), sign) : glm::vec4(0.0f);
+  };
   const auto uv = [&](uint32_t v) {
     const glm::dvec2 t(uvs->get(v, 0), uvs->get(v, 1));
     if (!(std::abs(t.x) <= kMaxCoordinate && std::abs(t.y) <= kMaxCoordinate))
@@ -501,6 +518,11 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
       if (uvs) tri.uv[k] = uv(c[k]);
     }
     tri.smooth = normals.has_value() && std::all_of(tri.normals.begin(), tri.normals.end(), [](const glm::vec3& n) { return n != glm::vec3(0.0f); });
+    // A triangle with a zero tangent at a corner, or not smooth, takes MikkTSpace's instead.
+    if (tangents && tri.smooth) {
+      for (size_t k = 0; k < 3; ++k) tri.tangents[k] = tangent(c[k]);
+      if (!std::all_of(tri.tangents.begin(), tri.tangents.end(), [](const glm::vec4& t_k) { return t_k.w != 0.0f; })) tri.tangents = {};
+    }
     scene_.triangles.push_back(tri);
   }
 }
@@ -571,9 +593,22 @@ uint32_t GltfReader::material(int index, const std::string& where) {
         warn_once("texcoord sets", name, "the metallicRoughnessTexture's texCoord differs from the other textures': all use TEXCOORD_" + std::to_string(set));
       if (!m.albedo_texture.present() && !m.emission_texture.present()) set = texcoord_of(pbr.metallicRoughnessTexture);
     }
+    if (g.normalTexture.index >= 0) {  // data, not colour: linear
+      tinygltf::TextureInfo info;
+      info.index = g.normalTexture.index;
+      info.texCoord = g.normalTexture.texCoord;
+      info.extensions = g.normalTexture.extensions;
+      m.normal_texture = texture(info, name + ".normalTexture", false);
+      if (!(std::abs(g.normalTexture.scale) <= 1e6))
+        fail(name + ".normalTexture.scale", "expected a number of at most 1e6 in magnitude, got " + brief(nlohmann::json(g.normalTexture.scale)));
+      m.normal_scale = float(g.normalTexture.scale);
+      const bool others = m.albedo_texture.present() || m.emission_texture.present() || m.metallic_roughness_texture.present();
+      if (others && texcoord_of(info) != set)
+        warn_once("texcoord sets", name, "the normalTexture's texCoord differs from the other textures': all use TEXCOORD_" + std::to_string(set));
+      if (!others) set = texcoord_of(info);
+    }
     if (set < 0 || set > 7) fail(name, "texCoord " + std::to_string(set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
     texcoord_sets_[index] = set;
-    if (g.normalTexture.index >= 0) warn_once("normalTexture", name, "normal textures are not rendered");
     if (g.occlusionTexture.index >= 0) warn_once("occlusionTexture", name, "occlusion textures are not rendered (light transport computes occlusion)");
     if (g.alphaMode == "MASK" || g.alphaMode == "BLEND")
       warn_once("alphaMode", name, "alphaMode " + g.alphaMode + " is not rendered: surfaces are opaque");

@@ -11,8 +11,10 @@
 #include "base/errors.h"
 #include "base/extension.h"
 #include "base/input_file.h"
+#include "base/interrupt.h"
 #include "base/json_document.h"
 #include "load/scene_parser.h"
+#include "mesh/tangents.h"
 #include "scene/float_range.h"
 
 namespace vkray {
@@ -67,9 +69,44 @@ void recentre_texture_coordinates(Scene& scene) {
   }
 }
 
-// What every scene goes through last, whatever its file type: its texture coordinates mapped by
-// shared transforms and recentred, and the checks that need the whole scene.
+// MikkTSpace's tangents for the triangles of normal-mapped materials that have none (a glTF file
+// without TANGENT, an OBJ or PLY file, a scene file's own triangles), each object's together, from
+// the normals they are shaded with and their texture coordinates before any transform maps them
+// (KHR_texture_transform moves where a texture is read, not the mesh's tangent space).
+void add_missing_tangents(Scene& scene) {
+  std::vector<std::vector<size_t>> of_object;  // the triangles that need tangents, by object
+  for (size_t i = 0; i < scene.triangles.size(); ++i) {
+    const Triangle& t = scene.triangles[i];
+    if (!scene.materials[t.material].normal_texture.present() || t.has_tangents()) continue;
+    if (t.object >= of_object.size()) of_object.resize(size_t(t.object) + 1);
+    of_object[t.object].push_back(i);
+  }
+  std::vector<TangentTriangle> input;
+  for (const std::vector<size_t>& triangles : of_object) {
+    if (triangles.empty()) continue;
+    throw_if_interrupted();
+    input.clear();
+    input.reserve(triangles.size());
+    for (const size_t i : triangles) {
+      const Triangle& t = scene.triangles[i];
+      TangentTriangle m{t.v, t.normals, t.uv};
+      if (!t.smooth) {
+        const glm::dvec3 n = glm::cross(glm::dvec3(t.v[1]) - glm::dvec3(t.v[0]), glm::dvec3(t.v[2]) - glm::dvec3(t.v[0]));
+        const double length = glm::length(n);
+        m.normal.fill(length > 0 ? glm::vec3(n / length) : glm::vec3(0.0f));
+      }
+      input.push_back(m);
+    }
+    const std::vector<std::array<glm::vec4, 3>> tangents = mikktspace_tangents(input);
+    for (size_t k = 0; k < triangles.size(); ++k) scene.triangles[triangles[k]].tangents = tangents[k];
+  }
+}
+
+// What every scene goes through last, whatever its file type: tangents where normal maps need them,
+// its texture coordinates mapped by shared transforms and recentred, and the checks that need the
+// whole scene.
 void finish_scene(Scene& scene) {
+  add_missing_tangents(scene);
   apply_shared_texture_transforms(scene);
   recentre_texture_coordinates(scene);
   check_float_range(scene);

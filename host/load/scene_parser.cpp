@@ -192,19 +192,19 @@ void SceneParser::parse_materials(const Value& v) {
     material.type = *known;
     switch (material.type) {
       case MaterialType::diffuse:
-        check_keys(m, {"type", "albedo", "emission"});
+        check_keys(m, {"type", "albedo", "emission", "normal_texture", "normal_scale"});
         material.albedo = reflectance(require(m, "albedo"));
         break;
       case MaterialType::mirror:
-        check_keys(m, {"type", "reflectance", "emission"});
+        check_keys(m, {"type", "reflectance", "emission", "normal_texture", "normal_scale"});
         material.albedo = reflectance(require(m, "reflectance"));
         break;
       case MaterialType::glass:
-        check_keys(m, {"type", "ior", "emission"});
+        check_keys(m, {"type", "ior", "emission", "normal_texture", "normal_scale"});
         if (m.has("ior")) material.ior = index_of_refraction(m["ior"]);
         break;
       case MaterialType::roughconductor:
-        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "specular_reflectance", "eta", "k", "emission"});
+        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "specular_reflectance", "eta", "k", "emission", "normal_texture", "normal_scale"});
         material.alpha = roughness(m);
         material.albedo = m.has("specular_reflectance") ? reflectance(m["specular_reflectance"]) : glm::vec3(1.0f);
         if (m.has("eta")) material.eta = bounded_color(m["eta"], kMaxIor, "indices of refraction up to 100");
@@ -215,14 +215,14 @@ void SceneParser::parse_materials(const Value& v) {
                                                  "either, eta 0 and k 1 reflect everything)");
         break;
       case MaterialType::roughdielectric:
-        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "int_ior", "emission"});
+        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "int_ior", "emission", "normal_texture", "normal_scale"});
         material.alpha = roughness(m);
         material.albedo = glm::vec3(1.0f);  // clear: Mitsuba's specular reflectance and transmittance, 1
         if (m.has("int_ior")) material.ior = index_of_refraction(m["int_ior"]);
         break;
       case MaterialType::metallic_roughness:  // glTF 2.0's, with its names and defaults
         check_keys(m, {"type", "base_color", "metallic", "roughness", "ior", "emission", "base_color_texture",
-                       "metallic_roughness_texture"});
+                       "metallic_roughness_texture", "normal_texture", "normal_scale"});
         material.albedo = m.has("base_color") ? reflectance(m["base_color"]) : glm::vec3(1.0f);
         // Pictures beside the scene file, read where a mesh gives texture coordinates: the base colour
         // as sRGB; metallic (blue) and roughness (green) as linear data, as glTF's textures are.
@@ -238,6 +238,14 @@ void SceneParser::parse_materials(const Value& v) {
         break;
     }
     if (m.has("emission")) material.emission = color(m["emission"]);
+    // A tangent-space normal map (linear data, as glTF's normalTexture) on any material, read where a
+    // mesh gives texture coordinates; normal_scale multiplies its red and green.
+    if (m.has("normal_texture")) material.normal_texture.texture = texture_file(m["normal_texture"], file_of(m["normal_texture"]), false);
+    if (m.has("normal_scale")) {
+      if (!m.has("normal_texture")) fail(m["normal_scale"], "normal_scale without a normal_texture");
+      material.normal_scale = number(m["normal_scale"]);
+      if (!(std::abs(material.normal_scale) <= 1e6f)) fail(m["normal_scale"], "expected a number of at most 1e6 in magnitude, got " + brief(m["normal_scale"].j));
+    }
     material_index_[name] = static_cast<uint32_t>(scene_.materials.size());
     scene_.materials.push_back(material);
   }

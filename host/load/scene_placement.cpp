@@ -51,8 +51,9 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
   static const json kNothing;
   const Value root{kNothing, ""};  // where messages point when the file is the scene itself
   const Value& at = where ? *where : root;
-  // The object's transform on top of the file's own: normals by the inverse transpose, and the
-  // winding turned around where it mirrors.
+  // The object's transform on top of the file's own: normals by the inverse transpose, tangents (the
+  // file's TANGENT) as directions along the surface, and the winding, with the tangents' sign, turned
+  // around where it mirrors.
   const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(transform)));
   const bool mirrors = glm::determinant(glm::mat3(transform)) < 0.0f;
   const bool moved = transform != glm::mat4(1.0f);
@@ -61,16 +62,25 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
     t.material += material_offset;
     t.object = object_;
     if (!moved) continue;
+    const bool tangents = t.has_tangents();
     for (size_t k = 0; k < 3; ++k) {
       t.v[k] = transform_point(transform, t.v[k]);
       if (t.smooth) t.normals[k] = glm::normalize(normal_matrix * t.normals[k]);
+      if (tangents) {
+        const glm::vec3 tangent = glm::mat3(transform) * glm::vec3(t.tangents[k]);
+        const float length = glm::length(tangent);
+        t.tangents[k] = length > 0.0f && std::isfinite(length) ? glm::vec4(tangent / length, mirrors ? -t.tangents[k].w : t.tangents[k].w)
+                                                               : glm::vec4(0.0f);
+      }
     }
+    if (!std::all_of(t.tangents.begin(), t.tangents.end(), [](const glm::vec4& corner) { return corner.w != 0.0f; })) t.tangents = {};
     if (t.smooth && !std::all_of(t.normals.begin(), t.normals.end(), [](const glm::vec3& n) { return std::isfinite(n.x) && glm::length(n) > 0.5f; }))
       t.smooth = false;
     if (mirrors) {
       std::swap(t.v[1], t.v[2]);
       std::swap(t.normals[1], t.normals[2]);
       std::swap(t.uv[1], t.uv[2]);
+      std::swap(t.tangents[1], t.tangents[2]);
     }
   }
   add_triangles(at, placed);

@@ -13,9 +13,9 @@ static_assert(sizeof(Camera) == 48, "a Camera field is not in scene_digest");
 static_assert(sizeof(Integrator) == 12, "an Integrator field is not in scene_digest");
 static_assert(sizeof(PointLight) == 24, "a PointLight field is not in scene_digest");
 static_assert(sizeof(Sphere) == 28, "a Sphere field is not in scene_digest");
-static_assert(sizeof(Triangle) == 108, "a Triangle field is not in scene_digest");
+static_assert(sizeof(Triangle) == 156, "a Triangle field is not in scene_digest");
 static_assert(sizeof(TextureRef) == 40, "a TextureRef field is not in scene_digest");
-static_assert(sizeof(Material) == 232, "a Material field is not in scene_digest");
+static_assert(sizeof(Material) == 272, "a Material field is not in scene_digest");
 static_assert(sizeof(Scene) == 376, "a Scene field is not in scene_digest");
 
 // Hasher with glm's vectors, component by component.
@@ -42,7 +42,7 @@ void add(SceneHasher& h, const TextureRef& t) {
 std::string scene_digest(const Scene& scene) {
   auto h = std::make_unique<SceneHasher>();  // its buffer is too large for a thread's stack to hold lightly
   // A version of this layout: bump it when the order or the meaning of what is hashed changes.
-  h->add(std::string("vkray scene digest 5"));
+  h->add(std::string("vkray scene digest 6"));
   const Camera& c = scene.camera;
   h->add(c.position), h->add(c.forward), h->add(c.up), h->add(c.focal_length), h->add(c.aperture_radius),
       h->add(c.focus_distance);
@@ -55,6 +55,8 @@ std::string scene_digest(const Scene& scene) {
     add(*h, m.albedo_texture);
     add(*h, m.emission_texture);
     add(*h, m.metallic_roughness_texture);
+    add(*h, m.normal_texture);
+    h->add(m.normal_scale);
     h->add(m.double_sided);
   }
   h->add(uint64_t(scene.textures.size()));
@@ -72,6 +74,7 @@ std::string scene_digest(const Scene& scene) {
     h->add(t.material), h->add(t.object), h->add(t.smooth);
     for (const glm::vec3& n : t.normals) h->add(n);
     for (const glm::vec2& uv : t.uv) h->add(uv);
+    for (const glm::vec4& tangent : t.tangents) h->add(tangent);
   }
   return h->hex();
 }

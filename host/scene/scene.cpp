@@ -42,7 +42,7 @@ bool same_bits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, 
 bool same_bits(const Triangle& a, const Triangle& b) {
   for (size_t k = 0; k < 3; ++k)
     if (!same_bits(a.v[k], b.v[k]) || !same_bits(a.normals[k], b.normals[k]) ||
-        std::memcmp(&a.uv[k], &b.uv[k], sizeof(glm::vec2)) != 0)
+        std::memcmp(&a.uv[k], &b.uv[k], sizeof(glm::vec2)) != 0 || std::memcmp(&a.tangents[k], &b.tangents[k], sizeof(glm::vec4)) != 0)
       return false;
   return a.material == b.material && a.object == b.object && a.smooth == b.smooth;
 }
@@ -64,13 +64,17 @@ bool same_geometry(const Scene& a, const Scene& b) {
   const auto textured = [](const Scene& s) {
     return std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.textured(); });
   };
+  // The tangents are on the device when some material has a normal map.
+  const auto normal_mapped = [](const Scene& s) {
+    return std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.normal_texture.present(); });
+  };
   // A primitive's flags also say whether its material is single-sided.
   const auto same_sidedness = [&] {
     for (size_t i = 0; i < a.materials.size(); ++i)
       if (a.materials[i].double_sided != b.materials[i].double_sided) return false;
     return true;
   };
-  return a.materials.size() == b.materials.size() && textured(a) == textured(b) && same_sidedness() &&
+  return a.materials.size() == b.materials.size() && textured(a) == textured(b) && normal_mapped(a) == normal_mapped(b) && same_sidedness() &&
          std::equal(a.textures.begin(), a.textures.end(), b.textures.begin(), b.textures.end(), same_texture) &&
          std::equal(a.triangles.begin(), a.triangles.end(), b.triangles.begin(), b.triangles.end(), same) &&
          std::equal(a.spheres.begin(), a.spheres.end(), b.spheres.begin(), b.spheres.end(), same);

@@ -103,6 +103,11 @@ struct Material {
   TextureRef albedo_texture;
   TextureRef emission_texture;
   TextureRef metallic_roughness_texture;
+  // A tangent-space normal map (glTF's normalTexture, linear): its red, green and blue, each taken from
+  // [0, 1] to [-1, 1], are a normal along a triangle's tangent, bitangent and normal (Triangle::tangents);
+  // `normal_scale` multiplies the first two (glTF's normalTexture.scale).
+  TextureRef normal_texture;
+  float normal_scale = 1.0f;
   // false: single-sided (glTF's doubleSided false): camera rays, and so the first-hit passes, pass
   // through its triangles' back faces (the side away from their winding's normal); every other ray
   // meets both sides.
@@ -110,8 +115,10 @@ struct Material {
 
   bool emissive() const { return emission != glm::vec3(0.0f); }
   // Every texture reference, for code that treats them alike.
-  std::array<TextureRef*, 3> textures() { return {&albedo_texture, &emission_texture, &metallic_roughness_texture}; }
-  std::array<const TextureRef*, 3> textures() const { return {&albedo_texture, &emission_texture, &metallic_roughness_texture}; }
+  std::array<TextureRef*, 4> textures() { return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture}; }
+  std::array<const TextureRef*, 4> textures() const {
+    return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture};
+  }
   bool textured() const {
     const auto refs = textures();
     return std::any_of(refs.begin(), refs.end(), [](const TextureRef* t) { return t->present(); });
@@ -152,7 +159,12 @@ struct Triangle {
   // Texture coordinates of the vertices, as glTF has them: (0, 0) is the top left corner of a
   // picture, (1, 1) its bottom right. All zero where the mesh has none.
   std::array<glm::vec2, 3> uv{};
+  // The vertices' tangents where the material has a normal map (glTF's TANGENT, or MikkTSpace's):
+  // xyz the unit tangent along which u grows, w the bitangent's sign: bitangent = w cross(normal,
+  // tangent), the direction in which v falls (up the picture). w 0: none.
+  std::array<glm::vec4, 3> tangents{};
 
+  bool has_tangents() const { return tangents[0].w != 0.0f; }
 };
 
 struct Scene {
