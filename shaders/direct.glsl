@@ -37,8 +37,8 @@ vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
       radiance += throughput * shade(ray, x, s, stream, rays);
       break;
     }
-    vec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
-    vec3 n = front ? s.shading_normal : -s.shading_normal;
+    Facing f = facing(s, ray.dir, front);
+    vec3 n_geometric = f.n_geometric, n = f.n;
     BsdfSample b = sample_bsdf(s, -ray.dir, n, front, stream);
     // A direction on the wrong side of the surface (an interpolated normal can point there) ends it.
     if ((dot(b.dir, n_geometric) > 0.0) == b.transmitted) break;

@@ -67,8 +67,8 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   // Mitsuba's depth: a path of max_depth vertices ends here (-1, as a uint, never does).
   if (++p.depth >= uint(frame.max_depth)) return true;
 
-  vec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
-  vec3 n = front ? s.shading_normal : -s.shading_normal;
+  Facing f = facing(s, p.ray.dir, front);
+  vec3 n_geometric = f.n_geometric, n = f.n;
   vec3 origin = x + frame.epsilon * n_geometric;  // on the side the ray came from
   vec3 wo = -p.ray.dir;
   if (!SCENE_HAS_NON_DIFFUSE || (s.properties & VKRAY_BSDF_DELTA) == 0u) {

@@ -14,10 +14,28 @@ float intersect_primitive(Ray ray, RayShear shear, vec4 a, vec4 b, vec4 c, float
   return intersect_triangle(ray, shear, a.xyz, b.xyz, c.xyz, t_min, t_max);
 }
 
+// ---- Normal maps ---------------------------------------------------------------------------------------
+// The unit shading normal n of the triangle in primitive slot `prim`, at barycentrics b, turned by a
+// tangent-space normal map's value `texel`, its red and green scaled by `scale` (glTF's formula),
+// in MikkTSpace's frame: the interpolated tangent t, not normalized, and the bitangent
+// sign cross(n, t). n itself where the triangle has no tangents or the result has no length.
+vec3 normal_mapped(vec3 n, uint prim, vec2 b, vec3 texel, float scale) {
+  int base = int(prim) * VKRAY_TEXELS_PER_PRIMITIVE;
+  vec4 t0 = texelFetch(tangents, base), t1 = texelFetch(tangents, base + 1), t2 = texelFetch(tangents, base + 2);
+  float b0 = 1.0 - b.x - b.y;
+  vec3 t = b0 * t0.xyz + b.x * t1.xyz + b.y * t2.xyz;
+  float sign = b0 * t0.w + b.x * t1.w + b.y * t2.w;
+  vec3 bt = (sign < 0.0 ? -1.0 : 1.0) * cross(n, t);
+  vec3 m = (2.0 * texel - 1.0) * vec3(scale, scale, 1.0);
+  vec3 perturbed = m.x * t + m.y * bt + m.z * n;
+  float length2 = dot(perturbed, perturbed);
+  return t0.w != 0.0 && length2 > 0.0 ? perturbed * inversesqrt(length2) : n;
+}
+
 // ---- The surface at a hit -------------------------------------------------------------------------------
 struct Surface {
   vec3 geometric_normal;  // unit, not yet oriented toward the ray: the side it faces emits
-  vec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal
+  vec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal; then the normal map's
   vec3 albedo;            // the material's colour (shared/materials.h), its texture applied
   uint material_type;     // VKRAY_MATERIAL_*: only bsdf.glsl asks it
   uint properties;        // VKRAY_BSDF_*: what everything else asks
@@ -77,13 +95,15 @@ Surface hit_surface(Hit hit, vec3 position) {
   s.geometric_normal = triangle_normal(a.xyz, v1, v2);
   s.shading_normal = s.geometric_normal;
   bool smooth_normals = (flags & VKRAY_PRIM_SMOOTH) != 0u;
-  vec4 albedo_texture = vec4(0.0), emission_texture = vec4(0.0), layers_texture = vec4(0.0);
+  vec4 albedo_texture = vec4(0.0), emission_texture = vec4(0.0), layers_texture = vec4(0.0), normal_texture = vec4(0.0);
   if (SCENE_HAS_TEXTURES) {
     albedo_texture = texelFetch(materials, material + VKRAY_MATERIAL_ALBEDO_TEXTURE);
     emission_texture = texelFetch(materials, material + VKRAY_MATERIAL_EMISSION_TEXTURE);
     if (SCENE_HAS_metallic_roughness) layers_texture = texelFetch(materials, material + VKRAY_MATERIAL_LAYERS_TEXTURE);
+    if (SCENE_HAS_NORMAL_MAPS) normal_texture = texelFetch(materials, material + VKRAY_MATERIAL_NORMAL_TEXTURE);
   }
-  bool textured = SCENE_HAS_TEXTURES && (has_texture(albedo_texture) || has_texture(emission_texture) || has_texture(layers_texture));
+  bool textured = SCENE_HAS_TEXTURES && (has_texture(albedo_texture) || has_texture(emission_texture) || has_texture(layers_texture) ||
+                                         has_texture(normal_texture));
   if (!smooth_normals && !textured) return s;
   vec2 b = triangle_barycentrics(position, a.xyz, v1, v2);
   if (smooth_normals)
@@ -98,6 +118,9 @@ Surface hit_surface(Hit hit, vec3 position) {
       s.metallic *= layers.b;
       s.roughness *= layers.g;
     }
+    if (SCENE_HAS_NORMAL_MAPS && has_texture(normal_texture))
+      s.shading_normal = normal_mapped(s.shading_normal, hit.prim, b, sample_texture(normal_texture, material + VKRAY_MATERIAL_NORMAL_TEXTURE, uv),
+                                       texelFetch(materials, material + VKRAY_MATERIAL_LAYERS).z);
   }
   return s;
 }

@@ -1,10 +1,11 @@
 // Direct shading from point lights plus an ambient term; for a Lambertian surface exactly the scene
 // contract:
 //   L = albedo * (A + sum_lights V * I * (n . w) / (pi r^2) + one area-light sample)
-// with n the normal facing the incoming ray (the interpolated vertex normal for smooth meshes, the
-// geometric normal otherwise), w the unit vector to the light, r its distance, and V = 0 when the
-// light is at most epsilon above the plane of n at x (n . (light - x) <= epsilon) or a shadow ray
-// finds anything closer than the light. Any other surface that is not a delta: the ambient term times
+// with n the shading normal facing the incoming ray (facing() below: the interpolated vertex normal
+// for smooth meshes, the geometric normal otherwise, turned by a normal map), w the unit vector to the
+// light, r its distance, and V = 0 when the light is at most epsilon above the plane of n at x
+// (n . (light - x) <= epsilon), below the geometric plane at x (shading normals let no light through
+// a surface), or a shadow ray finds anything closer than the light. Any other surface that is not a delta: the ambient term times
 // its colour, and its BSDF f(wo, w) (n . w) in place of albedo (n . w) / pi. The path integrator
 // (path.glsl) uses the same light terms.
 #ifndef VKRAY_SHADE_GLSL
@@ -16,6 +17,42 @@
 #include "resources.glsl"
 #include "traversal.glsl"
 #include "warp.glsl"
+
+// ---- The side a ray meets ------------------------------------------------------------------------------
+// The shading normal n bent toward the geometric normal ng (both on wo's side) just enough that the
+// mirror reflection of wo about it leaves the surface at least min(0.9 (ng . wo), 0.01) above it in
+// cosine: Cycles' rule for shading normals that face away from the viewer (a normal map's steep
+// slopes, a coarse mesh's vertex normals at its silhouette), which would otherwise reflect into the
+// surface and shade black. n itself where its reflection already leaves. With N = x X + z ng (X the
+// unit part of n across ng) the condition 2 (N . wo) z - (ng . wo) = threshold is a quadratic in z^2;
+// its one root that solves it before squaring.
+vec3 valid_reflection_normal(vec3 ng, vec3 wo, vec3 n) {
+  float iz = dot(wo, ng);
+  float threshold = min(0.9 * iz, 0.01);
+  if (dot(ng, 2.0 * dot(n, wo) * n - wo) >= threshold) return n;
+  vec3 across = n - dot(n, ng) * ng;
+  float across2 = dot(across, across);
+  float ix = across2 > 0.0 ? dot(wo, across) * inversesqrt(across2) : 0.0;
+  float a = ix * ix + iz * iz;
+  if (!(across2 > 0.0) || !(a > 0.0)) return ng;
+  float b = 2.0 * (a + iz * threshold);
+  float c = (threshold + iz) * (threshold + iz);
+  float root = sqrt(max(b * b - 4.0 * a * c, 0.0));
+  float z2 = clamp(0.25 * (ix < 0.0 ? b + root : b - root) / a, 0.0, 1.0);
+  return sqrt(1.0 - z2) * (across * inversesqrt(across2)) + sqrt(z2) * ng;
+}
+
+// A surface as a ray along `dir` meets it: on its front (the side its geometric normal faces, as the
+// caller decides it), its two normals turned toward the ray, the shading one made valid for it.
+struct Facing {
+  vec3 n_geometric;
+  vec3 n;
+};
+
+Facing facing(Surface s, vec3 dir, bool front) {
+  vec3 ng = front ? s.geometric_normal : -s.geometric_normal;
+  return Facing(ng, valid_reflection_normal(ng, -dir, front ? s.shading_normal : -s.shading_normal));
+}
 
 // A point lit by the lights: x, its shading normal n turned toward the incoming ray, and where its
 // shadow rays leave: epsilon off the surface on the ray's side, or, for a BSDF that transmits (lit
@@ -34,13 +71,15 @@ LitPoint lit_point(vec3 x, vec3 n, vec3 n_geometric, Surface s) {
   return LitPoint(x, n, n_geometric, x + frame.epsilon * n_geometric, x - frame.epsilon * n_geometric, transmits);
 }
 
-// Whether light from direction w can reach the BSDF: above n; or, for a BSDF that transmits, on
-// either side where the shading and geometric normals agree on the side (where they do not, the
-// BSDF's own sampling ends the path too, so light sampling must not count it either).
+// Whether light from direction w can reach the BSDF: above both n and the geometric surface; or, for
+// a BSDF that transmits, on either side where the shading and geometric normals agree on the side
+// (where they do not, the BSDF's own sampling ends the path too, so light sampling must not count it
+// either).
 bool faces(LitPoint p, vec3 w) {
   float c = dot(p.n, w);
-  if (!p.both_sides) return c > 0.0;
-  return c != 0.0 && (c > 0.0) == (dot(p.n_geometric, w) > 0.0);
+  bool above = dot(p.n_geometric, w) > 0.0;
+  if (!p.both_sides) return c > 0.0 && above;
+  return c != 0.0 && (c > 0.0) == above;
 }
 vec3 origin_toward(LitPoint p, vec3 w) { return p.both_sides && dot(p.n_geometric, w) < 0.0 ? p.origin_back : p.origin_front; }
 
@@ -108,8 +147,8 @@ void add_point_lights(LitPoint p, Surface s, vec3 wo, bool front, inout vec3 rad
 vec3 shade(Ray ray, vec3 x, Surface surface, inout uint stream, inout uint rays) {
   // Both normals face the incoming ray, decided by the geometric one.
   bool front = !(dot(surface.geometric_normal, ray.dir) > 0.0);
-  vec3 n_geometric = front ? surface.geometric_normal : -surface.geometric_normal;
-  vec3 n = front ? surface.shading_normal : -surface.shading_normal;
+  Facing f = facing(surface, ray.dir, front);
+  vec3 n_geometric = f.n_geometric, n = f.n;
   vec3 wo = -ray.dir;
 
   // Shadow rays start a little off the surface, on the side the ray came from (or the light's).

@@ -119,6 +119,7 @@ TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
     m.alpha_v = 0.6f;
     m.metallic = 0.25f;
     m.roughness = 0.75f;
+    m.normal_scale = -1.5f;
     const MaterialValueTexels texels = material_value_texels(m);
     const MaterialValues back = material_values(texels);
     EXPECT_EQ(back.color, m.color);
@@ -131,8 +132,9 @@ TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
     EXPECT_EQ(back.alpha_v, m.alpha_v);
     EXPECT_EQ(back.metallic, m.metallic);
     EXPECT_EQ(back.roughness, m.roughness);
+    EXPECT_EQ(back.normal_scale, m.normal_scale);
     EXPECT_EQ(material_properties_of(texels.color), material_properties(t));
-    static_assert(sizeof(MaterialValues) == 72, "a MaterialValues member is not checked here");
+    static_assert(sizeof(MaterialValues) == 76, "a MaterialValues member is not checked here");
   }
 }
 

@@ -97,6 +97,7 @@ TEST(ShaderCompilerTest, ReflectsTheBindingsTheShaderDeclares) {
       {VKRAY_BINDING_AOVS, {"AovOutput", D::eStorageBuffer}},
       {VKRAY_BINDING_TEXCOORDS, {"texcoords", D::eUniformTexelBuffer}},
       {VKRAY_BINDING_TEXTURES, {"textures", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_TANGENTS, {"tangents", D::eUniformTexelBuffer}},
   };
   EXPECT_EQ(found, expected);
 }

@@ -208,7 +208,9 @@ INSTANTIATE_TEST_SUITE_P(Khronos, ShippedModelTest,
                                            "TextureSettingsTest/glTF/TextureSettingsTest.gltf",
                                            "TextureCoordinateTest/glTF/TextureCoordinateTest.gltf", "Cameras/glTF/Cameras.gltf",
                                            "TextureTransformTest/glTF/TextureTransformTest.gltf",
-                                           "MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb"),
+                                           "MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb",
+                                           "NormalTangentTest/glTF/NormalTangentTest.gltf",
+                                           "NormalTangentMirrorTest/glTF/NormalTangentMirrorTest.gltf", "TwoSidedPlane/glTF/TwoSidedPlane.gltf"),
                          [](const auto& p) {
                            std::string name = std::filesystem::path(p.param).parent_path().string();
                            for (char& c : name)

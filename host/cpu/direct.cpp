@@ -49,8 +49,7 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
     const Material& material = scene.materials[s.material];
     // Both normals face the incoming ray, as the geometric one decides (a grazing ray meets the front).
     const bool front = !(glm::dot(s.geometric_normal, ray.dir) > 0);
-    const dvec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
-    const dvec3 n = front ? s.shading_normal : -s.shading_normal;
+    const auto [n_geometric, n] = facing(s, ray.dir, front);
     if (front) radiance += throughput * s.emission;
     const Bsdf bsdf = bsdf_of(material, s.albedo, s.metallic, s.roughness);
     if (!bsdf.has(VKRAY_BSDF_DELTA) && !passes_straight_on(bsdf)) {

@@ -34,13 +34,15 @@ struct LitPoint {
   dvec3 origin_back;       // x - epsilon n_geometric
   bool both_sides = false;
 
-  // Whether light from direction w (unit or not) can reach the BSDF: above n; or, for a BSDF that
-  // transmits, on either side where the shading and geometric normals agree on the side (where they
-  // do not, BSDF sampling ends the path, and light sampling must not count it either).
+  // Whether light from direction w (unit or not) can reach the BSDF: above n and above the geometric
+  // surface (no light through it); or, for a BSDF that transmits, on either side where the shading
+  // and geometric normals agree on the side (where they do not, BSDF sampling ends the path, and
+  // light sampling must not count it either).
   bool faces(const dvec3& w) const {
     const double c = glm::dot(n, w);
-    if (!both_sides) return c > 0;
-    return c != 0 && (c > 0) == (glm::dot(n_geometric, w) > 0);
+    const bool above = glm::dot(n_geometric, w) > 0;
+    if (!both_sides) return c > 0 && above;
+    return c != 0 && (c > 0) == above;
   }
   const dvec3& origin_toward(const dvec3& w) const { return both_sides && glm::dot(n_geometric, w) < 0 ? origin_back : origin_front; }
 };

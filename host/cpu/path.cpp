@@ -49,8 +49,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     }
     if (++depth >= max_depth) break;
 
-    const dvec3 n_geometric = front ? s.geometric_normal : -s.geometric_normal;
-    const dvec3 n = front ? s.shading_normal : -s.shading_normal;
+    const auto [n_geometric, n] = facing(s, ray.dir, front);
     const dvec3 x = s.position;
     const dvec3 origin = x + epsilon * n_geometric;
     const Bsdf bsdf = bsdf_of(material, s.albedo, s.metallic, s.roughness);

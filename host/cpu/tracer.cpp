@@ -120,6 +120,33 @@ bool Tracer::visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min
   return false;
 }
 
+dvec3 valid_reflection_normal(const dvec3& ng, const dvec3& wo, const dvec3& n) {
+  const double cos_o = glm::dot(wo, ng);
+  const double threshold = std::min(0.9 * cos_o, 0.01);
+  const dvec3 reflected = 2 * glm::dot(n, wo) * n - wo;
+  if (glm::dot(reflected, ng) >= threshold) return n;
+  // The bent normal is sin(theta) x + cos(theta) ng, x the unit direction of n's part across ng. Its
+  // reflection's height 2 (wo . N) cos(theta) - cos_o = threshold, squared, is a quadratic in
+  // c = cos^2(theta): 4 a c^2 - 2 b c + (threshold + cos_o)^2 = 0 with a = (wo . x)^2 + cos_o^2 and
+  // b = 2 (a + cos_o threshold); of its two roots, the one on the side wo's part along x picks.
+  const dvec3 across = n - glm::dot(n, ng) * ng;
+  const double across_length = glm::length(across);
+  if (!(across_length > 0)) return ng;
+  const dvec3 x = across / across_length;
+  const double wo_x = glm::dot(wo, x);
+  const double a = wo_x * wo_x + cos_o * cos_o;
+  if (!(a > 0)) return ng;
+  const double b = 2 * (a + cos_o * threshold);
+  const double root = std::sqrt(std::max(b * b - 4 * a * (threshold + cos_o) * (threshold + cos_o), 0.0));
+  const double c = std::clamp((wo_x < 0 ? b + root : b - root) / (4 * a), 0.0, 1.0);
+  return std::sqrt(1 - c) * x + std::sqrt(c) * ng;
+}
+
+Facing facing(const SurfacePoint& s, const dvec3& dir, bool front) {
+  const dvec3 ng = front ? s.geometric_normal : -s.geometric_normal;
+  return {ng, valid_reflection_normal(ng, -dir, front ? s.shading_normal : -s.shading_normal)};
+}
+
 SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
   SurfacePoint s;
   s.position = ray.origin + hit.t * ray.dir;
@@ -144,6 +171,21 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
         const dvec3 layers = sample_texture(scene_, m.metallic_roughness_texture, uv);
         s.metallic *= layers.b;
         s.roughness *= layers.g;
+      }
+      // A normal map in MikkTSpace's frame: the tangent interpolated and not normalized, the
+      // bitangent its sign times normal x tangent, the map's red and green scaled (glTF's formula).
+      if (m.normal_texture.present() && tri.has_tangents()) {
+        const double weight[3] = {1 - hit.u - hit.v, hit.u, hit.v};
+        dvec3 tangent(0.0);
+        double sign = 0;
+        for (size_t k = 0; k < 3; ++k) {
+          tangent += weight[k] * dvec3(tri.tangents[k]);
+          sign += weight[k] * double(tri.tangents[k].w);
+        }
+        const dvec3 bitangent = (sign < 0 ? -1.0 : 1.0) * glm::cross(s.shading_normal, tangent);
+        const dvec3 mapped = (2.0 * sample_texture(scene_, m.normal_texture, uv) - 1.0) * dvec3(m.normal_scale, m.normal_scale, 1.0);
+        const dvec3 n = mapped.x * tangent + mapped.y * bitangent + mapped.z * s.shading_normal;
+        if (glm::dot(n, n) > 0) s.shading_normal = n / std::sqrt(glm::dot(n, n));
       }
     }
   } else {

@@ -32,13 +32,27 @@ struct Hit {
 struct SurfacePoint {
   dvec3 position;
   dvec3 geometric_normal;  // unit; the side it faces emits, and is glass's outside
-  dvec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal
+  dvec3 shading_normal;    // unit: the geometric normal, or the interpolated vertex normal; then the normal map's
   uint32_t material = 0;
   dvec3 albedo{0.0};    // the material's albedo (or reflectance), its texture applied
   dvec3 emission{0.0};  // the material's emission, its texture applied
   double metallic = 1;   // metallic_roughness: the material's metallic and roughness, its texture applied
   double roughness = 1;
 };
+
+// A surface as a ray along `dir` meets it, on its front (the side its geometric normal faces) or
+// not: both normals turned toward the ray, the shading one bent toward the geometric one where the
+// mirror reflection of -dir about it would not leave the surface (valid_reflection_normal).
+struct Facing {
+  dvec3 n_geometric;
+  dvec3 n;
+};
+Facing facing(const SurfacePoint& s, const dvec3& dir, bool front);
+
+// Cycles' rule for a shading normal n that faces away from the viewer along wo (ng . wo >= 0): the
+// unit normal in the plane of n and ng, nearest n, about which wo's mirror reflection r has
+// r . ng = min(0.9 (ng . wo), 0.01); n itself where r . ng is already at least that.
+dvec3 valid_reflection_normal(const dvec3& ng, const dvec3& wo, const dvec3& n);
 
 class Tracer {
  public:

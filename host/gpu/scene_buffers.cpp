@@ -61,7 +61,7 @@ TexelBuffer make_texture_buffer(const Context& ctx, const std::vector<uint16_t>&
 // Refuses, before allocating anything, a scene whose buffers cannot fit the device's memory.
 void check_memory(const Context& ctx, const PackedScene& packed) {
   uint64_t texels = packed.nodes.size();
-  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.texcoords, &packed.materials, &packed.lights, &packed.emitters})
+  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.texcoords, &packed.tangents, &packed.materials, &packed.lights, &packed.emitters})
     texels = checked_add(texels, buffer->size(), "scene buffers");
   const uint64_t bytes = checked_add(checked_mul(texels, sizeof(glm::vec4), "scene buffers"),
                                      checked_mul(packed.textures.size(), sizeof(uint16_t), "textures"), "scene buffers");
@@ -78,7 +78,7 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
 }  // namespace
 
 struct SceneBuffers::Geometry {
-  TexelBuffer primitives, normals, nodes, texcoords, textures;
+  TexelBuffer primitives, normals, nodes, texcoords, textures, tangents;
   std::vector<uint32_t> order;  // the BVH's leaf order: the lighting's area lights name slots in it
 };
 
@@ -106,7 +106,8 @@ SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<c
                                                         make_texel_buffer(*ctx_, packed.normals, "normal"),
                                                         make_texel_buffer(*ctx_, packed.nodes, "BVH node"),
                                                         make_texel_buffer(*ctx_, packed.texcoords, "texture coordinate"),
-                                                        make_texture_buffer(*ctx_, packed.textures), bvh.order});
+                                                        make_texture_buffer(*ctx_, packed.textures),
+                                                        make_texel_buffer(*ctx_, packed.tangents, "tangent"), bvh.order});
   lighting_ = std::make_unique<Lighting>(*ctx_, packed);
   lighting_frame_ = packed.frame;
   // A BVH built beforehand (perhaps while the shaders compiled) still counts: the upload stage
@@ -139,7 +140,8 @@ void SceneBuffers::bind(DescriptorWriter& writer) const {
       .texel_buffer(VKRAY_BINDING_LIGHTS, *lighting_->lights.view)
       .texel_buffer(VKRAY_BINDING_EMITTERS, *lighting_->emitters.view)
       .texel_buffer(VKRAY_BINDING_TEXCOORDS, *geometry_->texcoords.view)
-      .texel_buffer(VKRAY_BINDING_TEXTURES, *geometry_->textures.view);
+      .texel_buffer(VKRAY_BINDING_TEXTURES, *geometry_->textures.view)
+      .texel_buffer(VKRAY_BINDING_TANGENTS, *geometry_->tangents.view);
 }
 
 }  // namespace vkray::gpu

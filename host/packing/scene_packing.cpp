@@ -216,7 +216,9 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
   const size_t triangle_count = scene.triangles.size();
   const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
   const bool textured = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.textured(); });
+  const bool normal_mapped = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.normal_texture.present(); });
   packed.primitives.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);
+  if (normal_mapped) packed.tangents.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
   if (any_smooth) packed.normals.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
   if (textured) packed.texcoords.resize(bvh.order.size() * VKRAY_TEXELS_PER_TEXCOORDS, glm::vec4(0.0f));
   for_blocks(bvh.order.size(), [&](size_t begin, size_t end) {
@@ -231,6 +233,8 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
         texels = triangle_texels(t.v[0], t.v[1], t.v[2], flags, p, t.object);
         if (t.smooth)
           for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
+        if (normal_mapped)
+          for (size_t k = 0; k < 3; ++k) packed.tangents[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = t.tangents[k];
         if (textured) {
           packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS] = glm::vec4(t.uv[0], t.uv[1]);
           packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS + 1] = glm::vec4(t.uv[2], 0.0f, 0.0f);
@@ -303,7 +307,7 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     glm::vec4* texels = &packed.materials[i * VKRAY_TEXELS_PER_MATERIAL];
     const MaterialValueTexels values = material_value_texels(
         {m.albedo, uint32_t(m.type), scale_radiance(m.emission, exponent), m.ior, m.eta, m.alpha.x, m.k, m.alpha.y, m.metallic,
-         m.roughness});
+         m.roughness, m.normal_scale});
     texels[VKRAY_MATERIAL_COLOR] = values.color;
     texels[VKRAY_MATERIAL_EMISSION] = values.emission;
     texels[VKRAY_MATERIAL_ETA] = values.eta;
@@ -312,6 +316,7 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     texture_slot(texels + VKRAY_MATERIAL_ALBEDO_TEXTURE, m.albedo_texture);
     texture_slot(texels + VKRAY_MATERIAL_EMISSION_TEXTURE, m.emission_texture);
     texture_slot(texels + VKRAY_MATERIAL_LAYERS_TEXTURE, m.metallic_roughness_texture);
+    texture_slot(texels + VKRAY_MATERIAL_NORMAL_TEXTURE, m.normal_texture);
     // In double on the host, then one rounding: no 1 / total power in float that could overflow.
     texels[VKRAY_MATERIAL_LIGHT] = glm::vec4(float(table.density[i]), 0.0f, 0.0f, 0.0f);
   }

@@ -66,6 +66,7 @@ struct MaterialValues {
   float alpha_v;   // along the second tangent
   float metallic;  // metallic_roughness: glTF's metallicFactor
   float roughness; // metallic_roughness: glTF's roughnessFactor (its GGX alpha is its square)
+  float normal_scale; // glTF's normalTexture.scale: multiplies the normal map's tangent and bitangent parts
 };
 
 // ---- Texels: VKRAY_TEXELS_PER_MATERIAL RGBA32F each ---------------------------------------------------
@@ -73,7 +74,8 @@ struct MaterialValues {
 //   VKRAY_MATERIAL_EMISSION:          (emitted radiance, ior)
 //   VKRAY_MATERIAL_ETA:               (eta, alpha_u)          read only by GLOSSY materials
 //   VKRAY_MATERIAL_K:                 (k, alpha_v)            read only by GLOSSY materials
-//   VKRAY_MATERIAL_LAYERS:            (metallic, roughness, 0, 0)  read only by GLOSSY materials
+//   VKRAY_MATERIAL_LAYERS:            (metallic, roughness, normal_scale, 0)  read by GLOSSY materials
+//                                     and normal-mapped ones
 //   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
 //                                     an emitter of this material, 0, 0, 0): scene/emitters.h
 // and three texture slots of VKRAY_TEXELS_PER_TEXTURE_SLOT texels each: the texture's header
@@ -84,7 +86,8 @@ struct MaterialValues {
 //   VKRAY_MATERIAL_EMISSION_TEXTURE:  the texture that multiplies the emission
 //   VKRAY_MATERIAL_LAYERS_TEXTURE:    metallic_roughness: the texture whose blue multiplies metallic and
 //                                     whose green multiplies roughness (glTF's metallicRoughnessTexture)
-#define VKRAY_TEXELS_PER_MATERIAL 15
+//   VKRAY_MATERIAL_NORMAL_TEXTURE:    the tangent-space normal map (glTF's normalTexture)
+#define VKRAY_TEXELS_PER_MATERIAL 18
 #define VKRAY_TEXELS_PER_TEXTURE_SLOT 3
 #define VKRAY_MATERIAL_COLOR 0
 #define VKRAY_MATERIAL_EMISSION 1
@@ -95,6 +98,7 @@ struct MaterialValues {
 #define VKRAY_MATERIAL_ALBEDO_TEXTURE 6
 #define VKRAY_MATERIAL_EMISSION_TEXTURE 9
 #define VKRAY_MATERIAL_LAYERS_TEXTURE 12
+#define VKRAY_MATERIAL_NORMAL_TEXTURE 15
 #define VKRAY_MATERIAL_PROPERTY_SHIFT 8u
 
 // The first texel of material `index`.
@@ -115,7 +119,7 @@ VKRAY_INLINE MaterialValueTexels material_value_texels(MaterialValues m) {
   t.emission = vec4(m.emission, m.ior);
   t.eta = vec4(m.eta, m.alpha_u);
   t.k = vec4(m.k, m.alpha_v);
-  t.layers = vec4(m.metallic, m.roughness, 0.0f, 0.0f);
+  t.layers = vec4(m.metallic, m.roughness, m.normal_scale, 0.0f);
   return t;
 }
 
@@ -134,6 +138,7 @@ VKRAY_INLINE MaterialValues material_values(MaterialValueTexels t) {
   m.alpha_v = t.k.w;
   m.metallic = t.layers.x;
   m.roughness = t.layers.y;
+  m.normal_scale = t.layers.z;
   return m;
 }
 

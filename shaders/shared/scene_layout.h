@@ -58,6 +58,9 @@ VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 // material has a texture.
 #define VKRAY_TEXELS_PER_TEXCOORDS 2
 
+// Tangents of triangles whose material has a normal map: a buffer in the same slots as the
+// primitives, one texel per vertex, (unit tangent, bitangent sign) as scene/scene.h's Triangle has
+// them (sign 0: none), present only when some material has a normal map.
 // ---- Materials: shared/materials.h ------------------------------------------------------------------
 
 // The material a primitive's flags name.

@@ -25,6 +25,7 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BINDING_AOVS 8        // storage buffer: FirstHitTexels per pixel (first_hit_layout.h)
 #define VKRAY_BINDING_TEXCOORDS 9   // uniform texel buffer, RGBA32F: texture coordinates of textured triangles
 #define VKRAY_BINDING_TEXTURES 10   // uniform texel buffer, RGBA16F: every texture's texels
+#define VKRAY_BINDING_TANGENTS 11   // uniform texel buffer, RGBA32F: vertex tangents of normal-mapped triangles
 
 // ---- Specialization constants ------------------------------------------------------------------
 // One table: X(id, GLSL name, gpu::ShaderVariant member, default). resources.glsl declares each
@@ -48,6 +49,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_TEXTURES 6
 // false when every material is two-sided: camera rays meet back faces like any other ray.
 #define VKRAY_SPEC_SINGLE_SIDED 7
+// false when no material has a normal map: no tangents and no normal-map code.
+#define VKRAY_SPEC_NORMAL_MAPS 8
 // And one per material type, id VKRAY_SPEC_MATERIALS + its number (shared/materials.h): whether the
 // scene has a material of that type (gpu::ShaderVariant::materials, a bit each); the BSDF code of
 // the others is left out. Declared as SCENE_HAS_<name> (SCENE_HAS_roughconductor).
@@ -60,7 +63,8 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_NON_DIFFUSE, SCENE_HAS_NON_DIFFUSE, non_diffuse, false) \
   X(VKRAY_SPEC_AOVS, FIRST_HIT_PASSES, aovs, false)           \
   X(VKRAY_SPEC_TEXTURES, SCENE_HAS_TEXTURES, textures, false) \
-  X(VKRAY_SPEC_SINGLE_SIDED, SCENE_HAS_SINGLE_SIDED, single_sided, false)
+  X(VKRAY_SPEC_SINGLE_SIDED, SCENE_HAS_SINGLE_SIDED, single_sided, false) \
+  X(VKRAY_SPEC_NORMAL_MAPS, SCENE_HAS_NORMAL_MAPS, normal_maps, false)
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
