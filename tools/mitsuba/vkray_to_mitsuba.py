@@ -34,7 +34,12 @@ Mapping (vkray's docs/scene-format.md and docs/rendering.md):
               tangent does; a mesh without UVs: coordinate_system(n), where vkray's tangent still
               runs around z), so anisotropic meshes agree only where the two tangents do;
               "emission" -> an 'area' emitter on each shape with the material (emits on the
-              normal side).
+              normal side). "normal_texture" -> 'normalmap' around the material's BSDF (inside
+              twosided), its picture a raw (linear) 'bitmap', bilinear and repeating; Mitsuba's
+              frame is its mesh's dp/du and n x dp/du, which is vkray's tangent frame wherever the
+              texture is not mirrored. Mitsuba has no normal scale: normal_scale other than 1 is
+              refused. Meshes of a normal-mapped material take their file's texture coordinates
+              (Mitsuba's OBJ reader flips v as vkray's does).
   objects     triangles/mesh are built in memory with the transform applied (M = T Rz Ry Rx S or
               the row-major matrix); flat shading = no vertex normals; "smooth": the file's
               normals, else area-weighted normals of the vertices welded by position (vkray's
@@ -160,15 +165,18 @@ def file_has_normals(path):
 
 
 def load_mesh_file(mi, path, with_normals):
-    """Positions (V,3), faces (F,3) and, when asked, the file's vertex normals, read by Mitsuba's
-    own OBJ/PLY loader (independent of vkray's)."""
+    """Positions (V,3), faces (F,3), when asked the file's vertex normals, and its texture
+    coordinates (V,2) if it has them, read by Mitsuba's own OBJ/PLY loader (independent of vkray's)."""
     kind = "ply" if path.lower().endswith(".ply") else "obj"
     mesh = mi.load_dict({"type": kind, "filename": path, "face_normals": not with_normals})
     params = mi.traverse(mesh)
     positions = np.array(params["vertex_positions"], dtype=np.float64).reshape(-1, 3)
     faces = np.array(params["faces"], dtype=np.int64).reshape(-1, 3)
     normals = np.array(params["vertex_normals"], dtype=np.float64).reshape(-1, 3) if with_normals else None
-    return positions, faces, normals
+    texcoords = None
+    if "vertex_texcoords" in params.keys() and len(params["vertex_texcoords"]) == 2 * len(positions):
+        texcoords = np.array(params["vertex_texcoords"], dtype=np.float64).reshape(-1, 2)
+    return positions, faces, normals, texcoords
 
 
 def welded_area_normals(positions, faces):
@@ -185,12 +193,15 @@ def welded_area_normals(positions, faces):
     return np.where(length > 0, n / np.where(length > 0, length, 1), 0.0)
 
 
-def make_mesh(mi, name, positions, faces, normals, props):
+def make_mesh(mi, name, positions, faces, normals, props, texcoords=None):
     """An in-memory Mitsuba mesh; props carries its bsdf and emitter."""
-    mesh = mi.Mesh(name, len(positions), len(faces), props, has_vertex_normals=normals is not None)
+    mesh = mi.Mesh(name, len(positions), len(faces), props, has_vertex_normals=normals is not None,
+                   has_vertex_texcoords=texcoords is not None)
     params = mi.traverse(mesh)
     params["vertex_positions"] = mi.Float(positions.astype(np.float32).ravel())
     params["faces"] = mi.UInt32(faces.astype(np.uint32).ravel())
+    if texcoords is not None:
+        params["vertex_texcoords"] = mi.Float(texcoords.astype(np.float32).ravel())
     params.update()  # recomputes (angle-weighted) vertex normals ...
     if normals is not None:  # ... which are then replaced by ours
         params["vertex_normals"] = mi.Float(normals.astype(np.float32).ravel())
@@ -297,7 +308,7 @@ def scene_dict(path, overrides=None):
     sensor["sampler"] = {"type": "independent", "sample_count": int(spp)}
 
     # materials
-    bsdfs, emissions, specular = {}, {}, False
+    bsdfs, emissions, specular, normal_mapped = {}, {}, False, set()
     for name, m in scene.get("materials", {}).items():
         kind = m.get("type", "diffuse")
         if kind == "diffuse":
@@ -316,6 +327,16 @@ def scene_dict(path, overrides=None):
                  **roughness(m, f"{path}: /materials/{name}"), "int_ior": float(m.get("int_ior", 1.5)), "ext_ior": 1.0}
         else:
             raise ValueError(f"{path}: /materials/{name}/type: unknown material type {kind!r}")
+        if "normal_texture" in m:
+            if float(m.get("normal_scale", 1.0)) != 1.0:
+                raise ValueError(f"{path}: /materials/{name}/normal_scale: Mitsuba's normalmap has no scale (only 1 converts)")
+            normalmap = {"type": "bitmap", "filename": os.path.normpath(os.path.join(base, m["normal_texture"])), "raw": True,
+                         "filter_type": "bilinear", "wrap_mode": "repeat"}
+            if b["type"] == "twosided":
+                b["bsdf"] = {"type": "normalmap", "normalmap": normalmap, "bsdf": b["bsdf"]}
+            else:
+                b = {"type": "normalmap", "normalmap": normalmap, "bsdf": b}
+            normal_mapped.add(name)
         bsdfs[name] = mi.load_dict(b)  # one instance, shared by every shape with the material
         e = m.get("emission")
         if e is not None and any(x != 0 for x in e):
@@ -354,7 +375,7 @@ def scene_dict(path, overrides=None):
         if kind == "triangles":
             positions = apply(m, np.array(obj["positions"], dtype=np.float64).reshape(-1, 3))
             faces = np.array(obj["indices"], dtype=np.int64).reshape(-1, 3)
-            normals = None
+            normals = texcoords = None
         elif kind == "mesh":
             file = os.path.normpath(os.path.join(base, obj["file"]))
             smooth = bool(obj.get("smooth", False))
@@ -365,7 +386,9 @@ def scene_dict(path, overrides=None):
             own = smooth and file_has_normals(file)
             if (file, own) not in mesh_cache:
                 mesh_cache[(file, own)] = load_mesh_file(mi, file, own)
-            positions, faces, normals = mesh_cache[(file, own)]
+            positions, faces, normals, texcoords = mesh_cache[(file, own)]
+            if material not in normal_mapped:
+                texcoords = None
             positions = apply(m, positions)
             if smooth:
                 if own:  # normals transform by the inverse transpose
@@ -390,10 +413,10 @@ def scene_dict(path, overrides=None):
             good = np.isfinite(normals).all(axis=1) & (np.linalg.norm(normals, axis=1) >= 0.5)
             flat = ~good[faces].all(axis=1)
             if flat.any():
-                d[key + "_flat"] = make_mesh(mi, key + "_flat", positions, faces[flat], None, shape_props(material))
+                d[key + "_flat"] = make_mesh(mi, key + "_flat", positions, faces[flat], None, shape_props(material), texcoords)
                 faces = faces[~flat]
         if len(faces):
-            d[key] = make_mesh(mi, key, positions, faces, normals, shape_props(material))
+            d[key] = make_mesh(mi, key, positions, faces, normals, shape_props(material), texcoords)
 
     # lights
     for i, light in enumerate(scene.get("lights", [])):
