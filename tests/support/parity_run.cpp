@@ -7,6 +7,7 @@
 
 #include "image/image.h"
 #include "image/image_file.h"
+#include "load/scene_loader.h"
 
 namespace vkray::test {
 
@@ -42,6 +43,12 @@ BrokenShaderParityTest::BrokenShaderParityTest(const std::string& file, const st
 void BrokenShaderParityTest::SetUp() {
   ParityTest::SetUp();
   if (!broken_) FAIL() << file_ << " no longer holds \"" << good_ << "\": the test breaks nothing";
+}
+
+void BrokenShaderParityTest::expect_caught_on_check(const std::string& name) {
+  const Scene scene = load_scene(std::filesystem::path(VKRAY_CHECK_DIR) / (name + ".json"));
+  const ParityResult r = run(scene, {96, 64, 4});
+  EXPECT_FALSE(r.metrics.pass) << name << ": " << describe_metrics(r.metrics);
 }
 
 }  // namespace vkray::test

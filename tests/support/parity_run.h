@@ -34,6 +34,8 @@ class BrokenShaderParityTest : public ParityTest {
   BrokenShaderParityTest(const std::string& file, const std::string& good, const std::string& bad);
   void SetUp() override;
   std::filesystem::path shader_dir() const override { return shaders_.path(); }
+  // Fails the test unless parity fails on checks/<name>.json at 96 x 64, 4 spp.
+  void expect_caught_on_check(const std::string& name);
 
  private:
   TempDir shaders_;
