@@ -13,7 +13,7 @@
 // The radiance along a camera ray; adds the rays it traces after the camera ray to `rays`.
 vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
   if (!SCENE_HAS_EMITTERS && !SCENE_HAS_NON_DIFFUSE) {  // the lecture's model: one hit, shaded
-    Hit hit = trace_closest(ray, frame.epsilon, FAR, true);
+    Hit hit = trace_closest(ray, frame.epsilon, FAR, true, stream);
     if (hit.prim == NO_HIT) return frame.background.rgb;
     vec3 x = ray_at(ray, hit.t);
     Surface s = hit_surface(hit, x);
@@ -23,7 +23,7 @@ vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
   vec3 radiance = vec3(0.0), throughput = vec3(1.0);
   uint bounce = 0u;
   do {
-    Hit hit = trace_closest(ray, frame.epsilon, FAR, bounce == 0u);
+    Hit hit = trace_closest(ray, frame.epsilon, FAR, bounce == 0u, stream);
     if (hit.prim == NO_HIT) {
       radiance += throughput * frame.background.rgb;
       break;

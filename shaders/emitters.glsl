@@ -7,6 +7,7 @@
 #define VKRAY_EMITTERS_GLSL
 
 #include "intersect.glsl"
+#include "primitives.glsl"
 #include "resources.glsl"
 #include "shared/sampling.h"
 #include "texture.glsl"
@@ -52,6 +53,12 @@ LightPoint sample_area_light(inout uint stream) {
     vec4 emission_texture = texelFetch(materials, slot);
     bool sphere = SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u;  // spheres have no texture coordinates
     if (!sphere && has_texture(emission_texture)) light.radiance *= sample_texture(emission_texture, slot, triangle_texcoord(prim, w.yz));
+  }
+  // Of a see-through emitter, only the part that is there sends light (shared/materials.h, alpha_coverage).
+  if (SCENE_HAS_ALPHA && (flags & VKRAY_PRIM_ALPHA) != 0u) {
+    vec4 alpha;
+    float opacity = opacity_at(prim, flags, w.yz, alpha);
+    light.radiance *= alpha_coverage(alpha_mode_of(alpha), opacity, alpha.y);
   }
   return light;
 }

@@ -47,7 +47,7 @@ PathState start_path(Ray camera_ray) { return PathState(camera_ray, vec3(0.0), v
 // instead of waiting, masked, for the longest path among the lanes it runs with.
 bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   bool background_sampled = frame.background.r > 0.0 || frame.background.g > 0.0 || frame.background.b > 0.0;
-  Hit hit = trace_closest(p.ray, frame.epsilon, FAR, p.depth == 0u);
+  Hit hit = trace_closest(p.ray, frame.epsilon, FAR, p.depth == 0u, stream);
   if (hit.prim == NO_HIT) {
     float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, BACKGROUND_PDF);
     p.radiance += p.throughput * frame.background.rgb * weight;
@@ -75,7 +75,7 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
     // ---- Next-event estimation: f cos times the light over its density, weighed against BSDF sampling --
     LitPoint lit = lit_point(x, n, n_geometric, s);
     vec3 from_points = vec3(0.0);
-    add_point_lights(lit, s, wo, front, from_points, rays);
+    add_point_lights(lit, s, wo, front, from_points, stream, rays);
     p.radiance += p.throughput * from_points;
     if (SCENE_HAS_EMITTERS) {
       AreaLightSample light = sample_area_light_from(lit, stream, rays);
@@ -87,7 +87,7 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
       vec3 w = uniform_sphere(vec2(next_random(stream), next_random(stream)));
       if (faces(lit, w)) {
         rays += 1u;
-        if (!trace_any(Ray(origin_toward(lit, w), w), frame.epsilon, FAR))
+        if (!trace_any(Ray(origin_toward(lit, w), w), frame.epsilon, FAR, stream))
           p.radiance += p.throughput * eval_bsdf(s, wo, w, n, front) * frame.background.rgb *
                         (power_heuristic(BACKGROUND_PDF, pdf_bsdf(s, wo, w, n, front)) / BACKGROUND_PDF);
       }

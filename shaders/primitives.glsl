@@ -5,6 +5,7 @@
 
 #include "intersect.glsl"
 #include "resources.glsl"
+#include "shared/sampling.h"
 #include "texture.glsl"
 
 // t of the nearest intersection with the primitive in (t_min, t_max), or -1.
@@ -13,6 +14,39 @@ float intersect_primitive(Ray ray, RayShear shear, vec4 a, vec4 b, vec4 c, float
     return intersect_sphere(ray, a.xyz, sphere_radius(b), t_min, t_max);
   return intersect_triangle(ray, shear, a.xyz, b.xyz, c.xyz, t_min, t_max);
 }
+
+// ---- Alpha (shared/materials.h) ----------------------------------------------------------------------------
+// The opacity of the primitive in slot `prim`, its flags `flags`, at barycentrics b (a triangle's; a
+// sphere has no texture coordinates, and its material's factor is its opacity); `alpha`: its
+// material's VKRAY_MATERIAL_OPACITY texel.
+float opacity_at(uint prim, uint flags, vec2 b, out vec4 alpha) {
+  int material = material_texel(primitive_material(flags));
+  alpha = texelFetch(materials, material + VKRAY_MATERIAL_OPACITY);
+  float opacity = alpha.x;
+  if (SCENE_HAS_TEXTURES && (flags & VKRAY_PRIM_SPHERE) == 0u) {
+    vec4 header = texelFetch(materials, material + VKRAY_MATERIAL_OPACITY_TEXTURE);
+    if (has_texture(header)) opacity *= sample_texture_rgba(header, material + VKRAY_MATERIAL_OPACITY_TEXTURE, triangle_texcoord(prim, b)).a;
+  }
+  return opacity;
+}
+
+// Whether a ray with alpha key `key` (shared/sampling.h) that reaches the primitive in slot `prim` at
+// t meets it there: always, but on a primitive of a see-through material, where its opacity decides
+// (on a sphere, for the side the ray leaves by apart from the side it enters by).
+bool meets_slot(Ray ray, uint prim, float t, uint key) {
+  int base = int(prim) * VKRAY_TEXELS_PER_PRIMITIVE;
+  vec4 a = texelFetch(primitives, base), b = texelFetch(primitives, base + 1), c = texelFetch(primitives, base + 2);
+  uint flags = primitive_flags(a);
+  if ((flags & VKRAY_PRIM_ALPHA) == 0u) return true;
+  bool sphere = (flags & VKRAY_PRIM_SPHERE) != 0u;
+  vec3 x = ray_at(ray, t);
+  vec2 bary = sphere ? vec2(0.0) : triangle_barycentrics(x, a.xyz, b.xyz, c.xyz);
+  vec4 alpha;
+  float opacity = opacity_at(prim, flags, bary, alpha);
+  bool far_side = sphere && dot(ray.dir, x - a.xyz) > 0.0;
+  return alpha_solid(alpha_mode_of(alpha), opacity, alpha.y, alpha_random(key, primitive_scene_index(b), far_side));
+}
+
 
 // ---- Normal maps ---------------------------------------------------------------------------------------
 // The unit shading normal n of the triangle in primitive slot `prim`, at barycentrics b, turned by a

@@ -105,7 +105,7 @@ AreaLightSample sample_area_light_from(LitPoint p, inout uint stream, inout uint
     float shadow_dist = length(shadow_dir);
     rays += 1u;
     // Stop epsilon short of the light: the surface the point lies on is not in the way.
-    if (trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon)) return s;
+    if (trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon, stream)) return s;
   }
   s.radiance = light.radiance;
   s.pdf = light.pdf_area * r2 / cos_l;
@@ -113,8 +113,8 @@ AreaLightSample sample_area_light_from(LitPoint p, inout uint stream, inout uint
 }
 
 // Adds V f(wo, w) |n . w| I / r^2 for every point light to `radiance`: the surface s at p, seen along
-// wo; adds the shadow rays it casts to `rays`.
-void add_point_lights(LitPoint p, Surface s, vec3 wo, bool front, inout vec3 radiance, inout uint rays) {
+// wo; adds the shadow rays it casts to `rays` (each draws its alpha key from the stream).
+void add_point_lights(LitPoint p, Surface s, vec3 wo, bool front, inout vec3 radiance, inout uint stream, inout uint rays) {
   // A do-while without `continue`, as the sample loop in trace.comp: a loop that tests first costs
   // a masked pass more, and so does one with a `continue` (the compiler moves the test to the top
   // of the next pass, for every lane).
@@ -135,7 +135,7 @@ void add_point_lights(LitPoint p, Surface s, vec3 wo, bool front, inout vec3 rad
       float shadow_dist = length(shadow_dir);
       rays += 1u;
       // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
-      lit = !trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon);
+      lit = !trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon, stream);
     }
     if (lit)
       radiance += eval_bsdf(s, wo, to_light * inversesqrt(r2), p.n, front) * (texelFetch(lights, base + VKRAY_LIGHT_INTENSITY).rgb / r2);
@@ -154,7 +154,7 @@ vec3 shade(Ray ray, vec3 x, Surface surface, inout uint stream, inout uint rays)
   // Shadow rays start a little off the surface, on the side the ray came from (or the light's).
   LitPoint p = lit_point(x, n, n_geometric, surface);
   vec3 radiance = surface.albedo * frame.ambient.rgb;
-  add_point_lights(p, surface, wo, front, radiance, rays);
+  add_point_lights(p, surface, wo, front, radiance, stream, rays);
   if (SCENE_HAS_EMITTERS) {  // one light sample: f cos Le / pdf
     AreaLightSample light = sample_area_light_from(p, stream, rays);
     if (light.pdf > 0.0) radiance += eval_bsdf(surface, wo, light.dir, n, front) * (light.radiance / light.pdf);

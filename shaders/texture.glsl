@@ -25,14 +25,12 @@ int wrap_texel(int i, int size, uint wrap) {
   return (i + size) % size;
 }
 
-vec3 texture_fetch(TextureHeader t, int x, int y) {
-  return texelFetch(textures, int(t.first + uint(y) * t.width + uint(x))).rgb;
-}
+vec4 texture_fetch(TextureHeader t, int x, int y) { return texelFetch(textures, int(t.first + uint(y) * t.width + uint(x))); }
 
 // The texture of the material's texture slot whose first texel (the header, texture_texel) is
 // header_texel, at index `slot` in the materials buffer, at the primitive's texture coordinate uv:
-// mapped by the slot's transform first where the header says it has one.
-vec3 sample_texture(vec4 header_texel, int slot, vec2 uv) {
+// mapped by the slot's transform first where the header says it has one. Colour and alpha.
+vec4 sample_texture_rgba(vec4 header_texel, int slot, vec2 uv) {
   TextureHeader t = texture_header(header_texel);
   if (texture_transformed(t.mode)) {
     vec3 p = vec3(uv, 1.0);
@@ -50,10 +48,13 @@ vec3 sample_texture(vec4 header_texel, int slot, vec2 uv) {
   float ax = x - x0, ay = y - y0;
   int i0 = wrap_texel(int(x0), width, wrap_s), i1 = wrap_texel(int(x0) + 1, width, wrap_s);
   int j0 = wrap_texel(int(y0), height, wrap_t), j1 = wrap_texel(int(y0) + 1, height, wrap_t);
-  vec3 top = (1.0 - ax) * texture_fetch(t, i0, j0) + ax * texture_fetch(t, i1, j0);
-  vec3 bottom = (1.0 - ax) * texture_fetch(t, i0, j1) + ax * texture_fetch(t, i1, j1);
+  vec4 top = (1.0 - ax) * texture_fetch(t, i0, j0) + ax * texture_fetch(t, i1, j0);
+  vec4 bottom = (1.0 - ax) * texture_fetch(t, i0, j1) + ax * texture_fetch(t, i1, j1);
   return (1.0 - ay) * top + ay * bottom;
 }
+
+// The same, colour only.
+vec3 sample_texture(vec4 header_texel, int slot, vec2 uv) { return sample_texture_rgba(header_texel, slot, uv).rgb; }
 
 // Whether a material texel names a texture (its width is not 0).
 bool has_texture(vec4 header_texel) { return floatBitsToUint(header_texel.y) != 0u; }

@@ -119,8 +119,8 @@ Children enter_node(Ray ray, vec3 inv_dir, bvec3 backward, uint node, float t_mi
   return Children(vec4(k0, k1, k2, k3), uvec4(l0, l1, l2, l3));
 }
 
-// Closest hit in (t_min, t_max); with any_hit, the first hit found (for shadow rays). cull_back: a
-// camera ray, which passes the back faces of single-sided triangles.
+// Closest hit in (t_min, t_max), every surface taken as whole; with any_hit, the first hit found (for
+// shadow rays). cull_back: a camera ray, which passes the back faces of single-sided triangles.
 Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back) {
   Hit hit = Hit(t_max, NO_HIT);
   uint hit_index = 0u;
@@ -171,9 +171,36 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back) {
   return hit;
 }
 
-// The closest hit of a ray; camera_ray: the ray leaves the camera (single-sided back faces pass it).
-Hit trace_closest(Ray ray, float t_min, float t_max, bool camera_ray) { return traverse(ray, t_min, t_max, false, camera_ray); }
+// The hit of a ray in (t_min, t_max) as traverse() finds it, where a see-through surface (alpha,
+// shared/materials.h) lets the ray through where its opacity says so. In a scene with such surfaces
+// the ray draws its alpha key from the stream (shared/sampling.h), and the search runs from the ray's
+// start to the nearest surface, every surface taken as whole; where that surface lets the ray
+// through, it runs again from there (a sphere's far side is then the next surface), until a surface
+// stops the ray or nothing is left. One opacity evaluation per surface the ray reaches, rather than
+// one per primitive tested: on llvmpipe a lane pays for whatever code any lane beside it runs, and
+// the opacity (a texture lookup) costs several times a triangle test. A shadow ray, too, looks for
+// the nearest surface: one that is not the nearest could stand behind a surface that lets the ray
+// through.
+Hit trace(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back, inout uint stream) {
+  if (!SCENE_HAS_ALPHA) return traverse(ray, t_min, t_max, any_hit, cull_back);
+  uint key = next_word(stream);
+  Hit hit;
+  float from = t_min;
+  bool passes;
+  do {  // (a do-while: see the sample loop in trace.comp)
+    hit = traverse(ray, from, t_max, false, cull_back);
+    passes = hit.prim != NO_HIT && !meets_slot(ray, hit.prim, hit.t, key);
+    from = hit.t;
+  } while (passes);
+  return hit;
+}
 
-bool trace_any(Ray ray, float t_min, float t_max) { return traverse(ray, t_min, t_max, true, false).prim != NO_HIT; }
+// The closest hit of a ray; camera_ray: the ray leaves the camera (single-sided back faces pass it).
+Hit trace_closest(Ray ray, float t_min, float t_max, bool camera_ray, inout uint stream) {
+  return trace(ray, t_min, t_max, false, camera_ray, stream);
+}
+
+// Whether anything lies on the ray in (t_min, t_max).
+bool trace_any(Ray ray, float t_min, float t_max, inout uint stream) { return trace(ray, t_min, t_max, true, false, stream).prim != NO_HIT; }
 
 #endif

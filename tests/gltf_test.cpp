@@ -193,11 +193,13 @@ TEST(GltfTest, MaterialsKeepTheirColourAndEmissionAndNameWhatIsNotRendered) {
   const int metal = b.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.3, 0.4, 0.5}}, {"metallicFactor", 1}}},
                                 {"alphaMode", "MASK"}, {"normalTexture", {{"index", texture}, {"scale", -0.5}}},
                                 {"occlusionTexture", {{"index", texture}}}});
+  const int leaf = b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", texture}}}}}, {"alphaMode", "BLEND"}});
   b.quad(lamp);
   b.quad(metal);
   b.quad(metal);
+  b.quad(leaf);
   const GltfScene s = parse(b.gltf());
-  ASSERT_EQ(s.materials.size(), 2u);
+  ASSERT_EQ(s.materials.size(), 3u);
   EXPECT_EQ(s.materials[0].emission, glm::vec3(4, 2, 1));
   EXPECT_TRUE(s.materials[0].emission_texture.present());
   EXPECT_EQ(s.materials[1].albedo, glm::vec3(0.2f, 0.3f, 0.4f));
@@ -206,11 +208,21 @@ TEST(GltfTest, MaterialsKeepTheirColourAndEmissionAndNameWhatIsNotRendered) {
   EXPECT_EQ(s.materials[1].roughness, 1.0f);  // glTF's default
   EXPECT_TRUE(s.materials[1].normal_texture.present());
   EXPECT_EQ(s.materials[1].normal_scale, -0.5f);
-  EXPECT_EQ(s.triangles.size(), 6u);
+  // Alpha: the base colour's, with glTF's default cutoff; the opacity texture is the base colour's
+  // (here none), and an opaque material reads none.
+  EXPECT_EQ(s.materials[1].alpha_mode, AlphaMode::mask);
+  EXPECT_EQ(s.materials[1].opacity, 0.5f);
+  EXPECT_EQ(s.materials[1].alpha_cutoff, 0.5f);
+  EXPECT_FALSE(s.materials[1].see_through());  // an opacity at the cutoff, no texture: whole
+  EXPECT_EQ(s.materials[0].alpha_mode, AlphaMode::opaque);
+  EXPECT_FALSE(s.materials[0].see_through());
+  EXPECT_EQ(s.materials[2].alpha_mode, AlphaMode::blend);
+  EXPECT_EQ(s.materials[2].opacity_texture, s.materials[2].albedo_texture);
+  EXPECT_TRUE(s.materials[2].see_through());
+  EXPECT_EQ(s.triangles.size(), 8u);
   std::string all;
   for (const auto& w : s.warnings) all += w + "\n";
-  EXPECT_EQ(s.warnings.size(), 2u) << all;  // once each, though two quads use the material
-  EXPECT_NE(all.find("alphaMode MASK is not rendered"), std::string::npos) << all;
+  EXPECT_EQ(s.warnings.size(), 1u) << all;  // once, though two quads use the material
   EXPECT_NE(all.find("occlusion textures are not rendered"), std::string::npos) << all;
 }
 

@@ -210,7 +210,8 @@ INSTANTIATE_TEST_SUITE_P(Khronos, ShippedModelTest,
                                            "TextureTransformTest/glTF/TextureTransformTest.gltf",
                                            "MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb",
                                            "NormalTangentTest/glTF/NormalTangentTest.gltf",
-                                           "NormalTangentMirrorTest/glTF/NormalTangentMirrorTest.gltf", "TwoSidedPlane/glTF/TwoSidedPlane.gltf"),
+                                           "NormalTangentMirrorTest/glTF/NormalTangentMirrorTest.gltf", "TwoSidedPlane/glTF/TwoSidedPlane.gltf",
+                                           "AlphaBlendModeTest/glTF/AlphaBlendModeTest.gltf"),
                          [](const auto& p) {
                            std::string name = std::filesystem::path(p.param).parent_path().string();
                            for (char& c : name)

@@ -488,11 +488,37 @@ TEST(TextureTransformTest, ATransformAllOfAMaterialsTexturesShareIsAppliedToItsC
 
 TEST_F(ObjMaterialTest, WhatIsNotRenderedIsNamedOnce) {
   write("quad.obj", kTexturedQuad);
-  write("quad.mtl", "newmtl checker\nd 0.5\nmap_Bump b.png\nbump b.png\nnewmtl plain\nd 0.3\n");
+  write("quad.mtl", "newmtl checker\nd -halo 0.5\nmap_Bump b.png\nbump b.png\nnewmtl plain\nmap_Bump c.png\n");
   const Scene scene = load(R"({"type": "mesh", "file": "quad.obj"})");
   ASSERT_EQ(scene.warnings.size(), 3u);
-  EXPECT_NE(scene.warnings[0].find("quad.mtl:2: d: transparency is not rendered"), std::string::npos) << scene.warnings[0];
+  EXPECT_NE(scene.warnings[0].find("quad.mtl:2: d -halo: not rendered"), std::string::npos) << scene.warnings[0];
   EXPECT_NE(scene.warnings[1].find("map_Bump: not rendered"), std::string::npos) << scene.warnings[1];
+}
+
+TEST_F(ObjMaterialTest, DissolveAndItsMapAreTheOpacityOfABlendedSurface) {
+  // d, or Tr = 1 - d (d wins where both are given), times map_d: its alpha, or its grey where it has
+  // none (a greyscale PNG here: grey 51 is opacity 0.2).
+  write("quad.obj", kTexturedQuad);
+  test::write_file(dir_ / "grey.png", test::png_bytes({1, 1, {51, 51, 51}}));
+  write("quad.mtl", "newmtl checker\nTr 0.25\nmap_d grey.png\nnewmtl plain\nd 1\n");
+  const Scene scene = load(R"({"type": "mesh", "file": "quad.obj"})");
+  ASSERT_EQ(scene.triangles.size(), 2u);
+  const Material& m = scene.materials[scene.triangles[0].material];
+  EXPECT_FALSE(scene.materials[scene.triangles[1].material].see_through());
+  EXPECT_EQ(m.alpha_mode, AlphaMode::blend);
+  EXPECT_EQ(m.opacity, 0.75f);
+  ASSERT_TRUE(m.opacity_texture.present());
+  EXPECT_NEAR(scene.textures[size_t(m.opacity_texture.texture)]->texel(0, 0).a, 0.2, 1e-3);
+  write("quad.mtl", "newmtl checker\nd 0.5\nTr 0.9\nnewmtl plain\n");
+  const Scene both = load(R"({"type": "mesh", "file": "quad.obj"})");
+  EXPECT_EQ(both.materials[both.triangles[0].material].opacity, 0.5f);
+  write("quad.mtl", "newmtl checker\nd 1.5\nnewmtl plain\n");
+  try {
+    load(R"({"type": "mesh", "file": "quad.obj"})");
+    ADD_FAILURE() << "d 1.5 accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("quad.mtl:2: d: expected a number from 0 to 1, got \"1.5\""), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

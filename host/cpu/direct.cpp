@@ -21,7 +21,7 @@ dvec3 shade(const Tracer& tracer, const Lights& lights, const SurfacePoint& s, c
   dvec3 radiance = bsdf.color * dvec3(scene.ambient);
   const LitPoint p{x, n, n_geometric, x + tracer.epsilon() * n_geometric, x - tracer.epsilon() * n_geometric,
                    bsdf.has(VKRAY_BSDF_TRANSMISSION)};
-  lights.add_point_lights(p, bsdf, wo, front, radiance, first ? &state.signature : nullptr, state.rays);
+  lights.add_point_lights(p, bsdf, wo, front, radiance, first ? &state.signature : nullptr, state.stream, state.rays);
   if (lights.has_area_lights()) {
     const AreaLightSample light = lights.sample_area_light_from(p, state.stream, state.rays);
     if (light.pdf > 0) radiance += eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance / light.pdf;
@@ -38,7 +38,7 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
   dvec3 radiance(0.0), throughput(1.0);
   for (uint32_t bounce = 0; bounce <= VKRAY_SPECULAR_BOUNCES; ++bounce) {
     const double far = std::numeric_limits<double>::infinity();
-    const Hit hit = bounce == 0 ? tracer.camera_hit(ray, epsilon, far) : tracer.closest(ray, epsilon, far);
+    const Hit hit = bounce == 0 ? tracer.camera_hit(ray, epsilon, far, state.stream) : tracer.closest(ray, epsilon, far, state.stream);
     if (bounce == 0) mix(state.signature, uint64_t(int64_t(hit.primitive)));
     if (hit.primitive < 0) {
       radiance += throughput * dvec3(scene.background);

@@ -15,7 +15,7 @@ Lights::Lights(const Tracer& tracer, bool shadows)
 }
 
 void Lights::add_point_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& wo, bool front, dvec3& radiance, uint64_t* signature,
-                              uint64_t& rays) const {
+                              uint32_t& stream, uint64_t& rays) const {
   const Scene& scene = tracer_.scene();
   for (size_t l = 0; l < scene.lights.size(); ++l) {
     const dvec3 light(scene.lights[l].position);
@@ -30,7 +30,7 @@ void Lights::add_point_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& 
       const dvec3& origin = p.origin_toward(to_light);
       const dvec3 shadow = light - origin;
       const double distance = glm::length(shadow);
-      if (tracer_.occluded({origin, shadow / distance}, epsilon_, distance - epsilon_)) continue;
+      if (tracer_.occluded({origin, shadow / distance}, epsilon_, distance - epsilon_, stream)) continue;
     }
     if (signature) mix(*signature, 0x8000000000000000ull | l);
     radiance += eval_bsdf(bsdf, wo, to_light / std::sqrt(r2), p.n, front) * dvec3(scene.lights[l].intensity) / r2;
@@ -53,7 +53,7 @@ AreaLightSample Lights::sample_area_light_from(const LitPoint& p, uint32_t& stre
     const dvec3 d = light.position - origin;
     const double distance = glm::length(d);
     // Stopped epsilon short of the light: the surface the point lies on is not in the way.
-    if (tracer_.occluded({origin, d / distance}, epsilon_, distance - epsilon_)) return s;
+    if (tracer_.occluded({origin, d / distance}, epsilon_, distance - epsilon_, stream)) return s;
   }
   s.radiance = light.radiance;
   s.pdf = light.pdf_area * r2 / cos_l;
@@ -93,6 +93,9 @@ LightPoint Lights::sample_area_light(uint32_t& stream) const {
     const Triangle& t = scene.triangles[p];
     light.radiance *= sample_texture(scene, m.emission_texture, b.x * glm::dvec2(t.uv[0]) + b.y * glm::dvec2(t.uv[1]) + b.z * glm::dvec2(t.uv[2]));
   }
+  // Of a see-through emitter, only the part that is there sends light.
+  if (m.see_through())
+    light.radiance *= double(gpu::alpha_coverage(uint32_t(m.alpha_mode), float(opacity_at(scene, p, b.y, b.z)), m.alpha_cutoff));
   return light;
 }
 

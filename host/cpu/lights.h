@@ -61,9 +61,9 @@ class Lights {
   Lights(const Tracer& tracer, bool shadows);
 
   // Adds V f(wo, w) |n . w| I / r^2 of every point light to `radiance` (for a diffuse surface, albedo V I (n . w) / (pi r^2), the scene contract's term); counts shadow
-  // rays in `rays`; mixes each light that lights x into `signature` when given.
+  // rays in `rays` (each draws its alpha key from `stream`); mixes each light that lights x into `signature` when given.
   void add_point_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& wo, bool front, dvec3& radiance, uint64_t* signature,
-                        uint64_t& rays) const;
+                        uint32_t& stream, uint64_t& rays) const;
 
   bool has_area_lights() const { return !table_.entries.empty(); }
   // Draws three numbers: the light, then the point on it.

@@ -32,7 +32,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
   // max_depth -1 is no limit; a path of max_depth vertices ends.
   const uint32_t max_depth = uint32_t(scene.integrator.max_depth);
   for (uint32_t depth = 0;;) {
-    const Hit hit = depth == 0 ? tracer.camera_hit(ray, epsilon, kFar) : tracer.closest(ray, epsilon, kFar);
+    const Hit hit = depth == 0 ? tracer.camera_hit(ray, epsilon, kFar, state.stream) : tracer.closest(ray, epsilon, kFar, state.stream);
     if (depth == 0) mix(state.signature, uint64_t(int64_t(hit.primitive)));
     if (hit.primitive < 0) {
       radiance += throughput * background * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, kBackgroundPdf));
@@ -58,7 +58,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
       // Next-event estimation: each term f cos times the light over its density, weighed against BSDF sampling.
       const LitPoint p{x, n, n_geometric, origin, x - epsilon * n_geometric, bsdf.has(VKRAY_BSDF_TRANSMISSION)};
       dvec3 from_points(0.0);
-      lights.add_point_lights(p, bsdf, wo, front, from_points, depth == 1 ? &state.signature : nullptr, state.rays);
+      lights.add_point_lights(p, bsdf, wo, front, from_points, depth == 1 ? &state.signature : nullptr, state.stream, state.rays);
       radiance += throughput * from_points;
       if (lights.has_area_lights()) {
         const AreaLightSample light = lights.sample_area_light_from(p, state.stream, state.rays);
@@ -71,7 +71,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
         const dvec3 w = uniform_sphere(u1, u2);
         if (p.faces(w)) {
           ++state.rays;
-          if (!tracer.occluded({p.origin_toward(w), w}, epsilon, kFar))
+          if (!tracer.occluded({p.origin_toward(w), w}, epsilon, kFar, state.stream))
             radiance += throughput * eval_bsdf(bsdf, wo, w, n, front) * background *
                         (power_heuristic(kBackgroundPdf, pdf_bsdf(bsdf, wo, w, n, front)) / kBackgroundPdf);
         }

@@ -40,13 +40,13 @@ double texel_coordinate(double u, int64_t size, TextureWrap mode) {
 
 }  // namespace
 
-glm::dvec3 sample_texture(const Scene& scene, const TextureRef& ref, const glm::dvec2& primitive_uv) {
+glm::dvec4 sample_texture_rgba(const Scene& scene, const TextureRef& ref, const glm::dvec2& primitive_uv) {
   const Texture& t = *scene.textures[size_t(ref.texture)];
   const int64_t w = t.width, h = t.height;
   const glm::dvec2 uv = ref.map(primitive_uv);
   const double x = texel_coordinate(uv.x, w, ref.wrap_s), y = texel_coordinate(uv.y, h, ref.wrap_t);
   const auto at = [&](int64_t i, int64_t j) {
-    return glm::dvec3(t.texel(uint32_t(wrap(i, w, ref.wrap_s)), uint32_t(wrap(j, h, ref.wrap_t))));
+    return glm::dvec4(t.texel(uint32_t(wrap(i, w, ref.wrap_s)), uint32_t(wrap(j, h, ref.wrap_t))));
   };
   if (ref.filter == TextureFilter::nearest) return at(int64_t(std::floor(x)), int64_t(std::floor(y)));
   // Bilinear: the four texels whose centres (at half-integer coordinates) surround (x, y).

@@ -8,7 +8,11 @@
 
 namespace vkray::cpu {
 
-// The colour of `ref`'s texture at texture coordinate uv ((0, 0) the top left corner of the picture).
-glm::dvec3 sample_texture(const Scene& scene, const TextureRef& ref, const glm::dvec2& uv);
+// The colour and alpha of `ref`'s texture at texture coordinate uv ((0, 0) the top left corner of the picture).
+glm::dvec4 sample_texture_rgba(const Scene& scene, const TextureRef& ref, const glm::dvec2& uv);
+// Its colour.
+inline glm::dvec3 sample_texture(const Scene& scene, const TextureRef& ref, const glm::dvec2& uv) {
+  return glm::dvec3(sample_texture_rgba(scene, ref, uv));
+}
 
 }  // namespace vkray::cpu

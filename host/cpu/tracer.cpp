@@ -5,6 +5,8 @@
 
 #include "bvh/bvh.h"
 #include "cpu/texture.h"
+#include "shared/materials.h"
+#include "shared/sampling.h"
 #include "shared/types.h"
 
 namespace vkray::cpu {
@@ -64,7 +66,40 @@ double intersect_sphere(const Ray& ray, const Sphere& s, double t_min, double t_
 }
 }  // namespace
 
-Hit Tracer::find(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray) const {
+double opacity_at(const Scene& scene, size_t p, double u, double v) {
+  if (p >= scene.triangles.size()) return scene.materials[scene.spheres[p - scene.triangles.size()].material].opacity;
+  const Triangle& tri = scene.triangles[p];
+  const Material& m = scene.materials[tri.material];
+  if (!m.opacity_texture.present()) return m.opacity;
+  const glm::dvec2 uv = (1 - u - v) * glm::dvec2(tri.uv[0]) + u * glm::dvec2(tri.uv[1]) + v * glm::dvec2(tri.uv[2]);
+  return m.opacity * sample_texture_rgba(scene, m.opacity_texture, uv).a;
+}
+
+uint32_t Tracer::alpha_key(uint32_t& stream) const { return see_through_ ? gpu::next_word(stream) : 0; }
+
+// The hit as search() finds it; where the scene has see-through materials, the nearest hit, and
+// where its surface lets the ray through, the nearest past it (a sphere's far side among them), until
+// one stops the ray or none is left: the shader's rule (trace() in traversal.glsl).
+Hit Tracer::find(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray, uint32_t alpha_key) const {
+  if (!see_through_) return search(ray, t_min, t_max, any_hit, camera_ray);
+  Hit hit = search(ray, t_min, t_max, false, camera_ray);
+  while (hit.primitive >= 0 && !solid(ray, hit, alpha_key)) hit = search(ray, hit.t, t_max, false, camera_ray);
+  return hit;
+}
+
+bool Tracer::solid(const Ray& ray, const Hit& hit, uint32_t alpha_key) const {
+  const auto p = size_t(hit.primitive);
+  const bool sphere = p >= scene_.triangles.size();
+  const Material& m = scene_.materials[sphere ? scene_.spheres[p - scene_.triangles.size()].material : scene_.triangles[p].material];
+  if (!m.see_through()) return true;
+  // A sphere is two surfaces to a ray: the side it enters by and the side it leaves by.
+  const bool far_side =
+      sphere && glm::dot(ray.dir, ray.origin + hit.t * ray.dir - dvec3(scene_.spheres[p - scene_.triangles.size()].center)) > 0;
+  return gpu::alpha_solid(uint32_t(m.alpha_mode), float(opacity_at(scene_, p, hit.u, hit.v)), m.alpha_cutoff,
+                          gpu::alpha_random(alpha_key, uint32_t(p), far_side));
+}
+
+Hit Tracer::search(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray) const {
   Hit best{t_max, -1};
   const size_t count = scene_.triangles.size() + scene_.spheres.size();
   if (!bvh_) {

@@ -54,18 +54,31 @@ Facing facing(const SurfacePoint& s, const dvec3& dir, bool front);
 // r . ng = min(0.9 (ng . wo), 0.01); n itself where r . ng is already at least that.
 dvec3 valid_reflection_normal(const dvec3& ng, const dvec3& wo, const dvec3& n);
 
+// The opacity of primitive p (the scene's numbering) at barycentrics (u, v) of a triangle: its
+// material's factor times its opacity texture's alpha (a sphere's: the factor).
+double opacity_at(const Scene& scene, size_t p, double u, double v);
+
 class Tracer {
  public:
   // `bvh` null: every primitive is tested (slow; checks the traversal).
-  Tracer(const Scene& scene, const Bvh* bvh) : scene_(scene), bvh_(bvh), epsilon_(scene.epsilon()) {}
+  Tracer(const Scene& scene, const Bvh* bvh) : scene_(scene), bvh_(bvh), epsilon_(scene.epsilon()), see_through_(scene.see_through()) {}
 
-  // Closest intersection with t in (t_min, t_max); with any_hit, the first one found.
-  Hit closest(const Ray& ray, double t_min, double t_max, bool any_hit = false) const { return find(ray, t_min, t_max, any_hit, false); }
+  // Each query draws the ray's alpha key from the sample's stream, where the scene has see-through
+  // materials (Material::see_through), as the shader does (traversal.glsl): the key decides where
+  // the ray passes a blended surface (shared/sampling.h, alpha_random).
+  // Closest intersection with t in (t_min, t_max).
+  Hit closest(const Ray& ray, double t_min, double t_max, uint32_t& stream) const {
+    return find(ray, t_min, t_max, false, false, alpha_key(stream));
+  }
   // The closest hit of a ray from the camera, which passes the back faces of single-sided
   // triangles (Material::double_sided).
-  Hit camera_hit(const Ray& ray, double t_min, double t_max) const { return find(ray, t_min, t_max, false, true); }
+  Hit camera_hit(const Ray& ray, double t_min, double t_max, uint32_t& stream) const {
+    return find(ray, t_min, t_max, false, true, alpha_key(stream));
+  }
   // Whether anything lies on the ray with t in (t_min, t_max).
-  bool occluded(const Ray& ray, double t_min, double t_max) const { return closest(ray, t_min, t_max, true).primitive >= 0; }
+  bool occluded(const Ray& ray, double t_min, double t_max, uint32_t& stream) const {
+    return find(ray, t_min, t_max, true, false, alpha_key(stream)).primitive >= 0;
+  }
 
   SurfacePoint surface(const Ray& ray, const Hit& hit) const;
 
@@ -74,7 +87,13 @@ class Tracer {
   double epsilon() const { return epsilon_; }
 
  private:
-  Hit find(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray) const;
+  // A ray's key: the next word of the stream where the scene has see-through materials.
+  uint32_t alpha_key(uint32_t& stream) const;
+  Hit find(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray, uint32_t alpha_key) const;
+  // Whether the ray with `alpha_key` meets the surface it reaches at `hit`.
+  bool solid(const Ray& ray, const Hit& hit, uint32_t alpha_key) const;
+  // Every surface taken as whole.
+  Hit search(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray) const;
   void test(const Ray& ray, size_t p, double t_min, double t_max, bool camera_ray, Hit& best) const;
   bool visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, bool camera_ray,
              Hit& best) const;
@@ -82,6 +101,7 @@ class Tracer {
   const Scene& scene_;
   const Bvh* bvh_;
   double epsilon_;
+  bool see_through_;
 };
 
 }  // namespace vkray::cpu

@@ -610,8 +610,16 @@ uint32_t GltfReader::material(int index, const std::string& where) {
     if (set < 0 || set > 7) fail(name, "texCoord " + std::to_string(set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
     texcoord_sets_[index] = set;
     if (g.occlusionTexture.index >= 0) warn_once("occlusionTexture", name, "occlusion textures are not rendered (light transport computes occlusion)");
-    if (g.alphaMode == "MASK" || g.alphaMode == "BLEND")
-      warn_once("alphaMode", name, "alphaMode " + g.alphaMode + " is not rendered: surfaces are opaque");
+    // Alpha: the base colour's, factor times texture (the texture's alpha, or 1 where it has none).
+    // (gltf_schema.cpp has checked the mode's name.)
+    m.alpha_mode = g.alphaMode == "MASK" ? AlphaMode::mask : g.alphaMode == "BLEND" ? AlphaMode::blend : AlphaMode::opaque;
+    if (!(g.alphaCutoff >= 0.0 && g.alphaCutoff <= double(FLT_MAX)))
+      fail(name + ".alphaCutoff", "expected a number of at least 0, got " + brief(nlohmann::json(g.alphaCutoff)));
+    m.alpha_cutoff = float(g.alphaCutoff);
+    if (!(pbr.baseColorFactor[3] >= 0.0 && pbr.baseColorFactor[3] <= 1.0))
+      fail(name + ".pbrMetallicRoughness.baseColorFactor", "an alpha outside [0, 1]");
+    m.opacity = float(pbr.baseColorFactor[3]);
+    if (m.alpha_mode != AlphaMode::opaque) m.opacity_texture = m.albedo_texture;
   }
   const auto at = uint32_t(scene_.materials.size());
   scene_.materials.push_back(std::move(m));

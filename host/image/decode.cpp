@@ -61,6 +61,11 @@ class PngReader {
   PngReader(const PngReader&) = delete;
   PngReader& operator=(const PngReader&) = delete;
 
+  // Whether the file has an alpha channel or a transparent colour (tRNS).
+  bool has_alpha() const {
+    return (png_get_color_type(png_.png, png_.info) & PNG_COLOR_MASK_ALPHA) != 0 || png_get_valid(png_.png, png_.info, PNG_INFO_tRNS) != 0;
+  }
+
   // The pixels as RGBA at the file's depth (8 bits, or 16 in the host's byte order) into `out`,
   // which holds height rows of width * 4 samples.
   void read(void* out, const std::string& name) {
@@ -165,7 +170,7 @@ class JpegReader {
 };
 
 Picture decode_png(PngReader& reader, const std::string& name) {
-  Picture picture{reader.width, reader.height, {}, {}};
+  Picture picture{reader.width, reader.height, {}, {}, reader.has_alpha()};
   const size_t samples = size_t(reader.width) * reader.height * 4;
   if (reader.bit_depth == 16) {
     picture.rgba16.resize(samples);
@@ -180,7 +185,7 @@ Picture decode_png(PngReader& reader, const std::string& name) {
 Picture decode_jpeg(std::string_view bytes, const std::string& name) {
   JpegReader reader(bytes, name);
   const int width = reader.width, height = reader.height;
-  Picture picture{uint32_t(width), uint32_t(height), std::vector<uint8_t>(size_t(width) * size_t(height) * 4), {}};
+  Picture picture{uint32_t(width), uint32_t(height), std::vector<uint8_t>(size_t(width) * size_t(height) * 4), {}, false};
   // TJFLAG_LIMITSCANS: a progressive file of thousands of tiny scans is refused, not decoded for minutes.
   if (tjDecompress2(reader.handle.get(), reader.data, reader.size, picture.rgba.data(), width, 0, height, TJPF_RGBA,
                     TJFLAG_ACCURATEDCT | TJFLAG_LIMITSCANS) != 0)

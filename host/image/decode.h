@@ -25,6 +25,7 @@ struct Picture {
   uint32_t height = 0;
   std::vector<uint8_t> rgba;     // 8-bit samples (JPEG, and PNG of 1 to 8 bits scaled to 8), or
   std::vector<uint16_t> rgba16;  // 16-bit samples (a 16-bit PNG, kept at full precision)
+  bool has_alpha = false;        // the file has alpha (or a transparent colour); without, alpha is full scale
 
   bool sixteen_bit() const { return !rgba16.empty(); }
 };

@@ -192,19 +192,23 @@ void SceneParser::parse_materials(const Value& v) {
     material.type = *known;
     switch (material.type) {
       case MaterialType::diffuse:
-        check_keys(m, {"type", "albedo", "emission", "normal_texture", "normal_scale"});
+        check_keys(m, {"type", "albedo", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
+                       "opacity_texture", "alpha_cutoff"});
         material.albedo = reflectance(require(m, "albedo"));
         break;
       case MaterialType::mirror:
-        check_keys(m, {"type", "reflectance", "emission", "normal_texture", "normal_scale"});
+        check_keys(m, {"type", "reflectance", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
+                       "opacity_texture", "alpha_cutoff"});
         material.albedo = reflectance(require(m, "reflectance"));
         break;
       case MaterialType::glass:
-        check_keys(m, {"type", "ior", "emission", "normal_texture", "normal_scale"});
+        check_keys(m, {"type", "ior", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
+                       "opacity_texture", "alpha_cutoff"});
         if (m.has("ior")) material.ior = index_of_refraction(m["ior"]);
         break;
       case MaterialType::roughconductor:
-        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "specular_reflectance", "eta", "k", "emission", "normal_texture", "normal_scale"});
+        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "specular_reflectance", "eta", "k", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
+                       "opacity_texture", "alpha_cutoff"});
         material.alpha = roughness(m);
         material.albedo = m.has("specular_reflectance") ? reflectance(m["specular_reflectance"]) : glm::vec3(1.0f);
         if (m.has("eta")) material.eta = bounded_color(m["eta"], kMaxIor, "indices of refraction up to 100");
@@ -215,20 +219,22 @@ void SceneParser::parse_materials(const Value& v) {
                                                  "either, eta 0 and k 1 reflect everything)");
         break;
       case MaterialType::roughdielectric:
-        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "int_ior", "emission", "normal_texture", "normal_scale"});
+        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "int_ior", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
+                       "opacity_texture", "alpha_cutoff"});
         material.alpha = roughness(m);
         material.albedo = glm::vec3(1.0f);  // clear: Mitsuba's specular reflectance and transmittance, 1
         if (m.has("int_ior")) material.ior = index_of_refraction(m["int_ior"]);
         break;
       case MaterialType::metallic_roughness:  // glTF 2.0's, with its names and defaults
         check_keys(m, {"type", "base_color", "metallic", "roughness", "ior", "emission", "base_color_texture",
-                       "metallic_roughness_texture", "normal_texture", "normal_scale"});
+                       "metallic_roughness_texture", "normal_texture", "normal_scale", "alpha_mode", "opacity",
+                       "opacity_texture", "alpha_cutoff"});
         material.albedo = m.has("base_color") ? reflectance(m["base_color"]) : glm::vec3(1.0f);
         // Pictures beside the scene file, read where a mesh gives texture coordinates: the base colour
         // as sRGB; metallic (blue) and roughness (green) as linear data, as glTF's textures are.
-        if (m.has("base_color_texture")) material.albedo_texture.texture = texture_file(m["base_color_texture"], file_of(m["base_color_texture"]), true);
+        if (m.has("base_color_texture")) material.albedo_texture.texture = texture_file(m["base_color_texture"], file_of(m["base_color_texture"]), TextureUse::colour);
         if (m.has("metallic_roughness_texture"))
-          material.metallic_roughness_texture.texture = texture_file(m["metallic_roughness_texture"], file_of(m["metallic_roughness_texture"]), false);
+          material.metallic_roughness_texture.texture = texture_file(m["metallic_roughness_texture"], file_of(m["metallic_roughness_texture"]), TextureUse::data);
         if (m.has("metallic")) material.metallic = unit_interval(m["metallic"]);
         if (m.has("roughness")) material.roughness = unit_interval(m["roughness"]);
         if (m.has("ior")) {
@@ -240,14 +246,43 @@ void SceneParser::parse_materials(const Value& v) {
     if (m.has("emission")) material.emission = color(m["emission"]);
     // A tangent-space normal map (linear data, as glTF's normalTexture) on any material, read where a
     // mesh gives texture coordinates; normal_scale multiplies its red and green.
-    if (m.has("normal_texture")) material.normal_texture.texture = texture_file(m["normal_texture"], file_of(m["normal_texture"]), false);
+    if (m.has("normal_texture")) material.normal_texture.texture = texture_file(m["normal_texture"], file_of(m["normal_texture"]), TextureUse::data);
     if (m.has("normal_scale")) {
       if (!m.has("normal_texture")) fail(m["normal_scale"], "normal_scale without a normal_texture");
       material.normal_scale = number(m["normal_scale"]);
       if (!(std::abs(material.normal_scale) <= 1e6f)) fail(m["normal_scale"], "expected a number of at most 1e6 in magnitude, got " + brief(m["normal_scale"].j));
     }
+    parse_alpha(m, material);
     material_index_[name] = static_cast<uint32_t>(scene_.materials.size());
     scene_.materials.push_back(material);
+  }
+}
+
+// How much of a surface is there, on any material (glTF's alpha, with glTF's modes): "opacity" (0 to 1)
+// times the alpha of "opacity_texture" (a picture's grey where it has no alpha), by "alpha_mode":
+// "blend" (the default where either is given: each ray meets the surface with probability its
+// opacity, as Mitsuba's mask), "mask" (where the opacity reaches "alpha_cutoff", 0.5 by default), or
+// "opaque".
+void SceneParser::parse_alpha(const Value& m, Material& material) {
+  const bool given = m.has("opacity") || m.has("opacity_texture");
+  material.alpha_mode = given ? AlphaMode::blend : AlphaMode::opaque;
+  if (m.has("alpha_mode")) {
+    const std::string mode = string(m["alpha_mode"]);
+    if (mode == "opaque") material.alpha_mode = AlphaMode::opaque;
+    else if (mode == "mask") material.alpha_mode = AlphaMode::mask;
+    else if (mode == "blend") material.alpha_mode = AlphaMode::blend;
+    else fail(m["alpha_mode"], "unknown alpha_mode \"" + printable(mode) + "\" (expected \"opaque\", \"mask\" or \"blend\")");
+    if (material.alpha_mode == AlphaMode::opaque && given)
+      fail(m["alpha_mode"], "alpha_mode \"opaque\" renders no opacity: leave out \"opacity\" and \"opacity_texture\", or give \"mask\" or \"blend\"");
+    if (material.alpha_mode != AlphaMode::opaque && !given)
+      fail(m["alpha_mode"], "alpha_mode \"" + mode + "\" without \"opacity\" or \"opacity_texture\": the surface would be whole");
+  }
+  if (m.has("opacity")) material.opacity = unit_interval(m["opacity"]);
+  if (m.has("opacity_texture"))
+    material.opacity_texture.texture = texture_file(m["opacity_texture"], file_of(m["opacity_texture"]), TextureUse::opacity);
+  if (m.has("alpha_cutoff")) {
+    if (material.alpha_mode != AlphaMode::mask) fail(m["alpha_cutoff"], "alpha_cutoff applies to alpha_mode \"mask\" only");
+    material.alpha_cutoff = unit_interval(m["alpha_cutoff"]);
   }
 }
 

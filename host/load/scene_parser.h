@@ -144,7 +144,9 @@ class SceneParser {
   // Adds a file the scene reads to Scene::referenced_files, once.
   void reference(const std::filesystem::path& file);
   // The index in Scene::textures of a texture file, read the first time it is named.
-  int32_t texture_file(const Value& where, const std::filesystem::path& file, bool srgb);
+  // A material's alpha keys (any type): alpha_mode, opacity, opacity_texture, alpha_cutoff.
+  void parse_alpha(const Value& m, Material& material);
+  int32_t texture_file(const Value& where, const std::filesystem::path& file, TextureUse use);
   // A file a string of the scene file names, relative to the scene file's folder.
   std::filesystem::path file_of(const Value& name) const;
   // The scene materials made from the .mtl materials a mesh's faces name, in Mesh::material_names order.
@@ -161,7 +163,7 @@ class SceneParser {
   std::map<std::string, uint32_t> material_index_;
   MeshCache& meshes_;  // each file loaded once, however often it is used
   std::set<std::filesystem::path> referenced_;  // the files in scene_.referenced_files
-  std::map<std::pair<std::filesystem::path, bool>, int32_t> texture_files_;  // (file, sRGB) -> Scene::textures
+  std::map<std::pair<std::filesystem::path, TextureUse>, int32_t> texture_files_;  // (file, use) -> Scene::textures
   struct LoadedGltf {
     GltfScene gltf;
     uint32_t material_offset = 0;  // where its materials start in Scene::materials

@@ -138,13 +138,13 @@ void SceneParser::reference(const std::filesystem::path& file) {
   if (referenced_.insert(file).second) scene_.referenced_files.push_back(file);
 }
 
-int32_t SceneParser::texture_file(const Value& where, const std::filesystem::path& file, bool srgb) {
-  const auto key = std::make_pair(file, srgb);
+int32_t SceneParser::texture_file(const Value& where, const std::filesystem::path& file, TextureUse use) {
+  const auto key = std::make_pair(file, use);
   if (const auto found = texture_files_.find(key); found != texture_files_.end()) return found->second;
   reference(file);
   std::shared_ptr<const Texture> texture;
   try {
-    texture = std::make_shared<const Texture>(load_texture(file, srgb));
+    texture = std::make_shared<const Texture>(load_texture(file, use));
   } catch (const LimitError& e) {
     throw LimitError(file_.string() + ": " + where.path + ": " + e.what());
   } catch (const SceneError& e) {
@@ -201,14 +201,18 @@ std::vector<uint32_t> SceneParser::mesh_materials(const Value& where, const std:
     material.name = mesh_file.filename().string() + ": " + name;
     material.albedo = mtl.diffuse;
     material.emission = mtl.emission;
-    const auto map = [&](const MtlTexture& t) {
+    const auto map = [&](const MtlTexture& t, TextureUse use) {
       TextureRef ref;
-      ref.texture = texture_file(where, (library.parent_path() / t.file).lexically_normal(), true);
+      ref.texture = texture_file(where, (library.parent_path() / t.file).lexically_normal(), use);
       ref.wrap_s = ref.wrap_t = t.wrap;
       return ref;
     };
-    if (!mtl.diffuse_map.file.empty()) material.albedo_texture = map(mtl.diffuse_map);
-    if (!mtl.emission_map.file.empty()) material.emission_texture = map(mtl.emission_map);
+    if (!mtl.diffuse_map.file.empty()) material.albedo_texture = map(mtl.diffuse_map, TextureUse::colour);
+    if (!mtl.emission_map.file.empty()) material.emission_texture = map(mtl.emission_map, TextureUse::colour);
+    // The dissolve: each ray meets the surface with probability d times map_d's value.
+    material.opacity = mtl.opacity;
+    if (!mtl.opacity_map.file.empty()) material.opacity_texture = map(mtl.opacity_map, TextureUse::opacity);
+    if (material.opacity < 1.0f || material.opacity_texture.present()) material.alpha_mode = AlphaMode::blend;
     index.push_back(uint32_t(scene_.materials.size()));
     scene_.materials.push_back(std::move(material));
   }

@@ -72,7 +72,7 @@ class MtlParser {
       material_ = MtlMaterial();
       material_.name = std::string(rest);
       open_ = true;
-      kd_given_ = false;
+      kd_given_ = d_given_ = false;
     } else if (keyword == "Kd") {
       current(keyword).diffuse = colour(keyword, rest);
       kd_given_ = true;
@@ -83,13 +83,27 @@ class MtlParser {
     } else if (keyword == "map_Ke") {
       current(keyword).emission_map = texture(keyword, rest);
     } else if (keyword == "d" || keyword == "Tr") {
+      // The dissolve d, or Tr = 1 - d; where a material gives both, d.
+      if (rest.starts_with("-halo")) {
+        warn_once(std::string(keyword) + " -halo: not rendered (the dissolve is the same at every angle)");
+        rest = trim(rest.substr(5));
+      }
       double value = 0;
       const auto [ptr, ec] = std::from_chars(rest.data(), rest.data() + rest.size(), value);
-      const bool opaque = ec == std::errc() && (keyword == "d" ? value >= 1.0 : value <= 0.0);
-      if (!opaque) warn_once(std::string(keyword) + ": transparency is not rendered (surfaces are opaque)");
+      if (ec != std::errc() || ptr != rest.data() + rest.size() || !(value >= 0.0 && value <= 1.0))
+        fail(std::string(keyword) + ": expected a number from 0 to 1, got \"" + printable(rest) + "\"");
+      MtlMaterial& m = current(keyword);
+      if (keyword == "d") {
+        m.opacity = float(value);
+        d_given_ = true;
+      } else if (!d_given_) {
+        m.opacity = float(1.0 - value);
+      }
+    } else if (keyword == "map_d") {
+      current(keyword).opacity_map = texture(keyword, rest);
     } else if (keyword.starts_with("map_") || keyword == "bump" || keyword == "disp" || keyword == "decal" || keyword == "norm" ||
                keyword == "refl") {
-      warn_once(std::string(keyword) + ": not rendered (vkray renders map_Kd and map_Ke)");
+      warn_once(std::string(keyword) + ": not rendered (vkray renders map_Kd, map_Ke and map_d)");
     }
     // Ka, Ks, Ns, Ni, illum, Tf and others describe shading vkray does not do: a diffuse surface is.
   }
@@ -153,7 +167,7 @@ class MtlParser {
   size_t line_ = 0;
   MtlLibrary library_;
   MtlMaterial material_;
-  bool open_ = false, kd_given_ = false;
+  bool open_ = false, kd_given_ = false, d_given_ = false;
   std::set<std::string> warned_;
 };
 

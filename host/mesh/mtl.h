@@ -1,7 +1,7 @@
 // Wavefront material libraries (.mtl), the materials an OBJ file's faces name: the diffuse colour
-// (Kd) and its texture (map_Kd), the emitted colour (Ke) and its texture (map_Ke). What vkray cannot
-// render of them (transparency, bump maps, other maps, texture offsets and scales) is named in a
-// warning, once a file.
+// (Kd) and its texture (map_Kd), the emitted colour (Ke) and its texture (map_Ke), the dissolve (d,
+// or Tr = 1 - d) and its texture (map_d). What vkray cannot render of them (bump maps, other maps,
+// texture offsets and scales) is named in a warning, once a file.
 #pragma once
 
 #include <filesystem>
@@ -26,6 +26,8 @@ struct MtlMaterial {
   glm::vec3 emission{0.0f};  // Ke
   MtlTexture diffuse_map;    // map_Kd: multiplies Kd
   MtlTexture emission_map;   // map_Ke: multiplies Ke
+  float opacity = 1.0f;      // d (1 - Tr): how much of the surface is there
+  MtlTexture opacity_map;    // map_d: its alpha, or its grey where it has none, multiplies d
 };
 
 struct MtlLibrary {

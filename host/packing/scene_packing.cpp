@@ -213,6 +213,10 @@ PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
 
 PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
   PackedGeometry packed;
+  // A primitive's flags hold its material's index.
+  if (scene.materials.size() > size_t(VKRAY_PRIM_MATERIAL_MASK) + 1)
+    throw LimitError(scene.file.string() + ": " + std::to_string(scene.materials.size()) + " materials; vkray renders at most " +
+                     std::to_string(size_t(VKRAY_PRIM_MATERIAL_MASK) + 1));
   const size_t triangle_count = scene.triangles.size();
   const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
   const bool textured = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.textured(); });
@@ -228,8 +232,9 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
       PrimitiveTexels texels;
       if (p < triangle_count) {
         const Triangle& t = scene.triangles[p];
-        const uint32_t flags = t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u) |
-                               (scene.materials[t.material].double_sided ? 0u : VKRAY_PRIM_SINGLE_SIDED);
+        const Material& m = scene.materials[t.material];
+        const uint32_t flags = t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u) | (m.double_sided ? 0u : VKRAY_PRIM_SINGLE_SIDED) |
+                               (m.see_through() ? VKRAY_PRIM_ALPHA : 0u);
         texels = triangle_texels(t.v[0], t.v[1], t.v[2], flags, p, t.object);
         if (t.smooth)
           for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
@@ -241,8 +246,10 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
         }
       } else {
         const Sphere& sphere = scene.spheres[p - triangle_count];
-        texels = sphere_texels(sphere.center, sphere.radius, sphere.material | (sphere.inward ? VKRAY_PRIM_INWARD : 0u), p,
-                               sphere.object);
+        texels = sphere_texels(sphere.center, sphere.radius,
+                               sphere.material | (sphere.inward ? VKRAY_PRIM_INWARD : 0u) |
+                                   (scene.materials[sphere.material].see_through() ? VKRAY_PRIM_ALPHA : 0u),
+                               p, sphere.object);
       }
       glm::vec4* out = &packed.primitives[slot * VKRAY_TEXELS_PER_PRIMITIVE];
       out[0] = texels.a;
@@ -317,6 +324,9 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     texture_slot(texels + VKRAY_MATERIAL_EMISSION_TEXTURE, m.emission_texture);
     texture_slot(texels + VKRAY_MATERIAL_LAYERS_TEXTURE, m.metallic_roughness_texture);
     texture_slot(texels + VKRAY_MATERIAL_NORMAL_TEXTURE, m.normal_texture);
+    texels[VKRAY_MATERIAL_OPACITY] =
+        opacity_texel(m.opacity, m.alpha_cutoff, uint32_t(m.see_through() ? m.alpha_mode : AlphaMode::opaque));
+    texture_slot(texels + VKRAY_MATERIAL_OPACITY_TEXTURE, m.opacity_texture);
     // In double on the host, then one rounding: no 1 / total power in float that could overflow.
     texels[VKRAY_MATERIAL_LIGHT] = glm::vec4(float(table.density[i]), 0.0f, 0.0f, 0.0f);
   }

@@ -68,13 +68,14 @@ bool same_geometry(const Scene& a, const Scene& b) {
   const auto normal_mapped = [](const Scene& s) {
     return std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.normal_texture.present(); });
   };
-  // A primitive's flags also say whether its material is single-sided.
-  const auto same_sidedness = [&] {
+  // A primitive's flags also say whether its material is single-sided, and whether it lets rays through.
+  const auto same_primitive_flags = [&] {
     for (size_t i = 0; i < a.materials.size(); ++i)
-      if (a.materials[i].double_sided != b.materials[i].double_sided) return false;
+      if (a.materials[i].double_sided != b.materials[i].double_sided || a.materials[i].see_through() != b.materials[i].see_through())
+        return false;
     return true;
   };
-  return a.materials.size() == b.materials.size() && textured(a) == textured(b) && normal_mapped(a) == normal_mapped(b) && same_sidedness() &&
+  return a.materials.size() == b.materials.size() && textured(a) == textured(b) && normal_mapped(a) == normal_mapped(b) && same_primitive_flags() &&
          std::equal(a.textures.begin(), a.textures.end(), b.textures.begin(), b.textures.end(), same_texture) &&
          std::equal(a.triangles.begin(), a.triangles.end(), b.triangles.begin(), b.triangles.end(), same) &&
          std::equal(a.spheres.begin(), a.spheres.end(), b.spheres.begin(), b.spheres.end(), same);

@@ -70,6 +70,9 @@ enum class MaterialType : uint32_t {
 #undef VKRAY_MATERIAL_ENUMERATOR
 };
 
+// glTF's alphaMode, numbered as the shader numbers them (VKRAY_ALPHA_* in shaders/shared/materials.h).
+enum class AlphaMode : uint32_t { opaque = VKRAY_ALPHA_OPAQUE, mask = VKRAY_ALPHA_MASK, blend = VKRAY_ALPHA_BLEND };
+
 // The name a scene file gives the type ("roughconductor"), and the type of a name (nullopt: none).
 std::string_view material_type_name(MaterialType type);
 std::optional<MaterialType> material_type_named(std::string_view name);
@@ -112,16 +115,33 @@ struct Material {
   // through its triangles' back faces (the side away from their winding's normal); every other ray
   // meets both sides.
   bool double_sided = true;
+  // How much of the surface is there (glTF's alphaMode; VKRAY_ALPHA_* in shaders/shared/materials.h):
+  // the opacity is `opacity` (glTF's baseColorFactor alpha, an .mtl file's d) times the alpha of
+  // `opacity_texture` (glTF's base colour texture; an .mtl file's map_d, whose grey is its alpha where
+  // the picture has none). opaque: all of it; mask: where the opacity is at least `alpha_cutoff`;
+  // blend: each ray meets it with probability the opacity. The same for every ray.
+  AlphaMode alpha_mode = AlphaMode::opaque;
+  float opacity = 1.0f;
+  float alpha_cutoff = 0.5f;
+  TextureRef opacity_texture;
 
   bool emissive() const { return emission != glm::vec3(0.0f); }
   // Every texture reference, for code that treats them alike.
-  std::array<TextureRef*, 4> textures() { return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture}; }
-  std::array<const TextureRef*, 4> textures() const {
-    return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture};
+  std::array<TextureRef*, 5> textures() {
+    return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture, &opacity_texture};
+  }
+  std::array<const TextureRef*, 5> textures() const {
+    return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture, &opacity_texture};
   }
   bool textured() const {
     const auto refs = textures();
     return std::any_of(refs.begin(), refs.end(), [](const TextureRef* t) { return t->present(); });
+  }
+  // Whether its alpha lets some ray through somewhere: a mode other than opaque with an opacity
+  // texture, or an opacity factor that is not whole (below the cutoff, for mask).
+  bool see_through() const {
+    if (alpha_mode == AlphaMode::opaque) return false;
+    return opacity_texture.present() || !(opacity >= (alpha_mode == AlphaMode::mask ? alpha_cutoff : 1.0f));
   }
   // Its properties (VKRAY_BSDF_* in shaders/shared/materials.h): code outside the BSDFs asks these.
   uint32_t properties() const { return gpu::material_properties(uint32_t(type)); }
@@ -191,6 +211,11 @@ struct Scene {
   // The contract's epsilon: the offset of shadow-ray origins and the smallest accepted t. 1e-5 of
   // the scene's extent: far above float rounding at that scale (~1e-7 relative), far below any feature.
   float epsilon() const { return std::max(extent(), 1e-30f) * 1e-5f; }
+  // Whether some material lets rays through (Material::see_through): every ray then draws a key
+  // from its sample's stream (shared/sampling.h, alpha_random), on both renderers.
+  bool see_through() const {
+    return std::any_of(materials.begin(), materials.end(), [](const Material& m) { return m.see_through(); });
+  }
 };
 
 // Whether two scenes have the same primitives, bit for bit, with the same materials, objects and

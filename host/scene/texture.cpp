@@ -58,10 +58,15 @@ Texture make_texture(const Picture& picture, std::string name, bool srgb) {
   return t;
 }
 
-Texture load_texture(const std::filesystem::path& file, bool srgb) {
+Texture load_texture(const std::filesystem::path& file, TextureUse use) {
   const InputFile input = read_input_file(file, kMaxPictureFileBytes);
   if (!input.error.empty()) throw SceneError(file.string() + ": " + (input.error == "not found" ? "texture file not found" : input.error));
-  return make_texture(decode_picture(input.text, file.string()), file.string(), srgb);
+  Picture picture = decode_picture(input.text, file.string());
+  if (use == TextureUse::opacity && !picture.has_alpha) {  // its grey is its alpha
+    for (size_t i = 0; i < picture.rgba.size(); i += 4) picture.rgba[i + 3] = picture.rgba[i];
+    for (size_t i = 0; i < picture.rgba16.size(); i += 4) picture.rgba16[i + 3] = picture.rgba16[i];
+  }
+  return make_texture(picture, file.string(), use == TextureUse::colour);
 }
 
 }  // namespace vkray

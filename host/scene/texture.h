@@ -33,12 +33,17 @@ struct Texture {
   glm::vec4 texel(uint32_t x, uint32_t y) const;
 };
 
+// What a picture file is read as: colour (decoded from sRGB, as base-colour and emissive textures
+// are), data (linear: metallic-roughness, normal maps), or opacity (linear, into alpha: the
+// picture's alpha, or its grey, its red, where it has no alpha, as an .mtl file's map_d).
+enum class TextureUse { colour, data, opacity };
+
 // A picture's colour decoded from sRGB (`srgb`, as base-colour and emissive textures are) or taken as
 // linear, rounded to half floats.
 Texture make_texture(const Picture& picture, std::string name, bool srgb = true);
 
-// A PNG or JPEG file read and decoded (image/decode.h). Throws SceneError naming the file.
-Texture load_texture(const std::filesystem::path& file, bool srgb = true);
+// A PNG or JPEG file read and decoded (image/decode.h) for `use`. Throws SceneError naming the file.
+Texture load_texture(const std::filesystem::path& file, TextureUse use = TextureUse::colour);
 
 // How a material samples a texture; `texture` is an index into Scene::textures, -1 for none.
 struct TextureRef {

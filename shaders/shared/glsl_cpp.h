@@ -19,6 +19,7 @@ using glm::floatBitsToInt;
 using glm::floatBitsToUint;
 using glm::intBitsToFloat;
 using glm::uintBitsToFloat;
+using glm::max;
 using glm::min;
 }  // namespace vkray::gpu
 #define VKRAY_SHARED_BEGIN namespace vkray::gpu {

@@ -53,6 +53,33 @@ VKRAY_INLINE uint material_properties(uint type) {
 // alpha is at least this (the scene parser refuses less; glTF's roughness 0 is taken as this).
 #define VKRAY_MIN_GGX_ALPHA 1e-4f
 
+// ---- Alpha: how much of a surface is there (glTF's alphaMode) ------------------------------------------
+// A material's opacity is its factor times the alpha of its opacity texture (shared/scene_layout.h:
+// glTF's base colour texture, an .mtl file's map_d). OPAQUE: every ray meets all of the surface;
+// MASK: where the opacity is at least the cutoff, and nowhere else; BLEND: stochastically, each ray
+// meets it with probability the opacity (shared/sampling.h, alpha_random). The same for every ray:
+// camera, shadow, indirect, and so the first-hit passes. The host packs OPAQUE for a material whose
+// alpha can let no ray through (Material::see_through), and only primitives of the others carry
+// VKRAY_PRIM_ALPHA.
+#define VKRAY_ALPHA_OPAQUE 0u
+#define VKRAY_ALPHA_MASK 1u
+#define VKRAY_ALPHA_BLEND 2u
+
+// Whether a ray meets the surface where its opacity is `opacity`; u: alpha_random's number.
+VKRAY_INLINE bool alpha_solid(uint mode, float opacity, float cutoff, float u) {
+  if (mode == VKRAY_ALPHA_MASK) return opacity >= cutoff;
+  if (mode == VKRAY_ALPHA_BLEND) return u < opacity;
+  return true;
+}
+
+// The fraction of the surface there where its opacity is `opacity`, the mean of alpha_solid over u:
+// what scales the light a point picked on an emitter sends.
+VKRAY_INLINE float alpha_coverage(uint mode, float opacity, float cutoff) {
+  if (mode == VKRAY_ALPHA_MASK) return opacity >= cutoff ? 1.0f : 0.0f;
+  if (mode == VKRAY_ALPHA_BLEND) return min(max(opacity, 0.0f), 1.0f);
+  return 1.0f;
+}
+
 // ---- The values: what a BSDF is evaluated from, before textures -----------------------------------------
 struct MaterialValues {
   vec3 color;      // diffuse: albedo; mirror: reflectance; roughconductor: specular_reflectance; dielectrics: 1;
@@ -78,6 +105,8 @@ struct MaterialValues {
 //                                     and normal-mapped ones
 //   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
 //                                     an emitter of this material, 0, 0, 0): scene/emitters.h
+//   VKRAY_MATERIAL_OPACITY:           (opacity factor, alpha cutoff, alpha mode as uint bits, 0): read
+//                                     only for primitives with VKRAY_PRIM_ALPHA (opacity_texel)
 // and three texture slots of VKRAY_TEXELS_PER_TEXTURE_SLOT texels each: the texture's header
 // (texture_texel in shared/scene_layout.h), then the two rows of the affine map from a primitive's
 // texture coordinate to the texture's (glTF's KHR_texture_transform), read only where the header says
@@ -87,7 +116,8 @@ struct MaterialValues {
 //   VKRAY_MATERIAL_LAYERS_TEXTURE:    metallic_roughness: the texture whose blue multiplies metallic and
 //                                     whose green multiplies roughness (glTF's metallicRoughnessTexture)
 //   VKRAY_MATERIAL_NORMAL_TEXTURE:    the tangent-space normal map (glTF's normalTexture)
-#define VKRAY_TEXELS_PER_MATERIAL 18
+//   VKRAY_MATERIAL_OPACITY_TEXTURE:   the texture whose alpha multiplies the opacity
+#define VKRAY_TEXELS_PER_MATERIAL 22
 #define VKRAY_TEXELS_PER_TEXTURE_SLOT 3
 #define VKRAY_MATERIAL_COLOR 0
 #define VKRAY_MATERIAL_EMISSION 1
@@ -99,6 +129,8 @@ struct MaterialValues {
 #define VKRAY_MATERIAL_EMISSION_TEXTURE 9
 #define VKRAY_MATERIAL_LAYERS_TEXTURE 12
 #define VKRAY_MATERIAL_NORMAL_TEXTURE 15
+#define VKRAY_MATERIAL_OPACITY 18
+#define VKRAY_MATERIAL_OPACITY_TEXTURE 19
 #define VKRAY_MATERIAL_PROPERTY_SHIFT 8u
 
 // The first texel of material `index`.
@@ -141,6 +173,10 @@ VKRAY_INLINE MaterialValues material_values(MaterialValueTexels t) {
   m.normal_scale = t.layers.z;
   return m;
 }
+
+// A material's alpha in its VKRAY_MATERIAL_OPACITY texel, and back.
+VKRAY_INLINE vec4 opacity_texel(float opacity, float cutoff, uint mode) { return vec4(opacity, cutoff, uintBitsToFloat(mode), 0.0f); }
+VKRAY_INLINE uint alpha_mode_of(vec4 opacity_texel) { return floatBitsToUint(opacity_texel.z); }
 
 VKRAY_SHARED_END
 

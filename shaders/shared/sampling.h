@@ -58,11 +58,25 @@ VKRAY_INLINE uint sample_stream(uint pixel_index, uint seed_key, uint k) {
   return pcg_hash(sample_hash(pixel_index, seed_key, k) ^ 0x9e3779b9u);
 }
 
-// The next uniform in [0, 1) of a stream (24 bits: exact in a float).
-VKRAY_INLINE float next_random(VKRAY_INOUT(uint) state) {
+// The next 32-bit word of a stream.
+VKRAY_INLINE uint next_word(VKRAY_INOUT(uint) state) {
   state = state * 747796405u + 2891336453u;
   uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-  return hash_to_unit((word >> 22u) ^ word);
+  return (word >> 22u) ^ word;
+}
+
+// The next uniform in [0, 1) of a stream (24 bits: exact in a float).
+VKRAY_INLINE float next_random(VKRAY_INOUT(uint) state) { return hash_to_unit(next_word(state)); }
+
+// ---- Stochastic opacity ------------------------------------------------------------------------------
+// A ray in a scene with see-through materials (shared/materials.h, alpha modes) carries a key, one
+// word of its sample's stream drawn just before it is traced; a primitive of a blended material that
+// the ray reaches is then solid for it when alpha_random(key, the primitive's place in the scene,
+// which side) is below its opacity. One number per ray and surface: a sphere is two, the side a ray
+// enters by and the side it leaves by (far_side); two surfaces on one ray, or one surface on two
+// rays, decide independently, and a ray meets a surface with probability exactly its opacity.
+VKRAY_INLINE float alpha_random(uint key, uint scene_index, bool far_side) {
+  return hash_to_unit(pcg_hash(key ^ pcg_hash(((scene_index << 1u) | (far_side ? 1u : 0u)) ^ 0x3c6ef372u)));
 }
 
 VKRAY_SHARED_END

@@ -12,7 +12,8 @@ VKRAY_SHARED_BEGIN
 // ---- Primitives: VKRAY_TEXELS_PER_PRIMITIVE RGBA32F texels each, in BVH leaf order ---------------------
 // A triangle is its vertices rather than its edges (every triangle sharing a vertex must see bitwise
 // the same coordinates for the watertight test); a sphere is its centre and radius. Each carries its
-// flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH | VKRAY_PRIM_INWARD | VKRAY_PRIM_SINGLE_SIDED),
+// flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH | VKRAY_PRIM_INWARD | VKRAY_PRIM_SINGLE_SIDED |
+// VKRAY_PRIM_ALPHA),
 // its place in the scene, which decides ties (VKRAY_TIE), and the object it belongs to (the `object`
 // pass), as the bits of floats.
 #define VKRAY_TEXELS_PER_PRIMITIVE 3
@@ -21,7 +22,9 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_PRIM_INWARD 0x20000000u  // a sphere whose normal points to its centre ("flip_normals")
 // A triangle of a single-sided material (glTF's doubleSided false): camera rays pass its back face.
 #define VKRAY_PRIM_SINGLE_SIDED 0x10000000u
-#define VKRAY_PRIM_MATERIAL_MASK 0x0fffffffu
+// A primitive of a material that lets rays through where its alpha says so (shared/materials.h).
+#define VKRAY_PRIM_ALPHA 0x08000000u
+#define VKRAY_PRIM_MATERIAL_MASK 0x07ffffffu
 
 struct PrimitiveTexels {
   vec4 a;  // triangle: (v0, flags);          sphere: (centre, flags)

@@ -51,6 +51,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_SINGLE_SIDED 7
 // false when no material has a normal map: no tangents and no normal-map code.
 #define VKRAY_SPEC_NORMAL_MAPS 8
+// false when no material lets rays through (VKRAY_ALPHA_*): no alpha test, and no ray keys drawn.
+#define VKRAY_SPEC_ALPHA 9
 // And one per material type, id VKRAY_SPEC_MATERIALS + its number (shared/materials.h): whether the
 // scene has a material of that type (gpu::ShaderVariant::materials, a bit each); the BSDF code of
 // the others is left out. Declared as SCENE_HAS_<name> (SCENE_HAS_roughconductor).
@@ -64,7 +66,8 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_AOVS, FIRST_HIT_PASSES, aovs, false)           \
   X(VKRAY_SPEC_TEXTURES, SCENE_HAS_TEXTURES, textures, false) \
   X(VKRAY_SPEC_SINGLE_SIDED, SCENE_HAS_SINGLE_SIDED, single_sided, false) \
-  X(VKRAY_SPEC_NORMAL_MAPS, SCENE_HAS_NORMAL_MAPS, normal_maps, false)
+  X(VKRAY_SPEC_NORMAL_MAPS, SCENE_HAS_NORMAL_MAPS, normal_maps, false) \
+  X(VKRAY_SPEC_ALPHA, SCENE_HAS_ALPHA, alpha, false)
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
