@@ -39,7 +39,11 @@ Mapping (vkray's docs/scene-format.md and docs/rendering.md):
               frame is its mesh's dp/du and n x dp/du, which is vkray's tangent frame wherever the
               texture is not mirrored. Mitsuba has no normal scale: normal_scale other than 1 is
               refused. Meshes of a normal-mapped material take their file's texture coordinates
-              (Mitsuba's OBJ reader flips v as vkray's does).
+              (Mitsuba's OBJ reader flips v as vkray's does). Alpha ("opacity", "opacity_texture",
+              alpha_mode "blend") -> 'mask' around the BSDF, its opacity the factor or a raw
+              bitmap of a greyscale picture, and the integrator 'volpath' (whose shadow rays pass
+              masks as vkray's do; 'path' takes them as solid); alpha_mode "mask" converts only
+              without a texture (whole, or a 'null' BSDF below the cutoff).
   objects     triangles/mesh are built in memory with the transform applied (M = T Rz Ry Rx S or
               the row-major matrix); flat shading = no vertex normals; "smooth": the file's
               normals, else area-weighted normals of the vertices welded by position (vkray's
@@ -237,6 +241,36 @@ def rough_conductor(m, where):
     return b
 
 
+def alpha_mask(mi, m, b, base, where):
+    """A material's alpha: 'blend' (the default where "opacity" or "opacity_texture" is given) is
+    Mitsuba's 'mask' (each ray meets the surface with probability the opacity) around the BSDF, its
+    opacity the factor, or a raw bitmap of a greyscale picture times the factor; 'mask' without a
+    texture is whole or gone by its cutoff. A masked picture (glTF's MASK with a texture) has no
+    counterpart, nor has a picture with colour or alpha (vkray reads its alpha, Mitsuba a bitmap's
+    luminance): refused."""
+    mode = m.get("alpha_mode", "blend")
+    factor = float(m.get("opacity", 1.0))
+    if mode == "opaque":
+        return b
+    if mode == "mask":
+        if "opacity_texture" in m:
+            raise ValueError(f"{where}/alpha_mode: Mitsuba has no alpha cutoff for a texture: only \"blend\" converts")
+        return b if factor >= float(m.get("alpha_cutoff", 0.5)) else {"type": "null"}
+    if "opacity_texture" in m:
+        file = os.path.normpath(os.path.join(base, m["opacity_texture"]))
+        if mi.Bitmap(file).pixel_format() != mi.Bitmap.PixelFormat.Y:
+            raise ValueError(f"{where}/opacity_texture: {file}: only a greyscale picture without alpha converts "
+                             "(vkray reads alpha where a picture has it, Mitsuba a bitmap's luminance)")
+        opacity = {"type": "bitmap", "filename": file, "raw": True, "filter_type": "bilinear", "wrap_mode": "repeat"}
+        if factor != 1.0:
+            raise ValueError(f"{where}/opacity: Mitsuba's bitmap has no factor: with an opacity_texture, only 1 converts")
+    else:
+        if factor >= 1.0:
+            return b
+        opacity = factor
+    return {"type": "mask", "opacity": opacity, "bsdf": b}
+
+
 def scene_dict(path, overrides=None):
     """(Mitsuba scene dict, info) for the vkray scene at `path`. Call mi.set_variant first."""
     import mitsuba as mi
@@ -308,7 +342,7 @@ def scene_dict(path, overrides=None):
     sensor["sampler"] = {"type": "independent", "sample_count": int(spp)}
 
     # materials
-    bsdfs, emissions, specular, normal_mapped = {}, {}, False, set()
+    bsdfs, emissions, specular, normal_mapped, see_through = {}, {}, False, set(), False
     for name, m in scene.get("materials", {}).items():
         kind = m.get("type", "diffuse")
         if kind == "diffuse":
@@ -337,10 +371,24 @@ def scene_dict(path, overrides=None):
             else:
                 b = {"type": "normalmap", "normalmap": normalmap, "bsdf": b}
             normal_mapped.add(name)
+        if "opacity" in m or "opacity_texture" in m:
+            b = alpha_mask(mi, m, b, base, f"{path}: /materials/{name}")
+            if b["type"] in ("mask", "null"):
+                see_through = True
+                if "opacity_texture" in m:
+                    normal_mapped.add(name)  # (its meshes take their texture coordinates)
+                e = m.get("emission")
+                if e is not None and any(x != 0 for x in e):
+                    raise ValueError(f"{path}: /materials/{name}: Mitsuba's area emitter ignores a mask's opacity "
+                                     "(vkray's lamp sends light only where it is there): not converted")
         bsdfs[name] = mi.load_dict(b)  # one instance, shared by every shape with the material
         e = m.get("emission")
         if e is not None and any(x != 0 for x in e):
             emissions[name] = [float(x) for x in e]
+    # Mitsuba's 'path' takes a mask as a solid surface on shadow rays; its 'volpath' passes them as
+    # vkray does (and, as vkray, does not count the pass as a bounce).
+    if see_through:
+        d["integrator"]["type"] = "volpath"
     if direct and specular:
         warn("vkray's direct model follows mirrors and glass for several bounces; Mitsuba's path with "
              "max_depth 2 does not, so they will differ (use a path integrator to compare them)")
