@@ -25,25 +25,32 @@
 // slopes, a coarse mesh's vertex normals at its silhouette), which would otherwise reflect into the
 // surface and shade black. n itself where its reflection already leaves. With N = x X + z ng (X the
 // unit part of n across ng) the condition 2 (N . wo) z - (ng . wo) = threshold is a quadratic in z^2;
-// its one root that solves it before squaring.
+// its one root that solves it before squaring. Applied to materials with a glossy or delta lobe, as
+// Cycles applies it to its specular closures: a Lambertian surface's shading does not depend on wo,
+// and light above n but below the surface is refused anyway (faces()).
 vec3 valid_reflection_normal(vec3 ng, vec3 wo, vec3 n) {
   float iz = dot(wo, ng);
   float threshold = min(0.9 * iz, 0.01);
-  if (dot(ng, 2.0 * dot(n, wo) * n - wo) >= threshold) return n;
-  vec3 across = n - dot(n, ng) * ng;
+  // The reflection 2 (n . wo) n - wo rises 2 (n . wo)(n . ng) - iz above the surface. (Scalars where
+  // they do: on llvmpipe every lane runs the bend below whether it needs it or not.)
+  float n_wo = dot(n, wo), n_ng = dot(n, ng);
+  if (2.0 * n_wo * n_ng - iz >= threshold) return n;
+  vec3 across = n - n_ng * ng;
   float across2 = dot(across, across);
-  float ix = across2 > 0.0 ? dot(wo, across) * inversesqrt(across2) : 0.0;
+  float inv_across = across2 > 0.0 ? inversesqrt(across2) : 0.0;
+  float ix = (n_wo - n_ng * iz) * inv_across;  // wo . across / |across|
   float a = ix * ix + iz * iz;
   if (!(across2 > 0.0) || !(a > 0.0)) return ng;
   float b = 2.0 * (a + iz * threshold);
   float c = (threshold + iz) * (threshold + iz);
   float root = sqrt(max(b * b - 4.0 * a * c, 0.0));
   float z2 = clamp(0.25 * (ix < 0.0 ? b + root : b - root) / a, 0.0, 1.0);
-  return sqrt(1.0 - z2) * (across * inversesqrt(across2)) + sqrt(z2) * ng;
+  return (sqrt(1.0 - z2) * inv_across) * across + sqrt(z2) * ng;
 }
 
 // A surface as a ray along `dir` meets it: on its front (the side its geometric normal faces, as the
-// caller decides it), its two normals turned toward the ray, the shading one made valid for it.
+// caller decides it), its two normals turned toward the ray, the shading one made valid for it where
+// the material is not purely Lambertian.
 struct Facing {
   vec3 n_geometric;
   vec3 n;
@@ -51,7 +58,9 @@ struct Facing {
 
 Facing facing(Surface s, vec3 dir, bool front) {
   vec3 ng = front ? s.geometric_normal : -s.geometric_normal;
-  return Facing(ng, valid_reflection_normal(ng, -dir, front ? s.shading_normal : -s.shading_normal));
+  vec3 n = front ? s.shading_normal : -s.shading_normal;
+  bool bend = SCENE_HAS_SHADING_NORMALS && SCENE_HAS_NON_DIFFUSE && s.properties != VKRAY_BSDF_DIFFUSE;
+  return Facing(ng, bend ? valid_reflection_normal(ng, -dir, n) : n);
 }
 
 // A point lit by the lights: x, its shading normal n turned toward the incoming ray, and where its

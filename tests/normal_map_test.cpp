@@ -98,7 +98,7 @@ class ShadingNormalNotBent : public BrokenNormalMap {
  protected:
   // Normals that face away from the viewer kept as they are: their reflections go into the surface.
   ShadingNormalNotBent()
-      : BrokenNormalMap("shade.glsl", "if (dot(ng, 2.0 * dot(n, wo) * n - wo) >= threshold) return n;", "return n;") {}
+      : BrokenNormalMap("shade.glsl", "if (2.0 * n_wo * n_ng - iz >= threshold) return n;", "return n;") {}
 };
 TEST_F(ShadingNormalNotBent, IsCaught) {
   expect_caught("direct");

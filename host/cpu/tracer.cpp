@@ -179,7 +179,8 @@ dvec3 valid_reflection_normal(const dvec3& ng, const dvec3& wo, const dvec3& n) 
 
 Facing facing(const SurfacePoint& s, const dvec3& dir, bool front) {
   const dvec3 ng = front ? s.geometric_normal : -s.geometric_normal;
-  return {ng, valid_reflection_normal(ng, -dir, front ? s.shading_normal : -s.shading_normal)};
+  const dvec3 n = front ? s.shading_normal : -s.shading_normal;
+  return {ng, s.properties == VKRAY_BSDF_DIFFUSE ? n : valid_reflection_normal(ng, -dir, n)};
 }
 
 SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
@@ -193,6 +194,7 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
       s.shading_normal = glm::normalize((1 - hit.u - hit.v) * dvec3(tri.normals[0]) + hit.u * dvec3(tri.normals[1]) +
                                         hit.v * dvec3(tri.normals[2]));
     s.material = tri.material;
+    s.properties = scene_.materials[tri.material].properties();
     const Material& m = scene_.materials[tri.material];
     s.albedo = dvec3(m.albedo);
     s.emission = dvec3(m.emission);
@@ -229,6 +231,7 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
     if (sphere.inward) s.geometric_normal = -s.geometric_normal;
     s.shading_normal = s.geometric_normal;
     s.material = sphere.material;
+    s.properties = scene_.materials[sphere.material].properties();
     const Material& m = scene_.materials[sphere.material];
     s.albedo = dvec3(m.albedo);
     s.emission = dvec3(m.emission);

@@ -38,11 +38,13 @@ struct SurfacePoint {
   dvec3 emission{0.0};  // the material's emission, its texture applied
   double metallic = 1;   // metallic_roughness: the material's metallic and roughness, its texture applied
   double roughness = 1;
+  uint32_t properties = 0;  // the material's (VKRAY_BSDF_*)
 };
 
 // A surface as a ray along `dir` meets it, on its front (the side its geometric normal faces) or
-// not: both normals turned toward the ray, the shading one bent toward the geometric one where the
-// mirror reflection of -dir about it would not leave the surface (valid_reflection_normal).
+// not: both normals turned toward the ray, the shading one, where the material is not purely
+// Lambertian, bent toward the geometric one where the mirror reflection of -dir about it would not
+// leave the surface (valid_reflection_normal).
 struct Facing {
   dvec3 n_geometric;
   dvec3 n;

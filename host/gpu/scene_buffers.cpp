@@ -100,6 +100,7 @@ SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<c
   bvh_seconds_ = bvh.build_seconds;
   primitive_count_ = uint32_t(bvh.order.size());
   const PackedScene packed = pack_scene(*scene_, bvh);
+  vertex_normals_ = !packed.normals.empty();
   if (primitive_count_ <= kMaxInlinePrimitives) inline_scene_ = inline_scene_glsl(packed);
   check_memory(*ctx_, packed);
   geometry_ = std::make_shared<const Geometry>(Geometry{make_texel_buffer(*ctx_, packed.primitives, "primitive"),
@@ -121,7 +122,8 @@ SceneBuffers::SceneBuffers(const SceneBuffers& same, std::shared_ptr<const Scene
       geometry_(same.geometry_),
       primitive_count_(same.primitive_count_),
       inline_scene_(same.inline_scene_),
-      shares_geometry_(true) {
+      shares_geometry_(true),
+      vertex_normals_(same.vertex_normals_) {
   if (!same_geometry(same.scene(), *scene_)) throw InternalError("a scene shares the device buffers of one with other geometry");
   const auto start = Clock::now();
   const PackedLighting packed = pack_lighting(*scene_, geometry_->order);

@@ -39,6 +39,8 @@ class SceneBuffers {
   double upload_seconds() const { return upload_seconds_; }  // BVH build included, prebuilt or not
   bool shares_geometry() const { return shares_geometry_; }  // made by the second constructor
   const LightingFrame& lighting() const { return lighting_frame_; }
+  // Whether some triangle is shaded with its vertex normals (Triangle::smooth).
+  bool vertex_normals() const { return vertex_normals_; }
 
   // Adds the scene's buffers at their bindings (shared/types.h).
   void bind(DescriptorWriter& writer) const;
@@ -55,6 +57,7 @@ class SceneBuffers {
   LightingFrame lighting_frame_;
   double bvh_seconds_ = 0, upload_seconds_ = 0;
   bool shares_geometry_ = false;
+  bool vertex_normals_ = false;
 };
 
 }  // namespace vkray::gpu

@@ -53,6 +53,9 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_NORMAL_MAPS 8
 // false when no material lets rays through (VKRAY_ALPHA_*): no alpha test, and no ray keys drawn.
 #define VKRAY_SPEC_ALPHA 9
+// false when every shading normal is the geometric one (no vertex normals, no normal maps): no code to
+// bend a shading normal that faces away from the viewer (shade.glsl), which the geometric one never does.
+#define VKRAY_SPEC_SHADING_NORMALS 10
 // And one per material type, id VKRAY_SPEC_MATERIALS + its number (shared/materials.h): whether the
 // scene has a material of that type (gpu::ShaderVariant::materials, a bit each); the BSDF code of
 // the others is left out. Declared as SCENE_HAS_<name> (SCENE_HAS_roughconductor).
@@ -67,7 +70,8 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_TEXTURES, SCENE_HAS_TEXTURES, textures, false) \
   X(VKRAY_SPEC_SINGLE_SIDED, SCENE_HAS_SINGLE_SIDED, single_sided, false) \
   X(VKRAY_SPEC_NORMAL_MAPS, SCENE_HAS_NORMAL_MAPS, normal_maps, false) \
-  X(VKRAY_SPEC_ALPHA, SCENE_HAS_ALPHA, alpha, false)
+  X(VKRAY_SPEC_ALPHA, SCENE_HAS_ALPHA, alpha, false) \
+  X(VKRAY_SPEC_SHADING_NORMALS, SCENE_HAS_SHADING_NORMALS, shading_normals, true)
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
