@@ -16,7 +16,7 @@ vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
     Hit hit = trace_closest(ray, frame.epsilon, FAR, true, stream);
     if (hit.prim == NO_HIT) return frame.background.rgb;
     vec3 x = ray_at(ray, hit.t);
-    Surface s = hit_surface(hit, x);
+    Surface s = hit_surface(hit, ray);
     if (FIRST_HIT_PASSES) add_first_hit(hit, x, s);
     return shade(ray, x, s, stream, rays);
   }
@@ -29,7 +29,7 @@ vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
       break;
     }
     vec3 x = ray_at(ray, hit.t);
-    Surface s = hit_surface(hit, x);
+    Surface s = hit_surface(hit, ray);
     if (FIRST_HIT_PASSES && bounce == 0u) add_first_hit(hit, x, s);
     bool front = !(dot(s.geometric_normal, ray.dir) > 0.0);  // a grazing ray meets the front, as in shade()
     if (front) radiance += throughput * s.emission;

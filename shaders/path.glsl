@@ -54,7 +54,7 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
     return true;
   }
   vec3 x = ray_at(p.ray, hit.t);
-  Surface s = hit_surface(hit, x);
+  Surface s = hit_surface(hit, p.ray);
   if (FIRST_HIT_PASSES && p.depth == 0u) add_first_hit(hit, x, s);
   float cos_hit = -dot(s.geometric_normal, p.ray.dir);
   bool front = cos_hit > 0.0;

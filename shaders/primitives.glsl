@@ -40,7 +40,7 @@ bool meets_slot(Ray ray, uint prim, float t, uint key) {
   if ((flags & VKRAY_PRIM_ALPHA) == 0u) return true;
   bool sphere = (flags & VKRAY_PRIM_SPHERE) != 0u;
   vec3 x = ray_at(ray, t);
-  vec2 bary = sphere ? vec2(0.0) : triangle_barycentrics(x, a.xyz, b.xyz, c.xyz);
+  vec2 bary = sphere ? vec2(0.0) : triangle_hit_barycentrics(ray, a.xyz, b.xyz, c.xyz);
   vec4 alpha;
   float opacity = opacity_at(prim, flags, bary, alpha);
   bool far_side = sphere && dot(ray.dir, x - a.xyz) > 0.0;
@@ -83,7 +83,9 @@ struct Surface {
   float light_pdf_area;   // the density per unit area with which light sampling picks this point (emitters.glsl)
 };
 
-Surface hit_surface(Hit hit, vec3 position) {
+// The surface where `ray` hits: `hit`.
+Surface hit_surface(Hit hit, Ray ray) {
+  vec3 position = ray_at(ray, hit.t);
   int base = int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE;
   vec4 a = texelFetch(primitives, base);
   uint flags = primitive_flags(a);
@@ -139,7 +141,7 @@ Surface hit_surface(Hit hit, vec3 position) {
   bool textured = SCENE_HAS_TEXTURES && (has_texture(albedo_texture) || has_texture(emission_texture) || has_texture(layers_texture) ||
                                          has_texture(normal_texture));
   if (!smooth_normals && !textured) return s;
-  vec2 b = triangle_barycentrics(position, a.xyz, v1, v2);
+  vec2 b = triangle_hit_barycentrics(ray, a.xyz, v1, v2);
   if (smooth_normals)
     s.shading_normal = normalize((1.0 - b.x - b.y) * texelFetch(normals, base).xyz + b.x * texelFetch(normals, base + 1).xyz +
                                  b.y * texelFetch(normals, base + 2).xyz);

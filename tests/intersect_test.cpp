@@ -109,6 +109,22 @@ TEST_F(IntersectTest, SharedEdgeHasNoCrack) {
   EXPECT_EQ(cracks, 0);
 }
 
+TEST_F(IntersectTest, HitBarycentricsKeepTheirPrecisionOnASliver) {
+  // A triangle 100 long and 1 wide (its sharpest angle 0.57 degrees), hit at (60, 0.1): b1 to float
+  // precision of the coordinates from the test's own edge functions, where solving it from the hit
+  // point loses digits as 1 / sin^2 of that angle (1.2e-4 off here: a quarter of a texel of a
+  // 2048-texel texture).
+  const glm::dvec3 v0(0, 0, 2), v1(100, 0.5, 2), v2(100, -0.5, 2), p(60, 0.1, 2);
+  // p = v0 + b1 (v1 - v0) + b2 (v2 - v0): x = 100 (b1 + b2), y = 0.5 (b1 - b2).
+  const double exact = (p.x / 100 + p.y / 0.5) / 2;
+  Case hit = triangle({60, 0.1f, 0}, {0, 0, 1}, v0, v1, v2), from_point = hit;
+  hit.range.z = 3;
+  from_point.range.z = 4;
+  const std::vector<float> b1 = run({hit, from_point});
+  EXPECT_NEAR(b1[0], exact, 2e-7);
+  EXPECT_GT(std::abs(b1[1] - exact), 10 * std::abs(b1[0] - exact));
+}
+
 TEST_F(IntersectTest, TriangleNormalsAreUnitAtEveryScale) {
   // A tilted triangle, so that every component of its cross product is nonzero. At 6e-10 its squared
   // cross product is near the smallest normal float (a device that flushes subnormals normalizes by

@@ -13,7 +13,8 @@ struct IntersectCase {
   vec4 a;       // triangle: v0; sphere: center (xyz) and radius (w)
   vec4 b;       // triangle: v1
   vec4 c;       // triangle: v2
-  vec4 range;   // t_min, t_max, kind (0 triangle, 1 sphere, 2 the triangle's normal against dir)
+  vec4 range;   // t_min, t_max, kind (0 triangle, 1 sphere, 2 the triangle's normal against dir, 3 and 4 the
+                //   barycentric b1 of the hit: from the test's edge functions, and solved from the hit point)
 };
 
 VKRAY_SHARED_END
