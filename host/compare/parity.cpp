@@ -30,8 +30,6 @@ ParityTolerance parity_tolerance(const Scene& scene) {
   const bool emitters = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissive(); });
   tolerance.stochastic = scene.integrator.type == Integrator::Type::path || chooses || emitters || scene.camera.aperture_radius > 0;
   tolerance.textured = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.textured(); });
-  tolerance.normal_mapped =
-      std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.normal_texture.present(); });
   return tolerance;
 }
 

@@ -104,7 +104,7 @@ void compare_aovs(const Aovs& gpu, const Aovs& reference, const std::vector<uint
                                                            !close(gpu.albedo[i], reference.albedo[i], 1e-2 * ref_albedo)
                                                      : !close(gpu.albedo[i], reference.albedo[i], 1e-4 * ref_albedo);
       const bool differs[kAllAovs.size()] = {
-          albedo_differs, !close(gpu.normal[i], reference.normal[i], tolerance.normal_mapped ? 2.0 / 255.0 : 1e-3),
+          albedo_differs, !close(gpu.normal[i], reference.normal[i], 1e-3),
           !close(gpu.position[i], reference.position[i], length_tolerance), !depth_agrees, gpu.object[i] != reference.object[i]};
       bool any = false;
       for (size_t pass = 0; pass < kAllAovs.size(); ++pass) {

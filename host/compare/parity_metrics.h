@@ -33,9 +33,6 @@ struct ParityTolerance {
   // The albedo pass is exact but for float rounding (10^-4 of the value), unless a texture makes it
   // depend on the interpolated texture coordinate: then it is judged by 8-bit sRGB steps, as the image is.
   bool textured = false;
-  // The normal pass is exact but for float rounding (10^-3), unless a normal map makes it depend on
-  // the interpolated texture coordinate: then to one step of an 8-bit map (2/255 per component).
-  bool normal_mapped = false;
 };
 
 struct ParityMetrics {
