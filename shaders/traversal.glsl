@@ -20,8 +20,11 @@ bool culled(Ray ray, vec4 a, vec4 b, vec4 c) {
 // Tests the primitives of a leaf against the ray, keeping the closest hit (ties go to the primitive
 // that comes first in the scene, VKRAY_TIE; hit_index is the best hit's place in the scene).
 // Returns true when any_hit and something was hit. cull_back: the ray is a camera ray (culled()).
-bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max, bool any_hit, bool cull_back, inout Hit hit,
-                    inout uint hit_index) {
+// passed_t, passed_index: a surface the ray has passed (trace()), after which the search goes on in
+// the tie rule's order: a primitive that comes later in the scene counts from t_min, any other only
+// past a tie with passed_t (a sphere's far side, say). passed_t 0: none.
+bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max, bool any_hit, bool cull_back, float passed_t,
+                    uint passed_index, inout Hit hit, inout uint hit_index) {
   uint first = leaf_first(link);
   uint end = first + leaf_count(link);
   // A do-while without `continue` (a leaf is never empty): see the light loop in shade.glsl.
@@ -31,10 +34,11 @@ bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max
     vec4 a = texelFetch(primitives, base), b = texelFetch(primitives, base + 1), c = texelFetch(primitives, base + 2);
     // Anything up to a tie with the best hit so far is still a candidate.
     float limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
-    float t = intersect_primitive(ray, shear, a, b, c, t_min, limit);
+    uint index = primitive_scene_index(b);
+    float t_from = SCENE_HAS_ALPHA && index <= passed_index ? max(t_min, passed_t * (1.0 + VKRAY_TIE)) : t_min;
+    float t = intersect_primitive(ray, shear, a, b, c, t_from, limit);
     if (SCENE_HAS_SINGLE_SIDED && cull_back && t > 0.0 && culled(ray, a, b, c)) t = -1.0;
     if (t > 0.0) {
-      uint index = primitive_scene_index(b);
       if (any_hit) {
         hit = Hit(t, prim);
         return true;
@@ -121,13 +125,14 @@ Children enter_node(Ray ray, vec3 inv_dir, bvec3 backward, uint node, float t_mi
 
 // Closest hit in (t_min, t_max), every surface taken as whole; with any_hit, the first hit found (for
 // shadow rays). cull_back: a camera ray, which passes the back faces of single-sided triangles.
-Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back) {
+// passed_t, passed_index: intersect_leaf's.
+Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back, float passed_t, uint passed_index) {
   Hit hit = Hit(t_max, NO_HIT);
   uint hit_index = 0u;
   if (frame.primitive_count == 0u) return hit;
   RayShear shear = ray_shear(ray.dir);
 #ifdef VKRAY_INLINE_SCENE
-  test_inline_primitives(ray, shear, t_min, t_max, any_hit, SCENE_HAS_SINGLE_SIDED && cull_back, hit);
+  test_inline_primitives(ray, shear, t_min, t_max, any_hit, SCENE_HAS_SINGLE_SIDED && cull_back, passed_t, passed_index, hit);
   return hit;
 #endif
   vec3 inv_dir = safe_inverse(ray.dir);
@@ -147,7 +152,7 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back) {
   for (;;) {
     bool pop = true;
     if (is_leaf(node)) {
-      if (intersect_leaf(ray, shear, node, t_min, t_max, any_hit, cull_back, hit, hit_index)) return hit;
+      if (intersect_leaf(ray, shear, node, t_min, t_max, any_hit, cull_back, passed_t, passed_index, hit, hit_index)) return hit;
     } else {
       float t_limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
       Children c = enter_node(ray, inv_dir, backward, node, t_min, t_limit);
@@ -175,22 +180,26 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back) {
 // shared/materials.h) lets the ray through where its opacity says so. In a scene with such surfaces
 // the ray draws its alpha key from the stream (shared/sampling.h), and the search runs from the ray's
 // start to the nearest surface, every surface taken as whole; where that surface lets the ray
-// through, it runs again from there (a sphere's far side is then the next surface), until a surface
-// stops the ray or nothing is left. One opacity evaluation per surface the ray reaches, rather than
+// through, it runs again from there in the tie rule's order (VKRAY_TIE: a surface within a tie of
+// the one passed counts if it comes later in the scene, so that a decal does not open the floor it
+// lies on; a sphere's far side is the next surface), until a surface stops the ray or nothing is left. One opacity evaluation per surface the ray reaches, rather than
 // one per primitive tested: on llvmpipe a lane pays for whatever code any lane beside it runs, and
 // the opacity (a texture lookup) costs several times a triangle test. A shadow ray, too, looks for
 // the nearest surface: one that is not the nearest could stand behind a surface that lets the ray
 // through.
 Hit trace(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back, inout uint stream) {
-  if (!SCENE_HAS_ALPHA) return traverse(ray, t_min, t_max, any_hit, cull_back);
+  if (!SCENE_HAS_ALPHA) return traverse(ray, t_min, t_max, any_hit, cull_back, 0.0, 0u);
   uint key = next_word(stream);
   Hit hit;
-  float from = t_min;
+  float from = t_min, passed_t = 0.0;
+  uint passed_index = 0u;
   bool passes;
   do {  // (a do-while: see the sample loop in trace.comp)
-    hit = traverse(ray, from, t_max, false, cull_back);
+    hit = traverse(ray, from, t_max, false, cull_back, passed_t, passed_index);
     passes = hit.prim != NO_HIT && !meets_slot(ray, hit.prim, hit.t, key);
-    from = hit.t;
+    passed_t = hit.t;
+    passed_index = primitive_scene_index(texelFetch(primitives, int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE + 1));
+    from = max(t_min, hit.t * (1.0 - VKRAY_TIE));
   } while (passes);
   return hit;
 }

@@ -18,20 +18,22 @@ namespace {
 const std::string kFloor = (std::filesystem::path(VKRAY_SCENE_DIR) / "meshes/tiled-floor.obj").string();
 
 // A white floor (y = 0) seen from a narrow camera at height 0.5 looking straight down at the origin,
-// lit by a point light 2 above it; `sheet` (a JSON object, or empty) is a 1.6 x 1.6 copy of the
-// tiled floor at height 1, between the light and the floor but above the camera, of material "sheet".
-std::string shadow_scene(const std::string& sheet_material, const std::string& integrator = "direct") {
-  std::string json = R"({
-    "integrator": {"type": ")" + integrator + R"("},
+// lit by a point light 2 above it. `materials`: more members of "materials"; `before`, `after`: more
+// objects, listed before and after the floor (JSON, each with a leading or trailing comma).
+std::string floor_scene(const std::string& materials, const std::string& before = "", const std::string& after = "") {
+  return R"({
     "camera": {"position": [0, 0.5, 0.0001], "look_at": [0, 0, 0], "vertical_fov": 10},
-    "materials": {"white": {"albedo": [0.5, 0.5, 0.5]})";
-  if (!sheet_material.empty()) json += R"(, "sheet": )" + sheet_material;
-  json += R"(},
+    "materials": {"white": {"albedo": [0.5, 0.5, 0.5]})" + materials + R"(},
     "lights": [{"type": "point", "position": [0, 2, 0], "intensity": [10, 10, 10]}],
-    "objects": [{"type": "mesh", "file": ")" + kFloor + R"(", "material": "white"})";
-  if (!sheet_material.empty())
-    json += R"(, {"type": "mesh", "file": ")" + kFloor + R"(", "material": "sheet", "transform": {"scale": 0.2, "translate": [0, 1, 0]}})";
-  return json + "]}";
+    "objects": [)" + before + R"({"type": "mesh", "file": ")" + kFloor + R"(", "material": "white"})" + after + "]}";
+}
+
+// The floor, and `sheet` (a material's JSON object, or empty: none) on a 1.6 x 1.6 copy of the tiled
+// floor at height 1, between the light and the floor but above the camera.
+std::string shadow_scene(const std::string& sheet) {
+  if (sheet.empty()) return floor_scene("");
+  return floor_scene(R"(, "sheet": )" + sheet, "",
+                     R"(, {"type": "mesh", "file": ")" + kFloor + R"(", "material": "sheet", "transform": {"scale": 0.2, "translate": [0, 1, 0]}})");
 }
 
 // A one-texel grey picture: as an opacity texture without alpha, its grey is its opacity.
@@ -57,17 +59,31 @@ TEST_F(AlphaShadingTest, ABlendedSheetPassesOneMinusItsOpacityOfTheLight) {
 TEST_F(AlphaShadingTest, ABlendedSphereIsTwoSurfacesToARayThatCrossesIt) {
   // A shadow ray through a sphere blended at opacity 0.5 crosses two surfaces, each deciding on its
   // own: it passes with probability 0.5^2 = 0.25 (the same number for both sides would pass 0.5).
-  const std::string json = R"({
-    "camera": {"position": [0, 0.5, 0.0001], "look_at": [0, 0, 0], "vertical_fov": 10},
-    "materials": {"white": {"albedo": [0.5, 0.5, 0.5]}, "ghost": {"albedo": [0.5, 0.5, 0.5], "opacity": 0.5}},
-    "lights": [{"type": "point", "position": [0, 2, 0], "intensity": [10, 10, 10]}],
-    "objects": [{"type": "mesh", "file": ")" + kFloor + R"(", "material": "white"},
-                {"type": "sphere", "center": [0, 1.3, 0], "radius": 0.4, "material": "ghost"}]})";
+  const std::string json = floor_scene(R"(, "ghost": {"albedo": [0.5, 0.5, 0.5], "opacity": 0.5})", "",
+                                       R"(, {"type": "sphere", "center": [0, 1.3, 0], "radius": 0.4, "material": "ghost"})");
   const Scene open = parse_scene(shadow_scene(""), dir_ / "open.json");
   const Scene sphere = parse_scene(json, dir_ / "sphere.json");
   for (const bool cpu : {false, true}) {
     const double expected = 0.25 * floor_radiance(open, 1, cpu);
     EXPECT_NEAR(floor_radiance(sphere, 256, cpu), expected, 0.03 * expected) << (cpu ? "CPU" : "GPU");
+  }
+}
+
+TEST_F(AlphaShadingTest, ADecalOnAnOpaqueFloorNeverOpensIt) {
+  // A blended decal lying on the floor, the same triangles listed first: where a ray passes the decal,
+  // the floor at the same distance still stops it (the search goes on in the tie rule's order, not
+  // from past the decal's t). With the decal's colour the floor's, the image is the bare floor's, bit
+  // for bit, through the BVH and compiled into the shader.
+  const std::string json = floor_scene(R"(, "decal": {"albedo": [0.5, 0.5, 0.5], "opacity": 0.5})",
+                                       R"({"type": "mesh", "file": ")" + kFloor + R"(", "material": "decal"}, )");
+  const Scene bare = parse_scene(shadow_scene(""), dir_ / "bare.json");
+  const Scene decal = parse_scene(json, dir_ / "decal.json");
+  for (const InlineScene inline_scene : {InlineScene::never, InlineScene::always}) {
+    RenderOptions options;
+    options.inline_scene = inline_scene;
+    for (const bool cpu : {false, true})
+      EXPECT_TRUE(render(decal, {16, 16, 4}, options, cpu).pixels == render(bare, {16, 16, 4}, options, cpu).pixels)
+          << (cpu ? "CPU" : "GPU") << (inline_scene == InlineScene::always ? ", compiled in" : "");
   }
 }
 

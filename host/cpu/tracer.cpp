@@ -78,12 +78,13 @@ double opacity_at(const Scene& scene, size_t p, double u, double v) {
 uint32_t Tracer::alpha_key(uint32_t& stream) const { return see_through_ ? gpu::next_word(stream) : 0; }
 
 // The hit as search() finds it; where the scene has see-through materials, the nearest hit, and
-// where its surface lets the ray through, the nearest past it (a sphere's far side among them), until
-// one stops the ray or none is left: the shader's rule (trace() in traversal.glsl).
+// where its surface lets the ray through, the next in the tie rule's order (a sphere's far side among
+// them), until one stops the ray or none is left: the shader's rule (trace() in traversal.glsl).
 Hit Tracer::find(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray, uint32_t alpha_key) const {
-  if (!see_through_) return search(ray, t_min, t_max, any_hit, camera_ray);
-  Hit hit = search(ray, t_min, t_max, false, camera_ray);
-  while (hit.primitive >= 0 && !solid(ray, hit, alpha_key)) hit = search(ray, hit.t, t_max, false, camera_ray);
+  if (!see_through_) return search(ray, t_min, t_max, any_hit, camera_ray, {});
+  Hit hit = search(ray, t_min, t_max, false, camera_ray, {});
+  while (hit.primitive >= 0 && !solid(ray, hit, alpha_key))
+    hit = search(ray, std::max(t_min, hit.t * (1 - VKRAY_TIE)), t_max, false, camera_ray, {hit.t, hit.primitive});
   return hit;
 }
 
@@ -99,25 +100,27 @@ bool Tracer::solid(const Ray& ray, const Hit& hit, uint32_t alpha_key) const {
                           gpu::alpha_random(alpha_key, uint32_t(p), far_side));
 }
 
-Hit Tracer::search(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray) const {
+Hit Tracer::search(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray, const Passed& passed) const {
   Hit best{t_max, -1};
   const size_t count = scene_.triangles.size() + scene_.spheres.size();
   if (!bvh_) {
-    for (size_t p = 0; p < count && !(any_hit && best.primitive >= 0); ++p) test(ray, p, t_min, t_max, camera_ray, best);
+    for (size_t p = 0; p < count && !(any_hit && best.primitive >= 0); ++p) test(ray, p, t_min, t_max, camera_ray, passed, best);
     return best;
   }
   if (bvh_->nodes.empty()) return best;
   // 1 / d with zero components replaced by tiny ones, so a slab test never computes 0 * inf.
   dvec3 inv;
   for (int a = 0; a < 3; ++a) inv[a] = (ray.dir[a] < 0 ? -1.0 : 1.0) / std::max(std::abs(ray.dir[a]), 1e-300);
-  visit(0, ray, inv, t_min, t_max, any_hit, camera_ray, best);
+  visit(0, ray, inv, t_min, t_max, any_hit, camera_ray, passed, best);
   return best;
 }
 
 // Tests primitive p, which becomes the best hit when it is closer than the best so far by more
 // than VKRAY_TIE, or ties with it and comes first in the scene.
-void Tracer::test(const Ray& ray, size_t p, double t_min, double t_max, bool camera_ray, Hit& best) const {
+void Tracer::test(const Ray& ray, size_t p, double t_min_all, double t_max, bool camera_ray, const Passed& passed, Hit& best) const {
   Hit candidate{-1, int(p)};
+  // After a surface passed, a primitive that does not come later in the scene counts only past a tie with it.
+  const double t_min = int(p) <= passed.primitive ? std::max(t_min_all, passed.t * (1 + VKRAY_TIE)) : t_min_all;
   if (p < scene_.triangles.size()) {
     const Triangle& tri = scene_.triangles[p];
     candidate.t = intersect_triangle(ray, tri, t_min, limit(best, t_max), candidate.u, candidate.v);
@@ -134,7 +137,7 @@ void Tracer::test(const Ray& ray, size_t p, double t_min, double t_max, bool cam
 
 // Recursive descent, nearer child first. Returns true to stop (any_hit found one).
 bool Tracer::visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, bool camera_ray,
-                   Hit& best) const {
+                   const Passed& passed, Hit& best) const {
   const BvhNode& n = bvh_->nodes[node];
   double t_enter[2];
   const bool hit[2] = {enters(n.child[0], ray, inv, t_min, limit(best, t_max), t_enter[0]),
@@ -145,10 +148,10 @@ bool Tracer::visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min
     const uint32_t link = n.link[c];
     if (is_leaf(link)) {
       for (uint32_t slot = leaf_first(link); slot < leaf_first(link) + leaf_count(link); ++slot) {
-        test(ray, bvh_->order[slot], t_min, t_max, camera_ray, best);
+        test(ray, bvh_->order[slot], t_min, t_max, camera_ray, passed, best);
         if (any_hit && best.primitive >= 0) return true;
       }
-    } else if (visit(link, ray, inv, t_min, t_max, any_hit, camera_ray, best)) {
+    } else if (visit(link, ray, inv, t_min, t_max, any_hit, camera_ray, passed, best)) {
       return true;
     }
   }

@@ -94,11 +94,17 @@ class Tracer {
   Hit find(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray, uint32_t alpha_key) const;
   // Whether the ray with `alpha_key` meets the surface it reaches at `hit`.
   bool solid(const Ray& ray, const Hit& hit, uint32_t alpha_key) const;
+  // A surface the ray has passed: the search after it goes on in the tie rule's order, a primitive
+  // within a tie of `t` counting only if it comes later in the scene. t 0: none.
+  struct Passed {
+    double t = 0;
+    int primitive = -1;
+  };
   // Every surface taken as whole.
-  Hit search(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray) const;
-  void test(const Ray& ray, size_t p, double t_min, double t_max, bool camera_ray, Hit& best) const;
+  Hit search(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray, const Passed& passed) const;
+  void test(const Ray& ray, size_t p, double t_min, double t_max, bool camera_ray, const Passed& passed, Hit& best) const;
   bool visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, bool camera_ray,
-             Hit& best) const;
+             const Passed& passed, Hit& best) const;
 
   const Scene& scene_;
   const Bvh* bvh_;

@@ -45,7 +45,11 @@ std::string inline_scene_glsl(const PackedGeometry& packed) {
   // every struct and `inout` argument through temporaries, which both it and the driver's compiler
   // then spend time on (for the Cornell box's 30 triangles 0.1 s more than this).
   out += "void test_inline_primitives(Ray ray, RayShear shear, float t_min, float t_max, bool any_hit, bool cull_back,\n"
-         "                            inout Hit hit) {\n";
+         "                            float passed_t, uint passed_index, inout Hit hit) {\n";
+  // In a scene with see-through materials: after a surface passed, a primitive that does not come
+  // later in the scene counts only past a tie with it (traversal.glsl's intersect_leaf).
+  bool see_through = false;
+  for (size_t p = 0; p < count; ++p) see_through = see_through || (primitive_flags(packed.primitives[p * VKRAY_TEXELS_PER_PRIMITIVE]) & VKRAY_PRIM_ALPHA);
   out += "  vec3 o = ray.origin, s = shear.s;\n  ivec3 k = shear.k;\n";
   out += "  float best_t = hit.t, bound = t_max, t;\n  uint best = hit.prim;\n";
   // Each distinct vertex is sheared once (triangles of a mesh or a box share them), the triangles
@@ -61,11 +65,17 @@ std::string inline_scene_glsl(const PackedGeometry& packed) {
   };
   for (const uint32_t p : order) {
     const glm::vec4* t = &packed.primitives[size_t(p) * VKRAY_TEXELS_PER_PRIMITIVE];
+    std::string from = "t_min";  // (appended to, not "(" + std::to_string(...): GCC 12's false -Wrestrict)
+    if (see_through) {
+      from = "(";
+      from += std::to_string(scene_index(p));
+      from += "u <= passed_index ? max(t_min, passed_t * (1.0 + VKRAY_TIE)) : t_min)";
+    }
     if (primitive_flags(t[0]) & VKRAY_PRIM_SPHERE) {
-      out += "  t = intersect_sphere(ray, " + vec3_literal(t[0]) + ", " + literal(sphere_radius(t[1])) + ", t_min, bound);\n";
+      out += "  t = intersect_sphere(ray, " + vec3_literal(t[0]) + ", " + literal(sphere_radius(t[1])) + ", " + from + ", bound);\n";
     } else {
       const std::string a = vertex(t[0]), b = vertex(t[1]), c = vertex(t[2]);
-      out += "  t = sheared_triangle(" + a + ", " + b + ", " + c + ", t_min, bound);\n";
+      out += "  t = sheared_triangle(" + a + ", " + b + ", " + c + ", " + from + ", bound);\n";
       // The back of a single-sided triangle passes a camera ray (traversal.glsl's culled()), with the
       // same triangle_normal_direction of the same coordinates.
       if (primitive_flags(t[0]) & VKRAY_PRIM_SINGLE_SIDED)
