@@ -61,8 +61,8 @@ float intersect_triangle(Ray ray, RayShear sh, vec3 v0, vec3 v1, vec3 v2, float 
 // The barycentrics (b1, b2) of the point where a ray that hits the triangle meets it: the test's
 // own edge functions for v1 and v2 over their sum. Each is a 2D cross product of coordinates, good
 // to float precision of the coordinates whatever the triangle's shape, where barycentrics solved from
-// the hit point (triangle_barycentrics below) lose digits as 1 / sin^2 of its smallest angle: on a
-// sliver of a 2048-texel texture, a tenth of a texel.
+// the hit point lose digits as 1 / sin^2 of its smallest angle: on a sliver of a 2048-texel texture,
+// a tenth of a texel.
 vec2 triangle_hit_barycentrics(Ray ray, vec3 v0, vec3 v1, vec3 v2) {
   RayShear sh = ray_shear(ray.dir);
   vec3 a = shear_vertex(ray, sh, v0), b = shear_vertex(ray, sh, v1), c = shear_vertex(ray, sh, v2);
@@ -97,29 +97,11 @@ float intersect_sphere(Ray ray, vec3 center, float radius, float t_min, float t_
   return -1.0;
 }
 
-// Barycentric coordinates (u, v) of a point in the triangle's plane: p = v0 + u (v1 - v0) + v (v2 - v0).
-// They do not change when the triangle is scaled, so it is brought to a size of about 1 first: the
-// denominator is an edge length to the fourth power, which for edges of 1e-10 is below the smallest
-// normal float (and 1 / it infinite). A triangle too thin for floats to tell from a line gives
-// (0, 0), the first vertex, rather than NaN.
-vec2 triangle_barycentrics(vec3 p, vec3 v0, vec3 v1, vec3 v2) {
-  vec3 e1 = v1 - v0, e2 = v2 - v0, d = p - v0;
-  vec3 largest = max(abs(e1), abs(e2));
-  float scale = 1.0 / max(largest.x, max(largest.y, largest.z));
-  e1 *= scale;
-  e2 *= scale;
-  d *= scale;
-  float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), d1 = dot(d, e1), d2 = dot(d, e2);
-  float denominator = d11 * d22 - d12 * d12;
-  float inv = denominator > 0.0 ? 1.0 / denominator : 0.0;
-  return vec2((d22 * d1 - d12 * d2) * inv, (d11 * d2 - d12 * d1) * inv);
-}
-
 // The direction of a triangle's normal, (v1 - v0) x (v2 - v0) times a positive number: the edges are
-// brought to a size of about 1 first, as above. For edges of 6e-10 the squared length of the plain
-// cross product is near the smallest normal float, and a device that flushes subnormals to zero
-// (NVIDIA's does) then normalizes by too short a length; for edges of 1e-12 it is 0 on every device
-// (a NaN normal), and for 1e13 it overflows (a zero normal).
+// brought to a size of about 1 first, which does not change the direction. For edges of 6e-10 the
+// squared length of the plain cross product is near the smallest normal float, and a device that
+// flushes subnormals to zero (NVIDIA's does) then normalizes by too short a length; for edges of
+// 1e-12 it is 0 on every device (a NaN normal), and for 1e13 it overflows (a zero normal).
 vec3 triangle_normal_direction(vec3 v0, vec3 v1, vec3 v2) {
   vec3 e1 = v1 - v0, e2 = v2 - v0;
   vec3 largest = max(abs(e1), abs(e2));

@@ -22,9 +22,6 @@ void main() {
     t[i] = intersect_sphere(ray, c.a.xyz, c.a.w, c.range.x, c.range.y);
   else if (c.range.z == 2.0)  // the triangle's normal against the expected one, in dir: 1 when they agree
     t[i] = dot(triangle_normal(c.a.xyz, c.b.xyz, c.c.xyz), c.dir.xyz);
-  else if (c.range.z == 3.0)  // the barycentric b1 of the hit, from the test's edge functions
+  else  // the barycentric b1 of the hit, from the test's edge functions
     t[i] = triangle_hit_barycentrics(ray, c.a.xyz, c.b.xyz, c.c.xyz).x;
-  else  // the same solved from the hit point
-    t[i] = triangle_barycentrics(ray_at(ray, intersect_triangle(ray, ray_shear(ray.dir), c.a.xyz, c.b.xyz, c.c.xyz, c.range.x, c.range.y)),
-                                 c.a.xyz, c.b.xyz, c.c.xyz).x;
 }
