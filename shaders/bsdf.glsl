@@ -11,7 +11,9 @@
 //                   an ior of 1 is no interface: light passes straight on
 //   metallic_roughness  glTF 2.0's, as its specification's Appendix B writes it: a mix by `metallic` of
 //                   a conductor with Schlick's Fresnel from the base colour and a dielectric (ior) over
-//                   Lambert; GGX with alpha = roughness^2; a lobe, then a direction (three numbers)
+//                   Lambert, or over KHR_materials_transmission's thin-walled BTDF by `transmission`
+//                   (the specular lobe mirrored through the surface, times the base colour); GGX with
+//                   alpha = roughness^2; a lobe, then a direction (three numbers)
 // Every function takes wo, unit, back along the incoming ray; n, the shading normal turned to the
 // ray's side; front, whether the ray met the side the geometric normal faces. Glossy lobes live in
 // the frame tangent_frame(n) builds (warp.glsl), whose first tangent is alpha_u's. The CPU reference implements
@@ -166,32 +168,38 @@ float metallic_roughness_alpha(Surface s) { return max(s.roughness * s.roughness
 
 float dielectric_f0(Surface s) { return ((s.ior - 1.0) / (s.ior + 1.0)) * ((s.ior - 1.0) / (s.ior + 1.0)); }
 
-// The probability of sampling the specular lobe seen from wo: the metal's weight and the dielectric's
-// Schlick reflectance at wo, against the diffuse lobe's (1 - F) times the base colour's luminance.
-float specular_share(Surface s, vec3 wo) {
+// The probabilities of sampling the reflection lobe (x) and the transmission lobe (y) seen from wo;
+// the diffuse lobe has the rest. The metal's weight and the dielectric's Schlick reflectance at wo,
+// against the base's (1 - F) times the base colour's luminance, split by transmission.
+vec2 lobe_shares(Surface s, vec3 wo) {
   float f0 = dielectric_f0(s), f = f0 + (1.0 - f0) * pow(1.0 - min(1.0, wo.z), 5.0);
-  float specular = s.metallic + (1.0 - s.metallic) * f, diffuse = (1.0 - s.metallic) * (1.0 - f) * emission_luminance(s.albedo);
-  return specular + diffuse > 0.0 ? specular / (specular + diffuse) : 1.0;
+  float specular = s.metallic + (1.0 - s.metallic) * f, base = (1.0 - s.metallic) * (1.0 - f) * emission_luminance(s.albedo);
+  return specular + base > 0.0 ? vec2(specular, base * s.transmission) / (specular + base) : vec2(1.0, 0.0);
 }
 
+// The thin-walled BTDF takes a direction wi below the surface at its mirror image above it, l: the
+// half vector is KHR_materials_transmission's H_T = normalize(wo + wi - 2 (n.wi) n).
 vec3 metallic_roughness_eval(Surface s, vec3 wo, vec3 wi) {
-  if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
+  if (wo.z <= 0.0 || wi.z == 0.0 || (wi.z < 0.0 && !(s.transmission > 0.0))) return vec3(0.0);
   vec2 alpha = vec2(metallic_roughness_alpha(s));
-  vec3 h = normalize(wo + wi);
+  vec3 l = vec3(wi.xy, abs(wi.z)), h = normalize(wo + l);
   float schlick = pow(max(0.0, 1.0 - abs(dot(wo, h))), 5.0);  // (GLSL leaves pow of a negative undefined)
-  float specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) * smith_masking(wi, h, alpha) / (4.0 * wo.z * wi.z);
+  float specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) * smith_masking(l, h, alpha) / (4.0 * wo.z * l.z);
   float f0 = dielectric_f0(s), fresnel = f0 + (1.0 - f0) * schlick;
-  vec3 dielectric = (1.0 - fresnel) * s.albedo / PI + vec3(fresnel * specular);
+  if (wi.z < 0.0) return (1.0 - s.metallic) * (1.0 - fresnel) * s.transmission * specular * s.albedo * l.z;
+  vec3 dielectric = (1.0 - fresnel) * (1.0 - s.transmission) * s.albedo / PI + vec3(fresnel * specular);
   vec3 metal = specular * (s.albedo + (1.0 - s.albedo) * schlick);
-  return ((1.0 - s.metallic) * dielectric + s.metallic * metal) * wi.z;
+  return ((1.0 - s.metallic) * dielectric + s.metallic * metal) * l.z;
 }
 
 float metallic_roughness_pdf(Surface s, vec3 wo, vec3 wi) {
-  if (wo.z <= 0.0 || wi.z <= 0.0) return 0.0;
+  if (wo.z <= 0.0 || wi.z == 0.0) return 0.0;
   vec2 alpha = vec2(metallic_roughness_alpha(s));
-  vec3 h = normalize(wo + wi);
-  float p = specular_share(s, wo);
-  return p * ggx_density(h, alpha) * smith_masking(wo, h, alpha) / (4.0 * wo.z) + (1.0 - p) * wi.z / PI;
+  vec3 l = vec3(wi.xy, abs(wi.z)), h = normalize(wo + l);
+  vec2 p = lobe_shares(s, wo);
+  float specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) / (4.0 * wo.z);
+  if (wi.z < 0.0) return p.y * specular;
+  return p.x * specular + (1.0 - p.x - p.y) * wi.z / PI;
 }
 
 // Whether the surface is no interface at all (a rough dielectric of index 1, which sample_bsdf passes
@@ -302,17 +310,21 @@ BsdfSample sample_bsdf(Surface s, vec3 wo, vec3 n, bool front, inout uint stream
     b.weight = vec3(0.0);
     if (o.z <= 0.0) return b;
     vec3 i;
-    if (u_lobe < specular_share(s, o)) {
+    vec2 p = lobe_shares(s, o);
+    if (u_lobe < p.x + p.y) {  // a visible normal's reflection, mirrored through the surface to transmit
       vec3 m = sample_visible_normal(o, vec2(metallic_roughness_alpha(s)), u);
       i = 2.0 * dot(o, m) * m - o;
+      if (i.z <= 0.0) return b;
+      if (u_lobe >= p.x) i.z = -i.z;
     } else {
       i = cosine_hemisphere(u);
+      if (i.z <= 0.0) return b;
     }
-    if (i.z <= 0.0) return b;
-    // Either lobe may have given the direction: the weight is the whole BSDF over the mixed density.
+    // Any lobe may have given the direction: the weight is the whole BSDF over the mixed density.
     b.pdf = metallic_roughness_pdf(s, o, i);
     if (!(b.pdf > 0.0)) return b;
     b.dir = normalize(from_tangent_space(i, n));
+    b.transmitted = i.z < 0.0;  // through a thin sheet: unbent, b.eta stays 1
     b.weight = metallic_roughness_eval(s, o, i) / b.pdf;
     return b;
   }

@@ -80,6 +80,7 @@ struct Surface {
   vec2 alpha;             // GGX roughness along the frame's two tangents
   float metallic;         // metallic_roughness
   float roughness;
+  float transmission;     // metallic_roughness
   float light_pdf_area;   // the density per unit area with which light sampling picks this point (emitters.glsl)
 };
 
@@ -120,6 +121,7 @@ Surface hit_surface(Hit hit, Ray ray) {
   s.alpha = vec2(m.alpha_u, m.alpha_v);
   s.metallic = m.metallic;
   s.roughness = m.roughness;
+  s.transmission = m.transmission;
   s.light_pdf_area = light_pdf_area;
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     s.geometric_normal = (position - a.xyz) / sphere_radius(texelFetch(primitives, base + 1));
@@ -131,15 +133,19 @@ Surface hit_surface(Hit hit, Ray ray) {
   s.geometric_normal = triangle_normal(a.xyz, v1, v2);
   s.shading_normal = s.geometric_normal;
   bool smooth_normals = (flags & VKRAY_PRIM_SMOOTH) != 0u;
-  vec4 albedo_texture = vec4(0.0), emission_texture = vec4(0.0), layers_texture = vec4(0.0), normal_texture = vec4(0.0);
+  vec4 albedo_texture = vec4(0.0), emission_texture = vec4(0.0), layers_texture = vec4(0.0), normal_texture = vec4(0.0),
+       transmission_texture = vec4(0.0);
   if (SCENE_HAS_TEXTURES) {
     albedo_texture = texelFetch(materials, material + VKRAY_MATERIAL_ALBEDO_TEXTURE);
     emission_texture = texelFetch(materials, material + VKRAY_MATERIAL_EMISSION_TEXTURE);
-    if (SCENE_HAS_metallic_roughness) layers_texture = texelFetch(materials, material + VKRAY_MATERIAL_LAYERS_TEXTURE);
+    if (SCENE_HAS_metallic_roughness) {
+      layers_texture = texelFetch(materials, material + VKRAY_MATERIAL_LAYERS_TEXTURE);
+      transmission_texture = texelFetch(materials, material + VKRAY_MATERIAL_TRANSMISSION_TEXTURE);
+    }
     if (SCENE_HAS_NORMAL_MAPS) normal_texture = texelFetch(materials, material + VKRAY_MATERIAL_NORMAL_TEXTURE);
   }
   bool textured = SCENE_HAS_TEXTURES && (has_texture(albedo_texture) || has_texture(emission_texture) || has_texture(layers_texture) ||
-                                         has_texture(normal_texture));
+                                         has_texture(normal_texture) || has_texture(transmission_texture));
   if (!smooth_normals && !textured) return s;
   vec2 b = triangle_hit_barycentrics(ray, a.xyz, v1, v2);
   if (smooth_normals)
@@ -154,6 +160,8 @@ Surface hit_surface(Hit hit, Ray ray) {
       s.metallic *= layers.b;
       s.roughness *= layers.g;
     }
+    if (has_texture(transmission_texture))  // glTF's transmissionTexture: transmission in red
+      s.transmission *= sample_texture(transmission_texture, material + VKRAY_MATERIAL_TRANSMISSION_TEXTURE, uv).r;
     if (SCENE_HAS_NORMAL_MAPS && has_texture(normal_texture))
       s.shading_normal = normal_mapped(s.shading_normal, hit.prim, b, sample_texture(normal_texture, material + VKRAY_MATERIAL_NORMAL_TEXTURE, uv),
                                        texelFetch(materials, material + VKRAY_MATERIAL_LAYERS).z);

@@ -115,6 +115,35 @@ TEST_F(FurnaceTest, AGltfMetalTexturedToHalfRoughnessIsTheUntexturedOne) {
     EXPECT_NEAR(image_mean(render(scene, {16, 16, 256}, {}, cpu)).g, expected, 0.01 * expected) << (cpu ? "CPU" : "GPU");
 }
 
+TEST_F(FurnaceTest, AWhiteThinTransmittingSheetLosesOnlyWhatARoughMetalLoses) {
+  // A white glTF dielectric with transmission 1 reflects F and passes 1 - F of each microfacet's
+  // light, through a sheet with no inside: under a constant sky, seen from either side, it shows
+  // the directional albedo of GGX with F = 1 and alpha = roughness^2 (the quadrature above). At
+  // roughness 0 it is invisible.
+  for (const double roughness : {0.0, 0.7}) {
+    for (const double mu : {1.0, 0.4}) {
+      for (const double side : {1.0, -1.0}) {
+        const double alpha = std::max(roughness * roughness, 1e-4), expected = ggx_albedo(alpha, mu);
+        const double back = mu == 1.0 ? 1e-4 : std::sqrt(1 - mu * mu) / mu;
+        const std::string json = R"({
+          "camera": {"position": [0, )" + std::to_string(side) + ", " + std::to_string(-back) + R"(], "look_at": [0, 0, 0],
+                     "up": [0, 0, 1], "vertical_fov": 0.5},
+          "integrator": {"type": "path"},
+          "background": [1, 1, 1],
+          "materials": {"sheet": {"type": "metallic_roughness", "base_color": [1, 1, 1], "metallic": 0, "transmission": 1,
+                                  "roughness": )" + std::to_string(roughness) + R"(}},
+          "objects": [{"type": "triangles", "material": "sheet", "positions": [[-100, 0, -100], [100, 0, -100], [100, 0, 100], [-100, 0, 100]],
+                       "indices": [[0, 2, 1], [0, 3, 2]]}]})";
+        const Scene scene = parse_scene(json, "furnace.json");
+        for (const bool cpu : {false, true}) {
+          const double m = image_mean(render(scene, {16, 16, 256}, {}, cpu)).g;
+          EXPECT_NEAR(m, expected, 0.01 * expected) << (cpu ? "CPU" : "GPU") << ", roughness " << roughness << ", mu " << mu << ", side " << side;
+        }
+      }
+    }
+  }
+}
+
 // ---- Single-sided materials: camera rays pass their back faces, shadow rays do not -------------------------
 
 class SingleSidedTest : public GpuTest {};
@@ -288,8 +317,8 @@ class GltfDiffuseWithoutFresnel : public BrokenMetallicRoughness {
  protected:
   // The dielectric's Lambert layer not weighed by 1 - F: light reflected twice.
   GltfDiffuseWithoutFresnel()
-      : BrokenMetallicRoughness("vec3 dielectric = (1.0 - fresnel) * s.albedo / PI + vec3(fresnel * specular);",
-                                "vec3 dielectric = s.albedo / PI + vec3(fresnel * specular);") {}
+      : BrokenMetallicRoughness("vec3 dielectric = (1.0 - fresnel) * (1.0 - s.transmission) * s.albedo / PI + vec3(fresnel * specular);",
+                                "vec3 dielectric = (1.0 - s.transmission) * s.albedo / PI + vec3(fresnel * specular);") {}
 };
 TEST_F(GltfDiffuseWithoutFresnel, IsCaught) { expect_caught("direct"); }
 
@@ -355,6 +384,53 @@ class DielectricShadowRaysOnTheWrongSide : public BrokenDielectric {
       : BrokenDielectric("shade.glsl", "return p.both_sides && dot(p.n_geometric, w) < 0.0 ? p.origin_back : p.origin_front;", "return p.origin_front;") {}
 };
 TEST_F(DielectricShadowRaysOnTheWrongSide, IsCaught) {
+  expect_caught("direct");
+  expect_caught("path");
+}
+
+// ---- ... and in glTF's thin-walled transmission (checks/transmission-*.json) ------------------------------
+class BrokenTransmission : public BrokenMaterialShader {
+ protected:
+  BrokenTransmission(const std::string& file, const std::string& good, const std::string& bad)
+      : BrokenMaterialShader("transmission", file, good, bad) {}
+};
+
+class TransmissionWithTheUnmirroredHalfVector : public BrokenTransmission {
+ protected:
+  // H_T from the direction below the surface itself, not its mirror image: the lobe looks away.
+  TransmissionWithTheUnmirroredHalfVector()
+      : BrokenTransmission("bsdf.glsl", "vec3 l = vec3(wi.xy, abs(wi.z)), h = normalize(wo + l);", "vec3 l = vec3(wi.xy, abs(wi.z)), h = normalize(wo + wi);") {}
+};
+TEST_F(TransmissionWithTheUnmirroredHalfVector, IsCaught) {
+  expect_caught("direct");
+  expect_caught("path");
+}
+
+class TransmissionWithoutFresnel : public BrokenTransmission {
+ protected:
+  // The transmitted share not weighed by 1 - F: light from behind comes through as if nothing were reflected.
+  TransmissionWithoutFresnel()
+      : BrokenTransmission("bsdf.glsl", "(1.0 - s.metallic) * (1.0 - fresnel) * s.transmission", "(1.0 - s.metallic) * s.transmission") {}
+};
+TEST_F(TransmissionWithoutFresnel, IsCaught) {
+  expect_caught("direct");
+  expect_caught("path");
+}
+
+class TransmissionSampledOnTheReflectedSide : public BrokenTransmission {
+ protected:
+  // The transmission lobe's sample left above the surface: eval and pdf still say where light passes.
+  TransmissionSampledOnTheReflectedSide() : BrokenTransmission("bsdf.glsl", "if (u_lobe >= p.x) i.z = -i.z;", "") {}
+};
+TEST_F(TransmissionSampledOnTheReflectedSide, IsCaught) { expect_caught("path"); }
+
+class TransmissionTextureReadFromGreen : public BrokenTransmission {
+ protected:
+  // glTF's transmissionTexture keeps the transmission in red.
+  TransmissionTextureReadFromGreen()
+      : BrokenTransmission("primitives.glsl", "material + VKRAY_MATERIAL_TRANSMISSION_TEXTURE, uv).r;", "material + VKRAY_MATERIAL_TRANSMISSION_TEXTURE, uv).g;") {}
+};
+TEST_F(TransmissionTextureReadFromGreen, IsCaught) {
   expect_caught("direct");
   expect_caught("path");
 }

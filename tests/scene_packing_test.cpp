@@ -106,7 +106,7 @@ TEST(ScenePackingTest, EveryMaterialTypeHasItsNameAndOneKindOfLobe) {
 
 TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
   // Every value through the shared pack and unpack, as the shader unpacks what the host packed, and
-  // the properties in the texel the table's.
+  // the properties in the texel the table's, with those the values add.
   for (uint32_t t = 0; t < VKRAY_MATERIAL_TYPE_COUNT; ++t) {
     MaterialValues m;
     m.color = vec3(0.25f, 0.5f, 0.75f) + float(t);
@@ -120,6 +120,7 @@ TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
     m.metallic = 0.25f;
     m.roughness = 0.75f;
     m.normal_scale = -1.5f;
+    m.transmission = 0.625f;
     const MaterialValueTexels texels = material_value_texels(m);
     const MaterialValues back = material_values(texels);
     EXPECT_EQ(back.color, m.color);
@@ -133,8 +134,13 @@ TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
     EXPECT_EQ(back.metallic, m.metallic);
     EXPECT_EQ(back.roughness, m.roughness);
     EXPECT_EQ(back.normal_scale, m.normal_scale);
-    EXPECT_EQ(material_properties_of(texels.color), material_properties(t));
-    static_assert(sizeof(MaterialValues) == 76, "a MaterialValues member is not checked here");
+    EXPECT_EQ(back.transmission, m.transmission);
+    // The table's properties, and TRANSMISSION where a metallic_roughness transmits.
+    const uint32_t expected = material_properties(t) | (t == VKRAY_MATERIAL_METALLIC_ROUGHNESS ? VKRAY_BSDF_TRANSMISSION : 0u);
+    EXPECT_EQ(material_properties_of(texels.color), expected);
+    m.transmission = 0.0f;
+    EXPECT_EQ(material_properties_of(material_value_texels(m).color), material_properties(t));
+    static_assert(sizeof(MaterialValues) == 80, "a MaterialValues member is not checked here");
   }
 }
 

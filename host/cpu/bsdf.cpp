@@ -11,7 +11,7 @@ namespace vkray::cpu {
 using glm::dvec2;
 using glm::dvec3;
 
-Bsdf bsdf_of(const Material& material, const dvec3& color, double metallic, double roughness) {
+Bsdf bsdf_of(const Material& material, const dvec3& color, double metallic, double roughness, double transmission) {
   Bsdf b;
   b.type = material.type;
   b.properties = material.properties();
@@ -22,6 +22,7 @@ Bsdf bsdf_of(const Material& material, const dvec3& color, double metallic, doub
   b.k = dvec3(material.k);
   b.metallic = metallic;
   b.roughness = roughness;
+  b.transmission = material.type == MaterialType::metallic_roughness ? transmission : 0.0;
   return b;
 }
 
@@ -163,41 +164,52 @@ double dielectric_pdf(const Bsdf& b, const dvec3& wo, const dvec3& wi, double et
 // ---- metallic_roughness: glTF 2.0's material, as its specification's Appendix B writes it --------------
 //   f = mix(dielectric, metal, metallic)
 //   metal = specular * (base + (1 - base) (1 - |wo.h|)^5)
-//   dielectric = mix(base / pi, specular, f0 + (1 - f0) (1 - |wo.h|)^5), f0 = ((ior - 1) / (ior + 1))^2
+//   dielectric = mix(mix(base / pi, specular_btdf * base, transmission), specular, F),
+//                F = f0 + (1 - f0) (1 - |wo.h|)^5, f0 = ((ior - 1) / (ior + 1))^2
 //   specular = D(h) G1(wo) G1(wi) / (4 cos_o cos_i), GGX with alpha = roughness^2
-// Sampled by the visible normals or by cosine, picked by an estimate of each lobe's share.
+// and KHR_materials_transmission's thin-walled specular_btdf: for wi below the surface, the same
+// lobe at wi's mirror image above it (its half vector H_T = normalize(wo + wi - 2 (n.wi) n)), the
+// light passing through unbent. Sampled by the visible normals (mirrored for transmission) or by
+// cosine, the lobe picked by an estimate of each one's share.
 
 double metallic_roughness_alpha(const Bsdf& b) { return std::max(b.roughness * b.roughness, double(VKRAY_MIN_GGX_ALPHA)); }
 
 double dielectric_f0(const Bsdf& b) { return ((b.ior - 1) / (b.ior + 1)) * ((b.ior - 1) / (b.ior + 1)); }
 
-// The probability of sampling the specular lobe seen from wo: the metal's weight and the dielectric's
-// Schlick reflectance at wo, against the diffuse lobe's (1 - F) times the base colour's luminance.
-double specular_share(const Bsdf& b, const dvec3& wo) {
+// The probabilities of sampling the reflection lobe (x) and the transmission lobe (y) seen from wo;
+// the diffuse lobe has the rest. The metal's weight and the dielectric's Schlick reflectance at wo,
+// against the base's (1 - F) times the base colour's luminance, split by transmission.
+glm::dvec2 lobe_shares(const Bsdf& b, const dvec3& wo) {
   const double f0 = dielectric_f0(b), f = f0 + (1 - f0) * std::pow(1 - std::min(1.0, wo.z), 5);
   const double luminance = 0.2126 * b.color.r + 0.7152 * b.color.g + 0.0722 * b.color.b;
-  const double specular = b.metallic + (1 - b.metallic) * f, diffuse = (1 - b.metallic) * (1 - f) * luminance;
-  return specular + diffuse > 0 ? specular / (specular + diffuse) : 1.0;
+  const double specular = b.metallic + (1 - b.metallic) * f, base = (1 - b.metallic) * (1 - f) * luminance;
+  return specular + base > 0 ? glm::dvec2(specular, base * b.transmission) / (specular + base) : glm::dvec2(1.0, 0.0);
 }
 
+// A direction below the surface as its mirror image above it: where the thin-walled BTDF is evaluated.
+dvec3 above(const dvec3& w) { return {w.x, w.y, std::abs(w.z)}; }
+
 dvec3 metallic_roughness_eval(const Bsdf& b, const dvec3& wo, const dvec3& wi) {
-  if (wo.z <= 0 || wi.z <= 0) return dvec3(0.0);
+  if (wo.z <= 0 || wi.z == 0 || (wi.z < 0 && !(b.transmission > 0))) return dvec3(0.0);
   const glm::dvec2 alpha(metallic_roughness_alpha(b));
-  const dvec3 h = glm::normalize(wo + wi);
+  const dvec3 l = above(wi), h = glm::normalize(wo + l);
   const double schlick = std::pow(std::max(0.0, 1 - std::abs(glm::dot(wo, h))), 5);
-  const double specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) * smith_masking(wi, h, alpha) / (4 * wo.z * wi.z);
+  const double specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) * smith_masking(l, h, alpha) / (4 * wo.z * l.z);
   const double f0 = dielectric_f0(b), fresnel = f0 + (1 - f0) * schlick;
-  const dvec3 dielectric = (1 - fresnel) * b.color / kPi + dvec3(fresnel * specular);
+  if (wi.z < 0) return (1 - b.metallic) * (1 - fresnel) * b.transmission * specular * b.color * l.z;
+  const dvec3 dielectric = (1 - fresnel) * (1 - b.transmission) * b.color / kPi + dvec3(fresnel * specular);
   const dvec3 metal = specular * (b.color + (1.0 - b.color) * schlick);
-  return ((1 - b.metallic) * dielectric + b.metallic * metal) * wi.z;
+  return ((1 - b.metallic) * dielectric + b.metallic * metal) * l.z;
 }
 
 double metallic_roughness_pdf(const Bsdf& b, const dvec3& wo, const dvec3& wi) {
-  if (wo.z <= 0 || wi.z <= 0) return 0;
+  if (wo.z <= 0 || wi.z == 0) return 0;
   const glm::dvec2 alpha(metallic_roughness_alpha(b));
-  const dvec3 h = glm::normalize(wo + wi);
-  const double p = specular_share(b, wo);
-  return p * ggx_density(h, alpha) * smith_masking(wo, h, alpha) / (4 * wo.z) + (1 - p) * wi.z / kPi;
+  const dvec3 l = above(wi), h = glm::normalize(wo + l);
+  const glm::dvec2 p = lobe_shares(b, wo);
+  const double specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) / (4 * wo.z);
+  if (wi.z < 0) return p.y * specular;
+  return p.x * specular + (1 - p.x - p.y) * wi.z / kPi;
 }
 
 }  // namespace
@@ -329,17 +341,21 @@ BsdfSample sample_bsdf(const Bsdf& bsdf, const dvec3& wo, const dvec3& n, bool f
       b.weight = dvec3(0.0);
       if (o.z <= 0) return b;
       dvec3 i;
-      if (u_lobe < specular_share(bsdf, o)) {
+      const glm::dvec2 p = lobe_shares(bsdf, o);
+      if (u_lobe < p.x + p.y) {  // a visible normal's reflection, mirrored through the surface to transmit
         const dvec3 m = sample_visible_normal(o, glm::dvec2(metallic_roughness_alpha(bsdf)), u1, u2);
         i = 2 * glm::dot(o, m) * m - o;
+        if (i.z <= 0) return b;
+        if (u_lobe >= p.x) i.z = -i.z;
       } else {
         i = cosine_hemisphere(u1, u2);
+        if (i.z <= 0) return b;
       }
-      if (i.z <= 0) return b;
-      // Either lobe may have given the direction: the weight is the whole BSDF over the mixed density.
+      // Any lobe may have given the direction: the weight is the whole BSDF over the mixed density.
       b.pdf = metallic_roughness_pdf(bsdf, o, i);
       if (!(b.pdf > 0)) return b;
       b.dir = glm::normalize(from_tangent_space(i, n));
+      b.transmitted = i.z < 0;  // through a thin sheet: unbent, b.eta stays 1
       b.weight = metallic_roughness_eval(bsdf, o, i) / b.pdf;
       return b;
     }

@@ -23,17 +23,18 @@ struct Bsdf {
   double ior = 1.5;
   glm::dvec2 alpha{0.1};
   glm::dvec3 eta{0.0}, k{1.0};
-  double metallic = 1, roughness = 1;
+  double metallic = 1, roughness = 1, transmission = 0;
 
   bool has(uint32_t property) const { return (properties & property) != 0; }
 };
 
 // The BSDF of `material` where its colour, textures applied, is `color`, and (metallic_roughness)
-// its metallic and roughness are `metallic` and `roughness`, its texture applied.
-Bsdf bsdf_of(const Material& material, const glm::dvec3& color, double metallic, double roughness);
+// its metallic, roughness and transmission are `metallic`, `roughness` and `transmission`, their
+// textures applied.
+Bsdf bsdf_of(const Material& material, const glm::dvec3& color, double metallic, double roughness, double transmission);
 // ... where nothing is textured.
 inline Bsdf bsdf_of(const Material& material, const glm::dvec3& color) {
-  return bsdf_of(material, color, material.metallic, material.roughness);
+  return bsdf_of(material, color, material.metallic, material.roughness, material.transmission);
 }
 
 struct BsdfSample {

@@ -52,7 +52,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     const auto [n_geometric, n] = facing(s, ray.dir, front);
     const dvec3 x = s.position;
     const dvec3 origin = x + epsilon * n_geometric;
-    const Bsdf bsdf = bsdf_of(material, s.albedo, s.metallic, s.roughness);
+    const Bsdf bsdf = bsdf_of(material, s.albedo, s.metallic, s.roughness, s.transmission);
     const dvec3 wo = -ray.dir;
     if (!bsdf.has(VKRAY_BSDF_DELTA)) {
       // Next-event estimation: each term f cos times the light over its density, weighed against BSDF sampling.

@@ -203,6 +203,7 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
     s.emission = dvec3(m.emission);
     s.metallic = m.metallic;
     s.roughness = m.roughness;
+    s.transmission = m.transmission;
     if (m.textured()) {
       const glm::dvec2 uv = (1 - hit.u - hit.v) * glm::dvec2(tri.uv[0]) + hit.u * glm::dvec2(tri.uv[1]) + hit.v * glm::dvec2(tri.uv[2]);
       if (m.albedo_texture.present()) s.albedo *= sample_texture(scene_, m.albedo_texture, uv);
@@ -212,6 +213,7 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
         s.metallic *= layers.b;
         s.roughness *= layers.g;
       }
+      if (m.transmission_texture.present()) s.transmission *= sample_texture(scene_, m.transmission_texture, uv).r;
       // A normal map in MikkTSpace's frame: the tangent interpolated and not normalized, the
       // bitangent its sign times normal x tangent, the map's red and green scaled (glTF's formula).
       if (m.normal_texture.present() && tri.has_tangents()) {
@@ -240,6 +242,7 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
     s.emission = dvec3(m.emission);
     s.metallic = m.metallic;
     s.roughness = m.roughness;
+    s.transmission = m.transmission;
   }
   return s;
 }

@@ -38,6 +38,7 @@ struct SurfacePoint {
   dvec3 emission{0.0};  // the material's emission, its texture applied
   double metallic = 1;   // metallic_roughness: the material's metallic and roughness, its texture applied
   double roughness = 1;
+  double transmission = 0;  // metallic_roughness: the material's transmission, its texture applied
   uint32_t properties = 0;  // the material's (VKRAY_BSDF_*)
 };
 

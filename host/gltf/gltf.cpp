@@ -29,7 +29,9 @@ using glm::dvec3;
 
 // Extensions whose content vkray reads; a file that requires any other is refused.
 const std::set<std::string> kReadExtensions = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior",
-                                               "KHR_texture_transform"};
+                                               "KHR_materials_transmission", "KHR_texture_transform"};
+// Extensions that carry metadata only (XMP packets: authors, licences), with nothing to render.
+const std::set<std::string> kMetadataExtensions = {"KHR_xmp", "KHR_xmp_json_ld"};
 
 std::string element(const char* array, size_t index) { return std::string(array) + "[" + std::to_string(index) + "]"; }
 
@@ -244,7 +246,7 @@ void GltfReader::check_required_extensions(const nlohmann::json& doc) const {
 
 void GltfReader::warn_used_extensions() {
   for (const std::string& name : model_.extensionsUsed)
-    if (!kReadExtensions.count(name))
+    if (!kReadExtensions.count(name) && !kMetadataExtensions.count(name))
       warn_once("extension " + name, "extensionsUsed", printable(name) + " is not read; what it adds is not rendered");
 }
 
@@ -606,6 +608,27 @@ uint32_t GltfReader::material(int index, const std::string& where) {
       if (others && texcoord_of(info) != set)
         warn_once("texcoord sets", name, "the normalTexture's texCoord differs from the other textures': all use TEXCOORD_" + std::to_string(set));
       if (!others) set = texcoord_of(info);
+    }
+    if (const auto ext = g.extensions.find("KHR_materials_transmission"); ext != g.extensions.end()) {
+      // Thin-walled, as the extension is without KHR_materials_volume (which vkray does not read): the
+      // factor times the red of a linear texture. (gltf_schema.cpp has checked the types.)
+      const std::string at = "extensions.KHR_materials_transmission";
+      const tinygltf::Value& f = ext->second.Get("transmissionFactor");
+      m.transmission = factor(f.IsNumber() ? f.GetNumberAsDouble() : 0.0, at + ".transmissionFactor");
+      const tinygltf::Value& t = ext->second.Get("transmissionTexture");
+      if (t.IsObject() && m.transmission > 0.0f) {
+        tinygltf::TextureInfo info;
+        info.index = t.Get("index").GetNumberAsInt();
+        if (t.Has("texCoord")) info.texCoord = t.Get("texCoord").GetNumberAsInt();
+        if (t.Has("extensions"))
+          for (const std::string& key : t.Get("extensions").Keys()) info.extensions[key] = t.Get("extensions").Get(key);
+        m.transmission_texture = texture(info, name + "." + at + ".transmissionTexture", false);
+        const bool others = m.albedo_texture.present() || m.emission_texture.present() || m.metallic_roughness_texture.present() ||
+                            m.normal_texture.present();
+        if (others && texcoord_of(info) != set)
+          warn_once("texcoord sets", name, "the transmissionTexture's texCoord differs from the other textures': all use TEXCOORD_" + std::to_string(set));
+        if (!others) set = texcoord_of(info);
+      }
     }
     if (set < 0 || set > 7) fail(name, "texCoord " + std::to_string(set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
     texcoord_sets_[index] = set;

@@ -324,6 +324,12 @@ void SchemaCheck::material(const json& m, const std::string& at) const {
     number_key(e, e_at, "ior");
     if (const json* v = find(e, e_at, "ior")) expect(std::abs(v->get<double>()) <= 1e6, *v, path(e_at, "ior"), "an index of refraction");
   }
+  if (m.contains("extensions") && m["extensions"].contains("KHR_materials_transmission")) {
+    const json& e = m["extensions"]["KHR_materials_transmission"];
+    const std::string e_at = path(at, "extensions.KHR_materials_transmission");
+    number_key(e, e_at, "transmissionFactor");
+    texture_info(e, e_at, "transmissionTexture");
+  }
 }
 
 void SchemaCheck::mesh(const json& m, const std::string& at) const {

@@ -226,9 +226,9 @@ void SceneParser::parse_materials(const Value& v) {
         if (m.has("int_ior")) material.ior = index_of_refraction(m["int_ior"]);
         break;
       case MaterialType::metallic_roughness:  // glTF 2.0's, with its names and defaults
-        check_keys(m, {"type", "base_color", "metallic", "roughness", "ior", "emission", "base_color_texture",
-                       "metallic_roughness_texture", "normal_texture", "normal_scale", "alpha_mode", "opacity",
-                       "opacity_texture", "alpha_cutoff"});
+        check_keys(m, {"type", "base_color", "metallic", "roughness", "ior", "transmission", "emission", "base_color_texture",
+                       "metallic_roughness_texture", "transmission_texture", "normal_texture", "normal_scale", "alpha_mode",
+                       "opacity", "opacity_texture", "alpha_cutoff"});
         material.albedo = m.has("base_color") ? reflectance(m["base_color"]) : glm::vec3(1.0f);
         // Pictures beside the scene file, read where a mesh gives texture coordinates: the base colour
         // as sRGB; metallic (blue) and roughness (green) as linear data, as glTF's textures are.
@@ -237,6 +237,15 @@ void SceneParser::parse_materials(const Value& v) {
           material.metallic_roughness_texture.texture = texture_file(m["metallic_roughness_texture"], file_of(m["metallic_roughness_texture"]), TextureUse::data);
         if (m.has("metallic")) material.metallic = unit_interval(m["metallic"]);
         if (m.has("roughness")) material.roughness = unit_interval(m["roughness"]);
+        // KHR_materials_transmission (thin-walled): the factor (glTF's default 0), times the red of a
+        // linear texture.
+        if (m.has("transmission")) material.transmission = unit_interval(m["transmission"]);
+        if (m.has("transmission_texture")) {
+          if (!(material.transmission > 0.0f))
+            fail(m["transmission_texture"], "a transmission_texture multiplies \"transmission\", which is 0: give it too");
+          material.transmission_texture.texture =
+              texture_file(m["transmission_texture"], file_of(m["transmission_texture"]), TextureUse::data);
+        }
         if (m.has("ior")) {
           material.ior = index_of_refraction(m["ior"]);
           if (material.ior < 1.0f) fail(m["ior"], "expected an index of refraction from 1 to 100 (KHR_materials_ior), got " + brief(m["ior"].j));

@@ -314,7 +314,7 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     glm::vec4* texels = &packed.materials[i * VKRAY_TEXELS_PER_MATERIAL];
     const MaterialValueTexels values = material_value_texels(
         {m.albedo, uint32_t(m.type), scale_radiance(m.emission, exponent), m.ior, m.eta, m.alpha.x, m.k, m.alpha.y, m.metallic,
-         m.roughness, m.normal_scale});
+         m.roughness, m.normal_scale, m.type == MaterialType::metallic_roughness ? m.transmission : 0.0f});
     texels[VKRAY_MATERIAL_COLOR] = values.color;
     texels[VKRAY_MATERIAL_EMISSION] = values.emission;
     texels[VKRAY_MATERIAL_ETA] = values.eta;
@@ -327,6 +327,7 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     texels[VKRAY_MATERIAL_OPACITY] =
         opacity_texel(m.opacity, m.alpha_cutoff, uint32_t(m.see_through() ? m.alpha_mode : AlphaMode::opaque));
     texture_slot(texels + VKRAY_MATERIAL_OPACITY_TEXTURE, m.opacity_texture);
+    texture_slot(texels + VKRAY_MATERIAL_TRANSMISSION_TEXTURE, m.transmission_texture);
     // In double on the host, then one rounding: no 1 / total power in float that could overflow.
     texels[VKRAY_MATERIAL_LIGHT] = glm::vec4(float(table.density[i]), 0.0f, 0.0f, 0.0f);
   }

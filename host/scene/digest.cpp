@@ -15,7 +15,7 @@ static_assert(sizeof(PointLight) == 24, "a PointLight field is not in scene_dige
 static_assert(sizeof(Sphere) == 28, "a Sphere field is not in scene_digest");
 static_assert(sizeof(Triangle) == 156, "a Triangle field is not in scene_digest");
 static_assert(sizeof(TextureRef) == 40, "a TextureRef field is not in scene_digest");
-static_assert(sizeof(Material) == 328, "a Material field is not in scene_digest");
+static_assert(sizeof(Material) == 368, "a Material field is not in scene_digest");
 static_assert(sizeof(Scene) == 376, "a Scene field is not in scene_digest");
 
 // Hasher with glm's vectors, component by component.
@@ -42,7 +42,7 @@ void add(SceneHasher& h, const TextureRef& t) {
 std::string scene_digest(const Scene& scene) {
   auto h = std::make_unique<SceneHasher>();  // its buffer is too large for a thread's stack to hold lightly
   // A version of this layout: bump it when the order or the meaning of what is hashed changes.
-  h->add(std::string("vkray scene digest 7"));
+  h->add(std::string("vkray scene digest 8"));
   const Camera& c = scene.camera;
   h->add(c.position), h->add(c.forward), h->add(c.up), h->add(c.focal_length), h->add(c.aperture_radius),
       h->add(c.focus_distance);
@@ -51,7 +51,7 @@ std::string scene_digest(const Scene& scene) {
   h->add(uint64_t(scene.materials.size()));
   for (const Material& m : scene.materials) {
     h->add(m.type), h->add(m.albedo), h->add(m.ior), h->add(m.emission), h->add(m.alpha), h->add(m.eta), h->add(m.k), h->add(m.metallic),
-        h->add(m.roughness);
+        h->add(m.roughness), h->add(m.transmission);
     add(*h, m.albedo_texture);
     add(*h, m.emission_texture);
     add(*h, m.metallic_roughness_texture);
@@ -60,6 +60,7 @@ std::string scene_digest(const Scene& scene) {
     h->add(m.double_sided);
     h->add(m.alpha_mode), h->add(m.opacity), h->add(m.alpha_cutoff);
     add(*h, m.opacity_texture);
+    add(*h, m.transmission_texture);
   }
   h->add(uint64_t(scene.textures.size()));
   for (const auto& t : scene.textures) {

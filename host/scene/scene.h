@@ -99,6 +99,11 @@ struct Material {
   // GGX alpha is roughness squared); glTF's defaults.
   float metallic = 1.0f;
   float roughness = 1.0f;
+  // metallic_roughness: how much of the light its dielectric does not reflect passes through it
+  // rather than into its Lambertian base (glTF's KHR_materials_transmission, thin-walled: a sheet
+  // with no inside, its transmission the specular lobe mirrored through the surface), times the red of
+  // `transmission_texture` (linear).
+  float transmission = 0.0f;
   // Textures that multiply albedo (or reflectance) and emission where a triangle has texture
   // coordinates (glTF's baseColorTexture and emissiveTexture, an .mtl file's map_Kd), and
   // metallic_roughness's metallic (by its blue) and roughness (by its green), a linear texture
@@ -124,14 +129,15 @@ struct Material {
   float opacity = 1.0f;
   float alpha_cutoff = 0.5f;
   TextureRef opacity_texture;
+  TextureRef transmission_texture;
 
   bool emissive() const { return emission != glm::vec3(0.0f); }
   // Every texture reference, for code that treats them alike.
-  std::array<TextureRef*, 5> textures() {
-    return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture, &opacity_texture};
+  std::array<TextureRef*, 6> textures() {
+    return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture, &opacity_texture, &transmission_texture};
   }
-  std::array<const TextureRef*, 5> textures() const {
-    return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture, &opacity_texture};
+  std::array<const TextureRef*, 6> textures() const {
+    return {&albedo_texture, &emission_texture, &metallic_roughness_texture, &normal_texture, &opacity_texture, &transmission_texture};
   }
   bool textured() const {
     const auto refs = textures();
@@ -144,7 +150,7 @@ struct Material {
     return opacity_texture.present() || !(opacity >= (alpha_mode == AlphaMode::mask ? alpha_cutoff : 1.0f));
   }
   // Its properties (VKRAY_BSDF_* in shaders/shared/materials.h): code outside the BSDFs asks these.
-  uint32_t properties() const { return gpu::material_properties(uint32_t(type)); }
+  uint32_t properties() const { return gpu::material_value_properties(uint32_t(type), transmission); }
   bool has(uint32_t property) const { return (properties() & property) != 0; }
 };
 

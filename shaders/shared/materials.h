@@ -15,7 +15,8 @@ VKRAY_SHARED_BEGIN
 // DIFFUSE       a Lambertian lobe
 // GLOSSY        a lobe that is neither Lambertian nor a delta: light sampling asks its eval and pdf
 // DELTA         delta lobes only: no light sampling there, and a light met after it counts whole
-// TRANSMISSION  light passes to the other side; inside and outside are told by the geometric normal
+// TRANSMISSION  light passes to the other side, so the surface is lit from both; a dielectric tells
+//               inside from outside by the geometric normal, a thin one (metallic_roughness) has none
 // CLEAR         its albedo pass is 1, not its colour (clear glass)
 #define VKRAY_BSDF_DIFFUSE 1u
 #define VKRAY_BSDF_GLOSSY 2u
@@ -24,7 +25,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BSDF_CLEAR 16u
 
 // ---- The types: X(number, name in scene files, properties) ---------------------------------------------
-// The host's MaterialType (scene/scene.h) and the scene parser's names are made from this table.
+// The host's MaterialType (scene/scene.h) and the scene parser's names are made from this table. A
+// material's properties are its type's, with those its values add (material_value_properties).
 #define VKRAY_MATERIAL_DIFFUSE 0u
 #define VKRAY_MATERIAL_MIRROR 1u
 #define VKRAY_MATERIAL_GLASS 2u
@@ -46,6 +48,16 @@ VKRAY_INLINE uint material_properties(uint type) {
   VKRAY_MATERIAL_TYPES(VKRAY_MATERIAL_PROPERTIES_OF)
 #undef VKRAY_MATERIAL_PROPERTIES_OF
   return 0u;
+}
+
+// The properties of a material of type `type` whose transmission (metallic_roughness: glTF's
+// KHR_materials_transmission factor; 0 for every other type) is `transmission`: its type's, and
+// TRANSMISSION where a metallic_roughness transmits. As pbrt's BxDF flags, they follow the values
+// where the type alone cannot tell.
+VKRAY_INLINE uint material_value_properties(uint type, float transmission) {
+  uint properties = material_properties(type);
+  if (type == VKRAY_MATERIAL_METALLIC_ROUGHNESS && transmission > 0.0f) properties |= VKRAY_BSDF_TRANSMISSION;
+  return properties;
 }
 
 // The smoothest GGX surface either renderer evaluates: at alpha 1e-4 the distribution's peak,
@@ -94,6 +106,8 @@ struct MaterialValues {
   float metallic;  // metallic_roughness: glTF's metallicFactor
   float roughness; // metallic_roughness: glTF's roughnessFactor (its GGX alpha is its square)
   float normal_scale; // glTF's normalTexture.scale: multiplies the normal map's tangent and bitangent parts
+  float transmission; // metallic_roughness: glTF's transmissionFactor (thin-walled: KHR_materials_transmission
+                      // without KHR_materials_volume); 0 for every other type
 };
 
 // ---- Texels: VKRAY_TEXELS_PER_MATERIAL RGBA32F each ---------------------------------------------------
@@ -101,13 +115,13 @@ struct MaterialValues {
 //   VKRAY_MATERIAL_EMISSION:          (emitted radiance, ior)
 //   VKRAY_MATERIAL_ETA:               (eta, alpha_u)          read only by GLOSSY materials
 //   VKRAY_MATERIAL_K:                 (k, alpha_v)            read only by GLOSSY materials
-//   VKRAY_MATERIAL_LAYERS:            (metallic, roughness, normal_scale, 0)  read by GLOSSY materials
-//                                     and normal-mapped ones
+//   VKRAY_MATERIAL_LAYERS:            (metallic, roughness, normal_scale, transmission)  read by GLOSSY
+//                                     materials and normal-mapped ones
 //   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
 //                                     an emitter of this material, 0, 0, 0): scene/emitters.h
 //   VKRAY_MATERIAL_OPACITY:           (opacity factor, alpha cutoff, alpha mode as uint bits, 0): read
 //                                     only for primitives with VKRAY_PRIM_ALPHA (opacity_texel)
-// and three texture slots of VKRAY_TEXELS_PER_TEXTURE_SLOT texels each: the texture's header
+// and six texture slots of VKRAY_TEXELS_PER_TEXTURE_SLOT texels each: the texture's header
 // (texture_texel in shared/scene_layout.h), then the two rows of the affine map from a primitive's
 // texture coordinate to the texture's (glTF's KHR_texture_transform), read only where the header says
 // the texture is transformed:
@@ -117,7 +131,9 @@ struct MaterialValues {
 //                                     whose green multiplies roughness (glTF's metallicRoughnessTexture)
 //   VKRAY_MATERIAL_NORMAL_TEXTURE:    the tangent-space normal map (glTF's normalTexture)
 //   VKRAY_MATERIAL_OPACITY_TEXTURE:   the texture whose alpha multiplies the opacity
-#define VKRAY_TEXELS_PER_MATERIAL 22
+//   VKRAY_MATERIAL_TRANSMISSION_TEXTURE: metallic_roughness: the texture whose red multiplies the
+//                                     transmission (glTF's transmissionTexture)
+#define VKRAY_TEXELS_PER_MATERIAL 25
 #define VKRAY_TEXELS_PER_TEXTURE_SLOT 3
 #define VKRAY_MATERIAL_COLOR 0
 #define VKRAY_MATERIAL_EMISSION 1
@@ -131,12 +147,14 @@ struct MaterialValues {
 #define VKRAY_MATERIAL_NORMAL_TEXTURE 15
 #define VKRAY_MATERIAL_OPACITY 18
 #define VKRAY_MATERIAL_OPACITY_TEXTURE 19
+#define VKRAY_MATERIAL_TRANSMISSION_TEXTURE 22
 #define VKRAY_MATERIAL_PROPERTY_SHIFT 8u
 
 // The first texel of material `index`.
 VKRAY_INLINE int material_texel(uint index) { return int(index) * VKRAY_TEXELS_PER_MATERIAL; }
 
-// The value texels (COLOR to LAYERS) of a material; its properties come from the table, never from the caller.
+// The value texels (COLOR to LAYERS) of a material; its properties come from its type and values
+// (material_value_properties), never from the caller.
 struct MaterialValueTexels {
   vec4 color;
   vec4 emission;
@@ -147,11 +165,11 @@ struct MaterialValueTexels {
 
 VKRAY_INLINE MaterialValueTexels material_value_texels(MaterialValues m) {
   MaterialValueTexels t;
-  t.color = vec4(m.color, uintBitsToFloat(m.type | (material_properties(m.type) << VKRAY_MATERIAL_PROPERTY_SHIFT)));
+  t.color = vec4(m.color, uintBitsToFloat(m.type | (material_value_properties(m.type, m.transmission) << VKRAY_MATERIAL_PROPERTY_SHIFT)));
   t.emission = vec4(m.emission, m.ior);
   t.eta = vec4(m.eta, m.alpha_u);
   t.k = vec4(m.k, m.alpha_v);
-  t.layers = vec4(m.metallic, m.roughness, m.normal_scale, 0.0f);
+  t.layers = vec4(m.metallic, m.roughness, m.normal_scale, m.transmission);
   return t;
 }
 
@@ -171,6 +189,7 @@ VKRAY_INLINE MaterialValues material_values(MaterialValueTexels t) {
   m.metallic = t.layers.x;
   m.roughness = t.layers.y;
   m.normal_scale = t.layers.z;
+  m.transmission = t.layers.w;
   return m;
 }
 
