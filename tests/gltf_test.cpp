@@ -272,6 +272,37 @@ TEST(GltfTest, MaterialsAreGltfsMetallicRoughnessModelWithTheirFactorsAndIor) {
   }
 }
 
+TEST(GltfTest, TransmissionIsThinWalledWithItsFactorAndTheRedOfItsTexture) {
+  // KHR_materials_transmission: the factor (default 0) times the texture's red, linear data even where
+  // the same picture is the base colour (sRGB); the metadata extension KHR_xmp_json_ld warns of nothing.
+  GltfBuilder b;
+  const int picture = b.texture(test::png_bytes({1, 1, {128, 64, 32}}));
+  const int sheet = b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", picture}}}, {"metallicFactor", 0}}},
+                                {"extensions", {{"KHR_materials_transmission",
+                                                 {{"transmissionFactor", 0.75}, {"transmissionTexture", {{"index", picture}}}}}}}});
+  const int bare = b.material({{"extensions", {{"KHR_materials_transmission", nlohmann::json::object()}}}});
+  b.quad(sheet);
+  b.quad(bare);
+  b.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_xmp_json_ld"};
+  b.doc["extensionsRequired"] = {"KHR_materials_transmission"};
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.materials.size(), 2u);
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.transmission, 0.75f);
+  EXPECT_TRUE(m.has(VKRAY_BSDF_TRANSMISSION));
+  ASSERT_TRUE(m.transmission_texture.present());
+  ASSERT_NE(m.transmission_texture.texture, m.albedo_texture.texture);
+  EXPECT_NEAR(s.textures[size_t(m.transmission_texture.texture)]->texel(0, 0).r, 128.0f / 255.0f, 1e-3f);
+  EXPECT_EQ(s.materials[1].transmission, 0.0f);  // the extension's default
+  EXPECT_FALSE(s.materials[1].has(VKRAY_BSDF_TRANSMISSION));
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  {
+    GltfBuilder bad = textured_quad();
+    bad.doc["materials"][0]["extensions"]["KHR_materials_transmission"]["transmissionFactor"] = -0.5;
+    expect_error(bad, "materials[0].extensions.KHR_materials_transmission.transmissionFactor: expected a number from 0 to 1");
+  }
+}
+
 TEST(GltfTest, AMetallicRoughnessTextureIsLinearDataWhereTheSamePictureAsBaseColourIsSrgb) {
   // One grey picture, 128 of 255, used as both textures: as base colour it decodes from sRGB (0.216),
   // as metallic-roughness it is data (128 / 255), and the two are decoded once each.
@@ -713,6 +744,17 @@ TEST(ShippedGltfTest, KhronosModelsLoadAsDescribed) {
   for (const Material& m : settings.materials)
     if (m.albedo_texture.present()) wraps.insert({m.albedo_texture.wrap_s, m.albedo_texture.wrap_t});
   EXPECT_GE(wraps.size(), 4u);  // clamp, repeat and mirror, per axis
+  // Transmission Test: twelve spheres, each with KHR_materials_transmission at factor 1, half of them
+  // with the transmission texture; nothing warned of (its KHR_xmp is metadata).
+  const GltfScene transmission = load_gltf(dir / "TransmissionTest/glTF-Binary/TransmissionTest.glb");
+  int transmitting = 0, textured = 0;
+  for (const Material& m : transmission.materials) {
+    transmitting += m.transmission == 1.0f;
+    textured += m.transmission_texture.present();
+  }
+  EXPECT_EQ(transmitting, 12);
+  EXPECT_EQ(textured, 6);
+  EXPECT_TRUE(transmission.warnings.empty()) << transmission.warnings[0];
   const GltfScene cameras = load_gltf(dir / "Cameras/glTF/Cameras.gltf");
   ASSERT_TRUE(cameras.camera);  // the perspective one
   EXPECT_NEAR(cameras.camera->focal_length, 0.5f / std::tan(0.35f), 1e-5f);  // yfov 0.7

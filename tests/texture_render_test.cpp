@@ -211,7 +211,8 @@ INSTANTIATE_TEST_SUITE_P(Khronos, ShippedModelTest,
                                            "MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb",
                                            "NormalTangentTest/glTF/NormalTangentTest.gltf",
                                            "NormalTangentMirrorTest/glTF/NormalTangentMirrorTest.gltf", "TwoSidedPlane/glTF/TwoSidedPlane.gltf",
-                                           "AlphaBlendModeTest/glTF/AlphaBlendModeTest.gltf"),
+                                           "AlphaBlendModeTest/glTF/AlphaBlendModeTest.gltf",
+                                           "TransmissionTest/glTF-Binary/TransmissionTest.glb"),
                          [](const auto& p) {
                            std::string name = std::filesystem::path(p.param).parent_path().string();
                            for (char& c : name)
