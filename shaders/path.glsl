@@ -46,7 +46,7 @@ PathState start_path(Ray camera_ray) { return PathState(camera_ray, vec3(0.0), v
 // One vertex at a time, so that trace.comp can start a pixel's next sample as soon as its path ends
 // instead of waiting, masked, for the longest path among the lanes it runs with.
 bool path_step(inout PathState p, inout uint stream, inout uint rays) {
-  bool background_sampled = frame.background.r > 0.0 || frame.background.g > 0.0 || frame.background.b > 0.0;
+  bool background_sampled = SCENE_HAS_BACKGROUND && (frame.background.r > 0.0 || frame.background.g > 0.0 || frame.background.b > 0.0);
   Hit hit = trace_closest(p.ray, frame.epsilon, FAR, p.depth == 0u, stream);
   if (hit.prim == NO_HIT) {
     float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, BACKGROUND_PDF);

@@ -128,7 +128,7 @@ void add_point_lights(LitPoint p, Surface s, vec3 wo, bool front, inout vec3 rad
   // a masked pass more, and so does one with a `continue` (the compiler moves the test to the top
   // of the next pass, for every lane).
   uint i = 0u;
-  if (frame.light_count > 0u) do {
+  if (SCENE_HAS_POINT_LIGHTS && frame.light_count > 0u) do {
     int base = int(i) * VKRAY_TEXELS_PER_LIGHT;
     vec3 light_pos = texelFetch(lights, base + VKRAY_LIGHT_POSITION).xyz;
     vec3 to_light = light_pos - p.x;

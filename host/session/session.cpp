@@ -171,6 +171,8 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   variant.normal_maps = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.normal_texture.present(); });
   variant.alpha = s.see_through();
   variant.shading_normals = scene.vertex_normals() || variant.normal_maps;
+  variant.point_lights = !s.lights.empty();
+  variant.background = s.background != glm::vec3(0.0f);
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))
     variant.inline_scene = scene.inline_scene();
   return variant;

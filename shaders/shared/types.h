@@ -56,6 +56,13 @@ VKRAY_SHARED_BEGIN
 // false when every shading normal is the geometric one (no vertex normals, no normal maps): no code to
 // bend a shading normal that faces away from the viewer (shade.glsl), which the geometric one never does.
 #define VKRAY_SPEC_SHADING_NORMALS 10
+// false when the scene has no point lights, and when its background is black: no code for lighting by
+// them (a point light's shadow ray; the path integrator's background sample and its shadow ray).
+// llvmpipe runs a block under a condition that no lane meets all the same, masked, and such a block
+// holding a traversal loop costs a traversal step: on scenes/rough-spheres.json, lit by an area
+// light alone under a black sky, the two blocks took a fifth of the trace time.
+#define VKRAY_SPEC_POINT_LIGHTS 11
+#define VKRAY_SPEC_BACKGROUND 12
 // And one per material type, id VKRAY_SPEC_MATERIALS + its number (shared/materials.h): whether the
 // scene has a material of that type (gpu::ShaderVariant::materials, a bit each); the BSDF code of
 // the others is left out. Declared as SCENE_HAS_<name> (SCENE_HAS_roughconductor).
@@ -71,7 +78,9 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_SINGLE_SIDED, SCENE_HAS_SINGLE_SIDED, single_sided, false) \
   X(VKRAY_SPEC_NORMAL_MAPS, SCENE_HAS_NORMAL_MAPS, normal_maps, false) \
   X(VKRAY_SPEC_ALPHA, SCENE_HAS_ALPHA, alpha, false) \
-  X(VKRAY_SPEC_SHADING_NORMALS, SCENE_HAS_SHADING_NORMALS, shading_normals, true)
+  X(VKRAY_SPEC_SHADING_NORMALS, SCENE_HAS_SHADING_NORMALS, shading_normals, true) \
+  X(VKRAY_SPEC_POINT_LIGHTS, SCENE_HAS_POINT_LIGHTS, point_lights, true) \
+  X(VKRAY_SPEC_BACKGROUND, SCENE_HAS_BACKGROUND, background, true)
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
