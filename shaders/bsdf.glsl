@@ -199,7 +199,7 @@ float metallic_roughness_pdf(Surface s, vec3 wo, vec3 wi) {
   vec2 p = lobe_shares(s, wo);
   float specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) / (4.0 * wo.z);
   if (wi.z < 0.0) return p.y * specular;
-  return p.x * specular + (1.0 - p.x - p.y) * wi.z / PI;
+  return p.x * specular + max(0.0, 1.0 - p.x - p.y) * wi.z / PI;  // (with transmission 1, 0 up to rounding)
 }
 
 // Whether the surface is no interface at all (a rough dielectric of index 1, which sample_bsdf passes

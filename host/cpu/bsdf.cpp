@@ -209,7 +209,7 @@ double metallic_roughness_pdf(const Bsdf& b, const dvec3& wo, const dvec3& wi) {
   const glm::dvec2 p = lobe_shares(b, wo);
   const double specular = ggx_density(h, alpha) * smith_masking(wo, h, alpha) / (4 * wo.z);
   if (wi.z < 0) return p.y * specular;
-  return p.x * specular + (1 - p.x - p.y) * wi.z / kPi;
+  return p.x * specular + std::max(0.0, 1 - p.x - p.y) * wi.z / kPi;  // (with transmission 1, 0 up to rounding)
 }
 
 }  // namespace
