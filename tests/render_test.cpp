@@ -141,6 +141,24 @@ TEST_F(RenderTest, OnePipelineServesScenesWithAndWithoutSpheres) {
   EXPECT_EQ(before.pixels, after.pixels);
 }
 
+TEST_F(RenderTest, OnePipelineServesPathsWithAndWithoutPointLightsAndASky) {
+  // Point lights, and a sky that paths sample as a light, are pipeline variants too: compiled for a
+  // scene with neither, the pipeline must not serve one with both (the sphere would be lit by
+  // neither).
+  Scene lit = one_sphere_scene();
+  lit.integrator.type = Integrator::Type::path;
+  lit.ambient = glm::vec3(0.0f);
+  Scene dark = lit;
+  dark.lights.clear();
+  dark.background = glm::vec3(0.0f);
+  const Image before = render(dark, {32, 32, 4});
+  const glm::dvec3 gpu = image_mean(render(lit, {32, 32, 4})), cpu = image_mean(render(lit, {32, 32, 4}, {}, /*cpu=*/true));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(gpu[c], cpu[c], 0.01 * cpu[c]) << "channel " << c;
+  EXPECT_GT(cpu.r, 0.2);  // the sky and the light both reach it
+  const Image after = render(dark, {32, 32, 4});
+  EXPECT_EQ(before.pixels, after.pixels);
+}
+
 TEST_F(RenderTest, TilesCoverTheImageExactly) {
   const Scene scene = load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json");
   const Image whole = render(scene, {100, 76, 2});

@@ -56,8 +56,9 @@ VKRAY_SHARED_BEGIN
 // false when every shading normal is the geometric one (no vertex normals, no normal maps): no code to
 // bend a shading normal that faces away from the viewer (shade.glsl), which the geometric one never does.
 #define VKRAY_SPEC_SHADING_NORMALS 10
-// false when the scene has no point lights, and when its background is black: no code for lighting by
-// them (a point light's shadow ray; the path integrator's background sample and its shadow ray).
+// false when the scene has no point lights, and when its background is black or it is not path traced:
+// no code for lighting by them (a point light's shadow ray; the path integrator's background sample
+// and its shadow ray).
 // llvmpipe runs a block under a condition that no lane meets all the same, masked, and such a block
 // holding a traversal loop costs a traversal step: on scenes/rough-spheres.json, lit by an area
 // light alone under a black sky, the two blocks took a fifth of the trace time.
