@@ -91,6 +91,7 @@ def test_metallic_roughness_is_appendix_b(material, shape, renderer):
     base, metallic, roughness = material["base_color"], material["metallic"], material["roughness"]
     transmission = material.get("transmission", 0.0)
     expected = np.zeros_like(p)
+    through = np.zeros_like(p)  # the part that comes through the surface from behind
     judged = hit.copy()
     for light in lights:
         to_light = light - p
@@ -99,8 +100,10 @@ def test_metallic_roughness_is_appendix_b(material, shape, renderer):
         n_l = np.sum(n * l, axis=-1)
         reaches = n_l > 0 if transmission == 0 or shape is SPHERE else n_l != 0
         with np.errstate(invalid="ignore", divide="ignore"):
-            expected += np.where(reaches[..., None], appendix_b(base, metallic, roughness, material.get("ior", 1.5), n, v, l, transmission)
-                                 * np.abs(n_l)[..., None] * INTENSITY / d2, 0.0)
+            light_part = np.where(reaches[..., None], appendix_b(base, metallic, roughness, material.get("ior", 1.5), n, v, l, transmission)
+                                  * np.abs(n_l)[..., None] * INTENSITY / d2, 0.0)
+        expected += light_part
+        through += np.where((n_l < 0)[..., None], light_part, 0.0)
         # Away from the terminator (where the height rule and rounding decide).
         judged &= (n_l > 0.02) | (n_l < -0.02)
     # ... and from grazing views.
@@ -115,3 +118,5 @@ def test_metallic_roughness_is_appendix_b(material, shape, renderer):
         f"{(error > tolerance).sum()} of {judged.sum()} pixels differ; worst: got {got[judged].reshape(-1)[worst]}, "
         f"expected {expected[judged].reshape(-1)[worst]}")
     assert expected[judged].max() > 0.05  # the lights reach what is judged
+    if transmission > 0 and shape is PLANE:
+        assert through[judged].max() > 0.02  # ... the light behind the plane among them
