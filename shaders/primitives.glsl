@@ -32,10 +32,12 @@ float opacity_at(uint prim, uint flags, vec2 b, out vec4 alpha) {
 
 // Whether a ray with alpha key `key` (shared/sampling.h) that reaches the primitive in slot `prim` at
 // t meets it there: always, but on a primitive of a see-through material, where its opacity decides
-// (on a sphere, for the side the ray leaves by apart from the side it enters by).
-bool meets_slot(Ray ray, uint prim, float t, uint key) {
+// (on a sphere, for the side the ray leaves by apart from the side it enters by). scene_index: the
+// primitive's place in the scene, from the texel read here.
+bool meets_slot(Ray ray, uint prim, float t, uint key, out uint scene_index) {
   int base = int(prim) * VKRAY_TEXELS_PER_PRIMITIVE;
   vec4 a = texelFetch(primitives, base), b = texelFetch(primitives, base + 1), c = texelFetch(primitives, base + 2);
+  scene_index = primitive_scene_index(b);
   uint flags = primitive_flags(a);
   if ((flags & VKRAY_PRIM_ALPHA) == 0u) return true;
   bool sphere = (flags & VKRAY_PRIM_SPHERE) != 0u;
@@ -44,9 +46,8 @@ bool meets_slot(Ray ray, uint prim, float t, uint key) {
   vec4 alpha;
   float opacity = opacity_at(prim, flags, bary, alpha);
   bool far_side = sphere && dot(ray.dir, x - a.xyz) > 0.0;
-  return alpha_solid(alpha_mode_of(alpha), opacity, alpha.y, alpha_random(key, primitive_scene_index(b), far_side));
+  return alpha_solid(alpha_mode_of(alpha), opacity, alpha.y, alpha_random(key, scene_index, far_side));
 }
-
 
 // ---- Normal maps ---------------------------------------------------------------------------------------
 // The unit shading normal n of the triangle in primitive slot `prim`, at barycentrics b, turned by a

@@ -196,9 +196,10 @@ Hit trace(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back, inout
   bool passes;
   do {  // (a do-while: see the sample loop in trace.comp)
     hit = traverse(ray, from, t_max, false, cull_back, passed_t, passed_index);
-    passes = hit.prim != NO_HIT && !meets_slot(ray, hit.prim, hit.t, key);
+    // (The primitive's texels are read only for a hit: NO_HIT is no slot, and a read there would fall
+    // outside the buffer, which a device without robust buffer access need not survive.)
+    passes = hit.prim != NO_HIT && !meets_slot(ray, hit.prim, hit.t, key, passed_index);
     passed_t = hit.t;
-    passed_index = primitive_scene_index(texelFetch(primitives, int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE + 1));
     from = max(t_min, hit.t * (1.0 - VKRAY_TIE));
   } while (passes);
   return hit;

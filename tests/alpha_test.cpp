@@ -147,7 +147,8 @@ class BrokenAlpha : public BrokenShaderParityTest {
 class AlphaIgnoredOnShadowRays : public BrokenAlpha {
  protected:
   AlphaIgnoredOnShadowRays()
-      : BrokenAlpha("traversal.glsl", "passes = hit.prim != NO_HIT && !meets_slot(", "passes = !any_hit && hit.prim != NO_HIT && !meets_slot(") {}
+      : BrokenAlpha("traversal.glsl", "passes = hit.prim != NO_HIT && !meets_slot(ray, hit.prim, hit.t, key, passed_index);",
+                    "passes = hit.prim != NO_HIT && !meets_slot(ray, hit.prim, hit.t, key, passed_index) && !any_hit;") {}
 };
 TEST_F(AlphaIgnoredOnShadowRays, IsCaught) { expect_caught(); }
 
