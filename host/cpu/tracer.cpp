@@ -189,60 +189,54 @@ Facing facing(const SurfacePoint& s, const dvec3& dir, bool front) {
 SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
   SurfacePoint s;
   s.position = ray.origin + hit.t * ray.dir;
-  if (size_t(hit.primitive) < scene_.triangles.size()) {
-    const Triangle& tri = scene_.triangles[size_t(hit.primitive)];
-    s.geometric_normal = glm::normalize(glm::cross(dvec3(tri.v[1]) - dvec3(tri.v[0]), dvec3(tri.v[2]) - dvec3(tri.v[0])));
-    s.shading_normal = s.geometric_normal;
-    if (tri.smooth)
-      s.shading_normal = glm::normalize((1 - hit.u - hit.v) * dvec3(tri.normals[0]) + hit.u * dvec3(tri.normals[1]) +
-                                        hit.v * dvec3(tri.normals[2]));
-    s.material = tri.material;
-    s.properties = scene_.materials[tri.material].properties();
-    const Material& m = scene_.materials[tri.material];
-    s.albedo = dvec3(m.albedo);
-    s.emission = dvec3(m.emission);
-    s.metallic = m.metallic;
-    s.roughness = m.roughness;
-    s.transmission = m.transmission;
-    if (m.textured()) {
-      const glm::dvec2 uv = (1 - hit.u - hit.v) * glm::dvec2(tri.uv[0]) + hit.u * glm::dvec2(tri.uv[1]) + hit.v * glm::dvec2(tri.uv[2]);
-      if (m.albedo_texture.present()) s.albedo *= sample_texture(scene_, m.albedo_texture, uv);
-      if (m.emission_texture.present()) s.emission *= sample_texture(scene_, m.emission_texture, uv);
-      if (m.metallic_roughness_texture.present()) {  // metalness in blue, roughness in green
-        const dvec3 layers = sample_texture(scene_, m.metallic_roughness_texture, uv);
-        s.metallic *= layers.b;
-        s.roughness *= layers.g;
-      }
-      if (m.transmission_texture.present()) s.transmission *= sample_texture(scene_, m.transmission_texture, uv).r;
-      // A normal map in MikkTSpace's frame: the tangent interpolated and not normalized, the
-      // bitangent its sign times normal x tangent, the map's red and green scaled (glTF's formula).
-      if (m.normal_texture.present() && tri.has_tangents()) {
-        const double weight[3] = {1 - hit.u - hit.v, hit.u, hit.v};
-        dvec3 tangent(0.0);
-        double sign = 0;
-        for (size_t k = 0; k < 3; ++k) {
-          tangent += weight[k] * dvec3(tri.tangents[k]);
-          sign += weight[k] * double(tri.tangents[k].w);
-        }
-        const dvec3 bitangent = (sign < 0 ? -1.0 : 1.0) * glm::cross(s.shading_normal, tangent);
-        const dvec3 mapped = (2.0 * sample_texture(scene_, m.normal_texture, uv) - 1.0) * dvec3(m.normal_scale, m.normal_scale, 1.0);
-        const dvec3 n = mapped.x * tangent + mapped.y * bitangent + mapped.z * s.shading_normal;
-        if (glm::dot(n, n) > 0) s.shading_normal = n / std::sqrt(glm::dot(n, n));
-      }
-    }
-  } else {
-    const Sphere& sphere = scene_.spheres[size_t(hit.primitive) - scene_.triangles.size()];
+  const auto p = size_t(hit.primitive);
+  const bool triangle = p < scene_.triangles.size();
+  // The material's values, then (on a triangle) its textures at the hit.
+  s.material = triangle ? scene_.triangles[p].material : scene_.spheres[p - scene_.triangles.size()].material;
+  const Material& m = scene_.materials[s.material];
+  s.properties = m.properties();
+  s.albedo = dvec3(m.albedo);
+  s.emission = dvec3(m.emission);
+  s.metallic = m.metallic;
+  s.roughness = m.roughness;
+  s.transmission = m.transmission;
+  if (!triangle) {
+    const Sphere& sphere = scene_.spheres[p - scene_.triangles.size()];
     s.geometric_normal = (s.position - dvec3(sphere.center)) / double(sphere.radius);
     if (sphere.inward) s.geometric_normal = -s.geometric_normal;
     s.shading_normal = s.geometric_normal;
-    s.material = sphere.material;
-    s.properties = scene_.materials[sphere.material].properties();
-    const Material& m = scene_.materials[sphere.material];
-    s.albedo = dvec3(m.albedo);
-    s.emission = dvec3(m.emission);
-    s.metallic = m.metallic;
-    s.roughness = m.roughness;
-    s.transmission = m.transmission;
+    return s;
+  }
+  const Triangle& tri = scene_.triangles[p];
+  s.geometric_normal = glm::normalize(glm::cross(dvec3(tri.v[1]) - dvec3(tri.v[0]), dvec3(tri.v[2]) - dvec3(tri.v[0])));
+  s.shading_normal = s.geometric_normal;
+  if (tri.smooth)
+    s.shading_normal = glm::normalize((1 - hit.u - hit.v) * dvec3(tri.normals[0]) + hit.u * dvec3(tri.normals[1]) +
+                                      hit.v * dvec3(tri.normals[2]));
+  if (!m.textured()) return s;
+  const glm::dvec2 uv = (1 - hit.u - hit.v) * glm::dvec2(tri.uv[0]) + hit.u * glm::dvec2(tri.uv[1]) + hit.v * glm::dvec2(tri.uv[2]);
+  if (m.albedo_texture.present()) s.albedo *= sample_texture(scene_, m.albedo_texture, uv);
+  if (m.emission_texture.present()) s.emission *= sample_texture(scene_, m.emission_texture, uv);
+  if (m.metallic_roughness_texture.present()) {  // metalness in blue, roughness in green
+    const dvec3 layers = sample_texture(scene_, m.metallic_roughness_texture, uv);
+    s.metallic *= layers.b;
+    s.roughness *= layers.g;
+  }
+  if (m.transmission_texture.present()) s.transmission *= sample_texture(scene_, m.transmission_texture, uv).r;
+  // A normal map in MikkTSpace's frame: the tangent interpolated and not normalized, the bitangent
+  // its sign times normal x tangent, the map's red and green scaled (glTF's formula).
+  if (m.normal_texture.present() && tri.has_tangents()) {
+    const double weight[3] = {1 - hit.u - hit.v, hit.u, hit.v};
+    dvec3 tangent(0.0);
+    double sign = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      tangent += weight[k] * dvec3(tri.tangents[k]);
+      sign += weight[k] * double(tri.tangents[k].w);
+    }
+    const dvec3 bitangent = (sign < 0 ? -1.0 : 1.0) * glm::cross(s.shading_normal, tangent);
+    const dvec3 mapped = (2.0 * sample_texture(scene_, m.normal_texture, uv) - 1.0) * dvec3(m.normal_scale, m.normal_scale, 1.0);
+    const dvec3 n = mapped.x * tangent + mapped.y * bitangent + mapped.z * s.shading_normal;
+    if (glm::dot(n, n) > 0) s.shading_normal = n / std::sqrt(glm::dot(n, n));
   }
   return s;
 }
