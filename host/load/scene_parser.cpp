@@ -179,6 +179,10 @@ bool SceneParser::flip_normals(const Value& v) const {
   return v["flip_normals"].j.get<bool>();
 }
 
+// The keys every material takes, whatever its type: emission, a normal map and alpha (read below).
+constexpr std::initializer_list<const char*> kAnyMaterialKeys = {"emission", "normal_texture", "normal_scale", "alpha_mode",
+                                                                 "opacity", "opacity_texture", "alpha_cutoff"};
+
 void SceneParser::parse_materials(const Value& v) {
   expect_object(v);
   for (const auto& [name, unused] : v.j.items()) {
@@ -192,23 +196,19 @@ void SceneParser::parse_materials(const Value& v) {
     material.type = *known;
     switch (material.type) {
       case MaterialType::diffuse:
-        check_keys(m, {"type", "albedo", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
-                       "opacity_texture", "alpha_cutoff"});
+        check_keys(m, {"type", "albedo"}, kAnyMaterialKeys);
         material.albedo = reflectance(require(m, "albedo"));
         break;
       case MaterialType::mirror:
-        check_keys(m, {"type", "reflectance", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
-                       "opacity_texture", "alpha_cutoff"});
+        check_keys(m, {"type", "reflectance"}, kAnyMaterialKeys);
         material.albedo = reflectance(require(m, "reflectance"));
         break;
       case MaterialType::glass:
-        check_keys(m, {"type", "ior", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
-                       "opacity_texture", "alpha_cutoff"});
+        check_keys(m, {"type", "ior"}, kAnyMaterialKeys);
         if (m.has("ior")) material.ior = index_of_refraction(m["ior"]);
         break;
       case MaterialType::roughconductor:
-        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "specular_reflectance", "eta", "k", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
-                       "opacity_texture", "alpha_cutoff"});
+        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "specular_reflectance", "eta", "k"}, kAnyMaterialKeys);
         material.alpha = roughness(m);
         material.albedo = m.has("specular_reflectance") ? reflectance(m["specular_reflectance"]) : glm::vec3(1.0f);
         if (m.has("eta")) material.eta = bounded_color(m["eta"], kMaxIor, "indices of refraction up to 100");
@@ -219,16 +219,15 @@ void SceneParser::parse_materials(const Value& v) {
                                                  "either, eta 0 and k 1 reflect everything)");
         break;
       case MaterialType::roughdielectric:
-        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "int_ior", "emission", "normal_texture", "normal_scale", "alpha_mode", "opacity",
-                       "opacity_texture", "alpha_cutoff"});
+        check_keys(m, {"type", "alpha", "alpha_u", "alpha_v", "int_ior"}, kAnyMaterialKeys);
         material.alpha = roughness(m);
         material.albedo = glm::vec3(1.0f);  // clear: Mitsuba's specular reflectance and transmittance, 1
         if (m.has("int_ior")) material.ior = index_of_refraction(m["int_ior"]);
         break;
       case MaterialType::metallic_roughness:  // glTF 2.0's, with its names and defaults
-        check_keys(m, {"type", "base_color", "metallic", "roughness", "ior", "transmission", "emission", "base_color_texture",
-                       "metallic_roughness_texture", "transmission_texture", "normal_texture", "normal_scale", "alpha_mode",
-                       "opacity", "opacity_texture", "alpha_cutoff"});
+        check_keys(m, {"type", "base_color", "metallic", "roughness", "ior", "transmission", "base_color_texture",
+                       "metallic_roughness_texture", "transmission_texture"},
+                   kAnyMaterialKeys);
         material.albedo = m.has("base_color") ? reflectance(m["base_color"]) : glm::vec3(1.0f);
         // Pictures beside the scene file, read where a mesh gives texture coordinates: the base colour
         // as sRGB; metallic (blue) and roughness (green) as linear data, as glTF's textures are.

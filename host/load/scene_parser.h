@@ -71,10 +71,11 @@ class SceneParser {
     return obj[key];
   }
   // Warns about keys the contract does not define (most often a typo).
-  void check_keys(const Value& obj, std::initializer_list<const char*> known) {
+  void check_keys(const Value& obj, std::initializer_list<const char*> known, std::initializer_list<const char*> also_known = {}) {
     for (const auto& item : obj.j.items()) {
       const std::string& key = item.key();
-      if (std::none_of(known.begin(), known.end(), [&](const char* k) { return key == k; }))
+      const auto is_key = [&](const char* k) { return key == k; };
+      if (std::none_of(known.begin(), known.end(), is_key) && std::none_of(also_known.begin(), also_known.end(), is_key))
         warn(obj[key], "unknown key (ignored)");
     }
   }
