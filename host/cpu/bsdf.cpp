@@ -22,7 +22,7 @@ Bsdf bsdf_of(const Material& material, const dvec3& color, double metallic, doub
   b.k = dvec3(material.k);
   b.metallic = metallic;
   b.roughness = roughness;
-  b.transmission = material.type == MaterialType::metallic_roughness ? transmission : 0.0;
+  b.transmission = transmission;
   return b;
 }
 

@@ -314,7 +314,7 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     glm::vec4* texels = &packed.materials[i * VKRAY_TEXELS_PER_MATERIAL];
     const MaterialValueTexels values = material_value_texels(
         {m.albedo, uint32_t(m.type), scale_radiance(m.emission, exponent), m.ior, m.eta, m.alpha.x, m.k, m.alpha.y, m.metallic,
-         m.roughness, m.normal_scale, m.type == MaterialType::metallic_roughness ? m.transmission : 0.0f});
+         m.roughness, m.normal_scale, m.transmission});
     texels[VKRAY_MATERIAL_COLOR] = values.color;
     texels[VKRAY_MATERIAL_EMISSION] = values.emission;
     texels[VKRAY_MATERIAL_ETA] = values.eta;

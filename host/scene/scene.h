@@ -99,10 +99,10 @@ struct Material {
   // GGX alpha is roughness squared); glTF's defaults.
   float metallic = 1.0f;
   float roughness = 1.0f;
-  // metallic_roughness: how much of the light its dielectric does not reflect passes through it
-  // rather than into its Lambertian base (glTF's KHR_materials_transmission, thin-walled: a sheet
-  // with no inside, its transmission the specular lobe mirrored through the surface), times the red of
-  // `transmission_texture` (linear).
+  // metallic_roughness (0 for every other type, which the readers never set): how much of the light
+  // its dielectric does not reflect passes through it rather than into its Lambertian base (glTF's
+  // KHR_materials_transmission, thin-walled: a sheet with no inside, its transmission the specular
+  // lobe mirrored through the surface), times the red of `transmission_texture` (linear).
   float transmission = 0.0f;
   // Textures that multiply albedo (or reflectance) and emission where a triangle has texture
   // coordinates (glTF's baseColorTexture and emissiveTexture, an .mtl file's map_Kd), and
