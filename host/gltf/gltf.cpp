@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -578,22 +579,26 @@ uint32_t GltfReader::material(int index, const std::string& where) {
              "emissiveFactor times emissiveStrength passes the largest 32-bit float (3.4e38)");
       m.emission = glm::vec3(emission);
     }
-    int set = 0;
+    // A material's textures share one texture coordinate set: the first texture read gives it, and
+    // one that asks for another is named in a warning.
+    std::optional<int> set;
+    const auto share_set = [&](const tinygltf::TextureInfo& info, const char* which) {
+      if (!set) set = texcoord_of(info);
+      else if (texcoord_of(info) != *set)
+        warn_once("texcoord sets", name, std::string("the ") + which + "'s texCoord differs from the other textures': all use TEXCOORD_" +
+                                             std::to_string(*set));
+    };
     if (pbr.baseColorTexture.index >= 0) {
       m.albedo_texture = texture(pbr.baseColorTexture, name + ".pbrMetallicRoughness.baseColorTexture", true);
-      set = texcoord_of(pbr.baseColorTexture);
+      share_set(pbr.baseColorTexture, "baseColorTexture");
     }
     if (g.emissiveTexture.index >= 0 && m.emission != glm::vec3(0.0f)) {
       m.emission_texture = texture(g.emissiveTexture, name + ".emissiveTexture", true);
-      if (m.albedo_texture.present() && texcoord_of(g.emissiveTexture) != set)
-        warn_once("texcoord sets", name, "the emissive texture's texCoord differs from the base colour's: both use TEXCOORD_" + std::to_string(set));
-      if (!m.albedo_texture.present()) set = texcoord_of(g.emissiveTexture);
+      share_set(g.emissiveTexture, "emissiveTexture");
     }
     if (pbr.metallicRoughnessTexture.index >= 0) {  // data, not colour: linear
       m.metallic_roughness_texture = texture(pbr.metallicRoughnessTexture, name + ".pbrMetallicRoughness.metallicRoughnessTexture", false);
-      if ((m.albedo_texture.present() || m.emission_texture.present()) && texcoord_of(pbr.metallicRoughnessTexture) != set)
-        warn_once("texcoord sets", name, "the metallicRoughnessTexture's texCoord differs from the other textures': all use TEXCOORD_" + std::to_string(set));
-      if (!m.albedo_texture.present() && !m.emission_texture.present()) set = texcoord_of(pbr.metallicRoughnessTexture);
+      share_set(pbr.metallicRoughnessTexture, "metallicRoughnessTexture");
     }
     if (g.normalTexture.index >= 0) {  // data, not colour: linear
       tinygltf::TextureInfo info;
@@ -604,10 +609,7 @@ uint32_t GltfReader::material(int index, const std::string& where) {
       if (!(std::abs(g.normalTexture.scale) <= 1e6))
         fail(name + ".normalTexture.scale", "expected a number of at most 1e6 in magnitude, got " + brief(nlohmann::json(g.normalTexture.scale)));
       m.normal_scale = float(g.normalTexture.scale);
-      const bool others = m.albedo_texture.present() || m.emission_texture.present() || m.metallic_roughness_texture.present();
-      if (others && texcoord_of(info) != set)
-        warn_once("texcoord sets", name, "the normalTexture's texCoord differs from the other textures': all use TEXCOORD_" + std::to_string(set));
-      if (!others) set = texcoord_of(info);
+      share_set(info, "normalTexture");
     }
     if (const auto ext = g.extensions.find("KHR_materials_transmission"); ext != g.extensions.end()) {
       // Thin-walled, as the extension is without KHR_materials_volume (which vkray does not read): the
@@ -623,15 +625,12 @@ uint32_t GltfReader::material(int index, const std::string& where) {
         if (t.Has("extensions"))
           for (const std::string& key : t.Get("extensions").Keys()) info.extensions[key] = t.Get("extensions").Get(key);
         m.transmission_texture = texture(info, name + "." + at + ".transmissionTexture", false);
-        const bool others = m.albedo_texture.present() || m.emission_texture.present() || m.metallic_roughness_texture.present() ||
-                            m.normal_texture.present();
-        if (others && texcoord_of(info) != set)
-          warn_once("texcoord sets", name, "the transmissionTexture's texCoord differs from the other textures': all use TEXCOORD_" + std::to_string(set));
-        if (!others) set = texcoord_of(info);
+        share_set(info, "transmissionTexture");
       }
     }
-    if (set < 0 || set > 7) fail(name, "texCoord " + std::to_string(set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
-    texcoord_sets_[index] = set;
+    if (set.value_or(0) < 0 || set.value_or(0) > 7)
+      fail(name, "texCoord " + std::to_string(*set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
+    texcoord_sets_[index] = set.value_or(0);
     if (g.occlusionTexture.index >= 0) warn_once("occlusionTexture", name, "occlusion textures are not rendered (light transport computes occlusion)");
     // Alpha: the base colour's, factor times texture (the texture's alpha, or 1 where it has none).
     // (gltf_schema.cpp has checked the mode's name.)
