@@ -303,6 +303,22 @@ TEST(GltfTest, TransmissionIsThinWalledWithItsFactorAndTheRedOfItsTexture) {
   }
 }
 
+TEST(GltfTest, AMaterialsTexturesShareTheFirstTexturesCoordinateSet) {
+  // The first texture read gives the set; one that asks for another is named in one warning.
+  GltfBuilder b;
+  const int picture = b.texture(test::png_bytes({1, 1, {128, 128, 128}}));
+  b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", picture}}},
+                                               {"metallicRoughnessTexture", {{"index", picture}, {"texCoord", 1}}}}},
+                     {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1}, {"transmissionTexture", {{"index", picture}, {"texCoord", 1}}}}}}}}));
+  b.doc["extensionsUsed"] = {"KHR_materials_transmission"};
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("the metallicRoughnessTexture's texCoord differs from the other textures': all use TEXCOORD_0"),
+            std::string::npos)
+      << s.warnings[0];
+  EXPECT_TRUE(s.materials[0].transmission_texture.present());
+}
+
 TEST(GltfTest, AMetallicRoughnessTextureIsLinearDataWhereTheSamePictureAsBaseColourIsSrgb) {
   // One grey picture, 128 of 255, used as both textures: as base colour it decodes from sRGB (0.216),
   // as metallic-roughness it is data (128 / 255), and the two are decoded once each.
