@@ -232,11 +232,28 @@ TEST_F(RenderTest, PolicyChoosesThePath) {
   const auto chooses = [&](const DeviceScene& scene, ImageSettings image, InlineScene policy) {
     return session().compiles_scene_in(scene, with_image(path(policy), image));
   };
-  EXPECT_FALSE(chooses(small, {512, 512, 1}, InlineScene::automatic));  // 2^18 camera rays
-  EXPECT_TRUE(chooses(small, {1024, 1024, 1}, InlineScene::automatic));
-  EXPECT_TRUE(chooses(small, {512, 512, 4}, InlineScene::automatic));
+  // auto: from 2^17 camera rays a primitive under `path`, 4x that under `direct`, where only up to 32
+  // primitives (session.cpp). The Cornell box's 30 triangles under `direct`: from 15.7 M.
+  EXPECT_FALSE(chooses(small, {512, 512, 1}, InlineScene::automatic));
+  EXPECT_FALSE(chooses(small, {2048, 2048, 3}, InlineScene::automatic));  // 12.6 M
+  EXPECT_TRUE(chooses(small, {2048, 2048, 4}, InlineScene::automatic));   // 16.8 M
   EXPECT_TRUE(chooses(small, {8, 8, 1}, InlineScene::always));
   EXPECT_FALSE(chooses(small, {4096, 4096, 1}, InlineScene::never));
+  // Under `path`: from 3.9 M.
+  Scene traced = *cornell;
+  traced.integrator.type = Integrator::Type::path;
+  const DeviceScene small_path = session().upload(std::make_shared<const Scene>(traced));
+  EXPECT_FALSE(chooses(small_path, {1024, 1024, 3}, InlineScene::automatic));  // 3.1 M
+  EXPECT_TRUE(chooses(small_path, {1024, 1024, 4}, InlineScene::automatic));   // 4.2 M
+  // 33 triangles: under `direct` never, under `path` from 4.3 M.
+  for (const auto type : {Integrator::Type::direct, Integrator::Type::path}) {
+    Scene more = *cornell;
+    more.integrator.type = type;
+    while (more.triangles.size() < 33) more.triangles.push_back(more.triangles.back());
+    const DeviceScene uploaded = session().upload(std::make_shared<const Scene>(more));
+    EXPECT_FALSE(chooses(uploaded, {2048, 1024, 2}, InlineScene::automatic));  // 4.2 M
+    EXPECT_EQ(chooses(uploaded, {4096, 4096, 4}, InlineScene::automatic), type == Integrator::Type::path);
+  }
 
   Scene larger = *cornell;  // one triangle over the limit
   while (larger.triangles.size() <= gpu::kMaxInlinePrimitives) larger.triangles.push_back(larger.triangles.back());

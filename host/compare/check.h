@@ -52,7 +52,7 @@ struct CheckOptions {
 // one name (the name of their cases) are an InternalError.
 std::vector<std::filesystem::path> check_scenes(const std::vector<std::filesystem::path>& folders);
 
-// "20 scenes at 256x256, each on the BVH and, with 32 primitives or fewer, compiled into the shader;
+// "20 scenes at 256x256, each on the BVH and, with 64 primitives or fewer, compiled into the shader;
 // at 1 and 16 spp": what run_check will do.
 std::string describe_plan(const CheckOptions& options);
 

@@ -11,8 +11,10 @@
 
 namespace vkray::gpu {
 
-// Scenes of at most this many primitives can be compiled into the shader.
-constexpr uint32_t kMaxInlinePrimitives = 32;
+// Scenes of at most this many primitives can be compiled into the shader. Its code and compile time
+// grow with each primitive, its rays' cost too, where a BVH walk's grows with the logarithm: on
+// lavapipe a path-traced scene's rays cost the same both ways near 100 primitives (docs/design.md).
+constexpr uint32_t kMaxInlinePrimitives = 64;
 
 // The text served as shaders/inline_scene.glsl for `packed` (the contract is in that file): it
 // defines VKRAY_INLINE_SCENE and test_inline_primitives(), which shears each distinct vertex once
