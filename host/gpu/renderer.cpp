@@ -58,11 +58,15 @@ uint32_t samples_in_one_dispatch(const Scene& scene) {
   return uint32_t(std::clamp(32768.0 / tests_per_sample(scene), 1.0, 64.0));
 }
 
-// Every submission after the first aims at this much device time, at the rate the ones before it
-// ran: long enough that a submission's fixed costs vanish on a fast GPU, short enough that
-// progress, Ctrl-C (which waits for the running submission) and a display watchdog are not kept
-// waiting on a slow one. Well below --tile-timeout's default of a minute (docs/commands.md).
-constexpr double kSubmissionSeconds = 0.1;
+// Every submission after the first aims at this much device time for each of its dispatches, at the
+// rate the ones before it ran: long enough that a submission's fixed costs vanish on a fast GPU, and
+// that llvmpipe's threads wait little at the end of a dispatch (each takes a contiguous share of its
+// workgroups, and the one done first waits for the others: the fewer workgroups, the longer); short
+// enough that progress, Ctrl-C (which waits for the running submission) and a display watchdog are
+// not kept waiting on a slow device: kMostSubmissionSeconds in all. Well below --tile-timeout's
+// default of a minute (docs/commands.md).
+constexpr double kDispatchSeconds = 0.1;
+constexpr double kMostSubmissionSeconds = 0.4;
 // The most pixels a submission (an output slot) holds: 64 MiB a slot, two slots.
 constexpr uint64_t kMostSlotPixels = uint64_t(1) << 22;
 
@@ -127,11 +131,12 @@ SlotPlan plan_slots(const Context& ctx, const TraceRequest& request, const Pixel
 // pattern takes.
 class TileSource {
  public:
-  TileSource(const Scene& scene, const TraceRequest& request, const PixelRegion& region, const SlotPlan& plan)
+  // dispatches: how many dispatches a submission makes (its samples, samples_in_one_dispatch() at a time).
+  TileSource(const Scene& scene, const TraceRequest& request, const PixelRegion& region, const SlotPlan& plan, uint32_t dispatches)
       : region_(region),
         side_(plan.tile_side),
         cursor_(region.width(), region.height(), kGranule),
-        sizer_(sizer(first_submission_pixels(scene, request.image), plan, request.tile_timeout)) {}
+        sizer_(sizer(first_submission_pixels(scene, request.image), plan, request.tile_timeout, dispatches)) {}
 
   bool done() const { return cursor_.done(); }
   TileRect next() {
@@ -147,8 +152,9 @@ class TileSource {
   // The first submission is the size the cost model gives; the sizer takes over from the second's
   // time on, aiming at a tenth of --tile-timeout at most, so that growing 8x from a cheap
   // submission stays within it.
-  static SubmissionSizer sizer(uint64_t first, const SlotPlan& plan, std::chrono::milliseconds tile_timeout) {
-    const double target_seconds = std::min(kSubmissionSeconds, 0.1 * std::chrono::duration<double>(tile_timeout).count());
+  static SubmissionSizer sizer(uint64_t first, const SlotPlan& plan, std::chrono::milliseconds tile_timeout, uint32_t dispatches) {
+    const double target_seconds = std::min({kDispatchSeconds * dispatches, kMostSubmissionSeconds,
+                                            0.1 * std::chrono::duration<double>(tile_timeout).count()});
     return SubmissionSizer(first, std::max<uint64_t>(kGranule * kGranule, first / 64), plan.slot_pixels, target_seconds);
   }
 
@@ -412,9 +418,9 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
 
 void Renderer::trace_tiles(Frame& frame, const TraceRequest& request, const PixelRegion& region, Image& result, Aovs* aovs,
                            TraceStats& stats) {
-  TileSource tiles(frame.scene->scene(), request, region, frame.plan);
   uint32_t samples_per_dispatch = samples_in_one_dispatch(frame.scene->scene());
   const uint32_t samples = request.image.samples_per_pixel;
+  TileSource tiles(frame.scene->scene(), request, region, frame.plan, (samples + samples_per_dispatch - 1) / samples_per_dispatch);
   Clock::time_point last_finished;
   uint64_t pixels_done = 0;
   frame.submit_tile(*ctx_, tiles.next(), samples, samples_per_dispatch);
