@@ -242,7 +242,8 @@ TEST(CliTest, BenchPrintsJsonForEachScene) {
   ASSERT_EQ(j.size(), 2u);
   EXPECT_EQ(j[1].at("scene"), "teapot");
   EXPECT_EQ(j[1].at("triangles"), 6322);
-  EXPECT_EQ(j[0].at("gpu_path"), "bvh");  // 32 x 32: too few camera rays to compile the Cornell box in
+  // A scene the shader can hold is measured compiled in, whatever the rays (the compile is not timed).
+  EXPECT_EQ(j[0].at("gpu_path"), "inline");
   EXPECT_EQ(j[1].at("gpu_path"), "bvh");
   EXPECT_EQ(j[0].at("vkray_version").get<std::string>().rfind("0.1.0 (", 0), 0u);  // a report names its build
   for (const char* mode : {"primary", "primary_shadow"}) {
