@@ -73,8 +73,9 @@ TEST_P(CheckCaseTest, ScaledScenesGiveTheSameImage) {
 }
 
 TEST_P(CheckCaseTest, ThousandsOfSamplesPerPixelMatchTheReference) {
-  // A dispatch traces at most 64 samples of a pixel (gpu/renderer.cpp, samples_in_one_dispatch): in one
-  // dispatch llvmpipe's loop limiter silently ended the samples of 2048 spp early, an image 29% too dark.
+  // A dispatch traces at most 64 samples of a pixel, 256 with the scene compiled in (gpu/renderer.cpp,
+  // samples_in_one_dispatch): in one dispatch llvmpipe's loop limiter silently ended the samples of
+  // 2048 spp early, an image 29% too dark.
   const ParityResult r = check(cornell(), "cornell-4096spp", {16, 16, 4096});
   EXPECT_EQ(r.metrics.interior_over_1, 0u);
   EXPECT_EQ(r.gpu.stats.rays, r.cpu.stats.rays);  // every sample traced, and each of its shadow rays

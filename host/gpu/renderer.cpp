@@ -25,10 +25,11 @@ constexpr double kTestsPerTile = double(1 << 26);
 
 // Ray-primitive tests one sample costs, roughly: a ray visits on the order of log2(N) nodes and a few
 // leaves, for the camera ray and each light's shadow ray; a path does so at each of its vertices, with
-// a shadow ray to an area light and one to the background besides.
-double tests_per_sample(const Scene& scene) {
+// a shadow ray to an area light and one to the background besides. per_ray: a ray's tests, when not
+// the BVH walk's.
+double tests_per_sample(const Scene& scene, double per_ray = 0.0) {
   const double primitives = double(scene.triangles.size() + scene.spheres.size()) + 1.0;
-  const double per_ray = 8.0 + 4.0 * std::log2(primitives);
+  if (per_ray == 0.0) per_ray = 8.0 + 4.0 * std::log2(primitives);
   if (scene.integrator.type == Integrator::Type::direct) return per_ray * (1.0 + double(scene.lights.size()));
   // Past rr_depth a path goes on with probability at most 0.95: 20 more vertices on average at most.
   const double rr_vertices = double(scene.integrator.rr_depth) + 20.0;
@@ -52,21 +53,26 @@ uint64_t first_submission_pixels(const Scene& scene, const ImageSettings& image)
 // at 16 x 16 pixels of the Cornell box, 2048 spp in one dispatch gave an image 29% too dark (1024 did
 // not). A sample's loop iterations (the sample loop, the light loop, each ray's BVH walk) are bounded
 // by its estimated tests; a dispatch gets at most half the limit of them, and at most 64 samples.
+// A scene compiled into the shader has no walk: a ray makes no iteration, or one for each surface
+// it passes in a scene with see-through surfaces (counted as 8), and a dispatch gets at most 256
+// samples. More samples a dispatch even out what a lane's paths cost: the lanes of a batch wait for
+// the one whose paths were longest, less so the more paths each adds up (the sphere grid: 4.6%
+// fewer instructions at 256 samples a dispatch than at 32).
 // That is an estimate (a path's length is random): the shader says when its loops were cut short
 // (VKRAY_LOOPS_CUT_SHORT), and the tile is traced again with half as many samples a dispatch.
-uint32_t samples_in_one_dispatch(const Scene& scene) {
+uint32_t samples_in_one_dispatch(const Scene& scene, const ShaderVariant& variant) {
+  if (!variant.inline_scene.empty())
+    return uint32_t(std::clamp(32768.0 / tests_per_sample(scene, variant.alpha ? 8.0 : 1.0), 1.0, 256.0));
   return uint32_t(std::clamp(32768.0 / tests_per_sample(scene), 1.0, 64.0));
 }
 
-// Every submission after the first aims at this much device time for each of its dispatches, at the
-// rate the ones before it ran: long enough that a submission's fixed costs vanish on a fast GPU, and
-// that llvmpipe's threads wait little at the end of a dispatch (each takes a contiguous share of its
-// workgroups, and the one done first waits for the others: the fewer workgroups, the longer); short
-// enough that progress, Ctrl-C (which waits for the running submission) and a display watchdog are
-// not kept waiting on a slow device: kMostSubmissionSeconds in all. Well below --tile-timeout's
-// default of a minute (docs/commands.md).
-constexpr double kDispatchSeconds = 0.1;
-constexpr double kMostSubmissionSeconds = 0.4;
+// Every submission after the first aims at this much device time, at the rate the ones before it
+// ran: long enough that a submission's fixed costs vanish on a fast GPU, and that llvmpipe's threads
+// wait little at the end of each dispatch (each takes a contiguous share of its workgroups, and the
+// one done first waits for the others: the fewer workgroups, the longer); short enough that
+// progress, Ctrl-C (which waits for the running submission) and a display watchdog are not kept
+// waiting on a slow device. Well below --tile-timeout's default of a minute (docs/commands.md).
+constexpr double kSubmissionSeconds = 0.4;
 // The most pixels a submission (an output slot) holds: 64 MiB a slot, two slots.
 constexpr uint64_t kMostSlotPixels = uint64_t(1) << 22;
 
@@ -131,12 +137,11 @@ SlotPlan plan_slots(const Context& ctx, const TraceRequest& request, const Pixel
 // pattern takes.
 class TileSource {
  public:
-  // dispatches: how many dispatches a submission makes (its samples, samples_in_one_dispatch() at a time).
-  TileSource(const Scene& scene, const TraceRequest& request, const PixelRegion& region, const SlotPlan& plan, uint32_t dispatches)
+  TileSource(const Scene& scene, const TraceRequest& request, const PixelRegion& region, const SlotPlan& plan)
       : region_(region),
         side_(plan.tile_side),
         cursor_(region.width(), region.height(), kGranule),
-        sizer_(sizer(first_submission_pixels(scene, request.image), plan, request.tile_timeout, dispatches)) {}
+        sizer_(sizer(first_submission_pixels(scene, request.image), plan, request.tile_timeout)) {}
 
   bool done() const { return cursor_.done(); }
   TileRect next() {
@@ -152,9 +157,8 @@ class TileSource {
   // The first submission is the size the cost model gives; the sizer takes over from the second's
   // time on, aiming at a tenth of --tile-timeout at most, so that growing 8x from a cheap
   // submission stays within it.
-  static SubmissionSizer sizer(uint64_t first, const SlotPlan& plan, std::chrono::milliseconds tile_timeout, uint32_t dispatches) {
-    const double target_seconds = std::min({kDispatchSeconds * dispatches, kMostSubmissionSeconds,
-                                            0.1 * std::chrono::duration<double>(tile_timeout).count()});
+  static SubmissionSizer sizer(uint64_t first, const SlotPlan& plan, std::chrono::milliseconds tile_timeout) {
+    const double target_seconds = std::min(kSubmissionSeconds, 0.1 * std::chrono::duration<double>(tile_timeout).count());
     return SubmissionSizer(first, std::max<uint64_t>(kGranule * kGranule, first / 64), plan.slot_pixels, target_seconds);
   }
 
@@ -418,9 +422,9 @@ Image Renderer::render(std::shared_ptr<const TracePipeline> trace_pipeline, std:
 
 void Renderer::trace_tiles(Frame& frame, const TraceRequest& request, const PixelRegion& region, Image& result, Aovs* aovs,
                            TraceStats& stats) {
-  uint32_t samples_per_dispatch = samples_in_one_dispatch(frame.scene->scene());
+  TileSource tiles(frame.scene->scene(), request, region, frame.plan);
+  uint32_t samples_per_dispatch = samples_in_one_dispatch(frame.scene->scene(), request.variant);
   const uint32_t samples = request.image.samples_per_pixel;
-  TileSource tiles(frame.scene->scene(), request, region, frame.plan, (samples + samples_per_dispatch - 1) / samples_per_dispatch);
   Clock::time_point last_finished;
   uint64_t pixels_done = 0;
   frame.submit_tile(*ctx_, tiles.next(), samples, samples_per_dispatch);

@@ -38,9 +38,8 @@ auto on_device(Work&& work) -> decltype(work()) {
 constexpr uint64_t kInlineCameraRaysPerPrimitive = uint64_t(1) << 17;
 constexpr uint32_t kInlineMaxDirectPrimitives = 32;
 
-// A tile that an interrupt left running ends with its submission (about 0.4 s at most at the rate the
-// ones before it ran, renderer.cpp's kMostSubmissionSeconds; never past the render's tile timeout,
-// which defaults to this): an upload or close() waits this long for it.
+// A tile that an interrupt left running ends with its submission (about kSubmissionSeconds, at most
+// the render's tile timeout, which defaults to this): an upload or close() waits this long for it.
 constexpr std::chrono::milliseconds kInterruptedTileWait{60000};
 
 }  // namespace
