@@ -254,6 +254,12 @@ TEST_F(RenderTest, PolicyChoosesThePath) {
     EXPECT_FALSE(chooses(uploaded, {2048, 1024, 2}, InlineScene::automatic));  // 4.2 M
     EXPECT_EQ(chooses(uploaded, {4096, 4096, 4}, InlineScene::automatic), type == Integrator::Type::path);
   }
+  // 64 triangles under `path`: past 44, the rays needed grow with the square, to 17.7 M.
+  Scene most = traced;
+  while (most.triangles.size() < 64) most.triangles.push_back(most.triangles.back());
+  const DeviceScene uploaded = session().upload(std::make_shared<const Scene>(most));
+  EXPECT_FALSE(chooses(uploaded, {4096, 4096, 1}, InlineScene::automatic));  // 16.8 M
+  EXPECT_TRUE(chooses(uploaded, {2048, 2048, 5}, InlineScene::automatic));   // 21.0 M
 
   Scene larger = *cornell;  // one triangle over the limit
   while (larger.triangles.size() <= gpu::kMaxInlinePrimitives) larger.triangles.push_back(larger.triangles.back());

@@ -85,8 +85,8 @@ void add_gpu_flags(CLI::App& command, GpuFlags& flags, bool inline_scene) {
           "--inline-scene", [&flags](const std::string& name) { flags.inline_scene = names.at(name); },
           "GPU path for scenes of at most 64 primitives: compile the scene into the shader (every primitive "
           "tested, no BVH) 'always', 'never', or 'auto' (default: when the render has at least 2^17 camera rays "
-          "per primitive under `path`, 2^19 under `direct` and only up to 32 primitives, so that the longer "
-          "compile pays off)")
+          "per primitive under `path`, more past 44 primitives, 2^19 under `direct` and only up to 32 "
+          "primitives, so that the longer compile pays off)")
       ->option_text("auto|always|never")
       ->check(CLI::IsMember({"auto", "always", "never"}));
 }

@@ -31,11 +31,14 @@ auto on_device(Work&& work) -> decltype(work()) {
 // Compiling a scene into the shader makes pipeline creation slower (on lavapipe with 2 cores and the
 // shader caches warm, by 15-25 ms a primitive) and each ray cheaper, by more the more a sample traces
 // (docs/design.md, "Small scenes compiled into the shader"). Measured break-even in camera rays: the
-// Cornell box (30 primitives) near 2^24 under `direct` and 2^20 under `path`, the sphere grid (44)
-// near 2^23 under `path`. So `auto` compiles a scene in from kInlineCameraRaysPerPrimitive camera rays
-// a primitive under `path` and 4x that under `direct`, and under `direct` only up to 32 primitives:
-// with more, its rays are no cheaper compiled in (60 triangles: the same trace time).
+// Cornell box (30 triangles) near 2^24 under `direct`, `cornell-path` (32) near 2^20, the sphere grid
+// (44) near 2^23 and the grid with 92 primitives near 2^26 under `path`. So `auto` compiles a scene
+// in from kInlineCameraRaysPerPrimitive camera rays a primitive under `path`, growing with the square
+// of the primitives past kInlineSteeperFrom (each ray saves less there, the compile grows on), 4x
+// that under `direct`, and under `direct` only up to 32 primitives: with more, its rays are no
+// cheaper compiled in (60 triangles: the same trace time).
 constexpr uint64_t kInlineCameraRaysPerPrimitive = uint64_t(1) << 17;
+constexpr double kInlineSteeperFrom = 44.0;
 constexpr uint32_t kInlineMaxDirectPrimitives = 32;
 
 // A tile that an interrupt left running ends with its submission (about kSubmissionSeconds, at most
@@ -159,7 +162,9 @@ bool use_inline_scene(const gpu::SceneBuffers& scene, const ImageSettings& image
   const bool direct = scene.scene().integrator.type == Integrator::Type::direct;
   if (direct && scene.primitive_count() > kInlineMaxDirectPrimitives) return false;
   const uint64_t camera_rays = uint64_t(image.width) * image.height * image.samples_per_pixel;
-  return camera_rays >= kInlineCameraRaysPerPrimitive * (direct ? 4 : 1) * scene.primitive_count();
+  const double primitives = scene.primitive_count();
+  const double steeper = std::max(1.0, (primitives / kInlineSteeperFrom) * (primitives / kInlineSteeperFrom));
+  return double(camera_rays) >= double(kInlineCameraRaysPerPrimitive) * (direct ? 4.0 : 1.0) * primitives * steeper;
 }
 
 gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOptions& options) {
