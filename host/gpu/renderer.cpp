@@ -23,18 +23,21 @@ namespace {
 // on lavapipe with 2 cores, so that not even the first one runs long on a slow device.
 constexpr double kTestsPerTile = double(1 << 26);
 
-// Ray-primitive tests one sample costs, roughly: a ray visits on the order of log2(N) nodes and a few
-// leaves, for the camera ray and each light's shadow ray; a path does so at each of its vertices, with
-// a shadow ray to an area light and one to the background besides. per_ray: a ray's tests, when not
-// the BVH walk's.
-double tests_per_sample(const Scene& scene, double per_ray = 0.0) {
-  const double primitives = double(scene.triangles.size() + scene.spheres.size()) + 1.0;
-  if (per_ray == 0.0) per_ray = 8.0 + 4.0 * std::log2(primitives);
-  if (scene.integrator.type == Integrator::Type::direct) return per_ray * (1.0 + double(scene.lights.size()));
+// Rays one sample traces, roughly: the camera ray and each light's shadow ray; a path these at each
+// of its vertices, with a shadow ray to an area light and one to the background besides.
+double rays_per_sample(const Scene& scene) {
+  if (scene.integrator.type == Integrator::Type::direct) return 1.0 + double(scene.lights.size());
   // Past rr_depth a path goes on with probability at most 0.95: 20 more vertices on average at most.
   const double rr_vertices = double(scene.integrator.rr_depth) + 20.0;
   const double vertices = scene.integrator.max_depth > 0 ? std::min(double(scene.integrator.max_depth), rr_vertices) : rr_vertices;
-  return per_ray * (3.0 + double(scene.lights.size())) * vertices;
+  return (3.0 + double(scene.lights.size())) * vertices;
+}
+
+// Ray-primitive tests one sample costs through the BVH, roughly: a ray visits on the order of
+// log2(N) nodes and a few leaves.
+double tests_per_sample(const Scene& scene) {
+  const double primitives = double(scene.triangles.size() + scene.spheres.size()) + 1.0;
+  return (8.0 + 4.0 * std::log2(primitives)) * rays_per_sample(scene);
 }
 
 // The first submission's pixels: a square (its side a multiple of the workgroup's, at most the
@@ -62,7 +65,7 @@ uint64_t first_submission_pixels(const Scene& scene, const ImageSettings& image)
 // (VKRAY_LOOPS_CUT_SHORT), and the tile is traced again with half as many samples a dispatch.
 uint32_t samples_in_one_dispatch(const Scene& scene, const ShaderVariant& variant) {
   if (!variant.inline_scene.empty())
-    return uint32_t(std::clamp(32768.0 / tests_per_sample(scene, variant.alpha ? 8.0 : 1.0), 1.0, 256.0));
+    return uint32_t(std::clamp(32768.0 / ((variant.alpha ? 8.0 : 1.0) * rays_per_sample(scene)), 1.0, 256.0));
   return uint32_t(std::clamp(32768.0 / tests_per_sample(scene), 1.0, 64.0));
 }
 
