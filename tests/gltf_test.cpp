@@ -115,6 +115,113 @@ TEST(GltfTest, NodeTransformsComposeDownTheHierarchy) {
   EXPECT_GT(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0]).z, 0.0f);
 }
 
+// A sparse accessor (glTF 3.6.2.3): its base elements (or zeros, without a buffer view) with the
+// elements its indices name replaced by its values.
+TEST(GltfTest, SparseAccessorsReplaceTheElementsTheyName) {
+  GltfBuilder b;
+  b.quad();
+  const int values = b.accessor({2, 2, 0, -2, 2, 0}, "VEC3");
+  const int indices = b.indices({2, 3}, 5123);
+  const json sparse = {{"count", 2},
+                       {"indices", {{"bufferView", b.doc["accessors"][indices]["bufferView"]}, {"componentType", 5123}}},
+                       {"values", {{"bufferView", b.doc["accessors"][values]["bufferView"]}}}};
+  const int position = b.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"];
+  b.doc["accessors"][position]["sparse"] = sparse;
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.triangles[0].v[0], glm::vec3(-1, -1, 0));  // vertex 0, as the buffer has it
+  EXPECT_EQ(s.triangles[0].v[2], glm::vec3(2, 2, 0));    // vertex 2, replaced
+  EXPECT_EQ(s.triangles[1].v[2], glm::vec3(-2, 2, 0));   // vertex 3, replaced
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+
+  // Without a buffer view the base is zeros (SimpleSparseAccessor's form); a .glb reads the same.
+  GltfBuilder z = b;
+  z.doc["accessors"][position].erase("bufferView");
+  for (const std::string& bytes : {z.gltf(), z.glb()}) {
+    const GltfScene zs = parse_gltf(bytes, "test.gltf");
+    ASSERT_EQ(zs.triangles.size(), 2u);
+    EXPECT_EQ(zs.triangles[0].v[0], glm::vec3(0, 0, 0));
+    EXPECT_EQ(zs.triangles[0].v[2], glm::vec3(2, 2, 0));
+  }
+
+  // Indices that do not increase, or name an element past the accessor, and too many substitutions.
+  GltfBuilder bad = b;
+  const int backwards = bad.indices({3, 2}, 5123);
+  bad.doc["accessors"][position]["sparse"]["indices"]["bufferView"] = bad.doc["accessors"][backwards]["bufferView"];
+  expect_error(bad, "accessors[" + std::to_string(position) + "].sparse.indices: index 2 at 1 does not increase on the one before");
+  const int past = bad.indices({2, 4}, 5123);
+  bad.doc["accessors"][position]["sparse"]["indices"]["bufferView"] = bad.doc["accessors"][past]["bufferView"];
+  expect_error(bad, "sparse.indices: index 4 at 1 is past the accessor's 4 elements");
+  bad.doc["accessors"][position]["sparse"]["count"] = 5;
+  expect_error(bad, "sparse.count: 5 substitutions for an accessor of 4 elements");
+  GltfBuilder strided = b;
+  strided.doc["bufferViews"][int(b.doc["accessors"][values]["bufferView"])]["byteStride"] = 12;
+  expect_error(strided, "has a byteStride; a sparse accessor's may not");
+}
+
+// Morph targets displace the mesh by their default weights: the node's, else the mesh's (glTF 3.7.2.2).
+TEST(GltfTest, MorphTargetsTakeTheNodesOrTheMeshsDefaultWeights) {
+  GltfBuilder b;
+  const int node = b.quad();
+  auto& primitive = b.doc["meshes"][0]["primitives"][0];
+  primitive["attributes"]["NORMAL"] = b.accessor({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3");
+  primitive["targets"] = {{{"POSITION", b.accessor({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3")}},
+                          {{"POSITION", b.accessor({0, 0, 0, 0, 0, 0, 0, 0, 0, 4, 0, 0}, "VEC3")},
+                           {"NORMAL", b.accessor({1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0}, "VEC3")}}};
+  const GltfScene rest = parse(b.gltf());  // no weights: as stored
+  EXPECT_EQ(rest.triangles[0].v[0], glm::vec3(-1, -1, 0));
+  b.doc["meshes"][0]["weights"] = {0.5, 0.25};
+  const GltfScene mesh = parse(b.gltf());
+  ASSERT_EQ(mesh.triangles.size(), 2u);
+  EXPECT_EQ(mesh.triangles[0].v[0], glm::vec3(-1, -1, 0.5f));
+  EXPECT_EQ(mesh.triangles[1].v[2], glm::vec3(0, 1, 0.5f));  // vertex 3: x -1 + 0.25 * 4
+  // Normals are displaced too, then made unit: (0.25, 0, 1) / |...|.
+  EXPECT_NEAR(mesh.triangles[0].normals[0].x, 0.25f / std::sqrt(1.0625f), 1e-6f);
+  EXPECT_TRUE(mesh.warnings.empty()) << mesh.warnings[0];
+  b.doc["nodes"][node]["weights"] = {2, 0};
+  const GltfScene by_node = parse(b.gltf());
+  EXPECT_EQ(by_node.triangles[0].v[0], glm::vec3(-1, -1, 2));
+  EXPECT_EQ(by_node.triangles[1].v[2], glm::vec3(-1, 1, 2));
+  // An animation of the weights is not played, and a warning says so.
+  b.doc["animations"] = {{{"channels", {{{"sampler", 0}, {"target", {{"node", node}, {"path", "weights"}}}}}},
+                          {"samplers", {{{"input", b.accessor({0, 1}, "SCALAR")}, {"output", b.accessor({0, 0, 1, 1}, "SCALAR")}}}}}};
+  const GltfScene animated = parse(b.gltf());
+  EXPECT_EQ(animated.triangles[0].v[0], by_node.triangles[0].v[0]);
+  ASSERT_EQ(animated.warnings.size(), 1u);
+  EXPECT_NE(animated.warnings[0].find("animations: 1 animations are not played: the file is shown at rest"), std::string::npos)
+      << animated.warnings[0];
+  b.doc["nodes"][node]["weights"] = {1};
+  expect_error(b, "nodes[0].weights: 1 weights for the 2 morph targets of meshes[0].primitives[0]");
+  b.doc["nodes"][node]["weights"] = {1, 1};
+  b.doc["meshes"][0]["primitives"][0]["targets"][1]["POSITION"] = b.accessor({0, 0, 0}, "VEC3");
+  expect_error(b, "meshes[0].primitives[0].targets[1].POSITION: 1 elements, where POSITION has 4");
+}
+
+// EXT_mesh_gpu_instancing: the node's mesh once per instance, each placed by its own translation,
+// rotation and scale and then by the node's transform.
+TEST(GltfTest, GpuInstancingPlacesTheMeshOncePerInstance) {
+  GltfBuilder b;
+  const int node = b.quad();
+  b.doc["nodes"][node]["translation"] = {0, 0, 5};
+  b.doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+  b.doc["extensionsRequired"] = {"EXT_mesh_gpu_instancing"};
+  b.doc["nodes"][node]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"] = {
+      {"TRANSLATION", b.accessor({0, 0, 0, 10, 0, 0, 0, 10, 0}, "VEC3")},
+      {"SCALE", b.accessor({1, 1, 1, 2, 2, 2, 1, 1, 1}, "VEC3")},
+      {"ROTATION", b.accessor({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0.7071067811865476f, 0.7071067811865476f}, "VEC4")},
+      {"_ID", b.accessor({0, 1, 2}, "SCALAR")}};
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.triangles.size(), 6u);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  EXPECT_EQ(s.triangles[0].v[0], glm::vec3(-1, -1, 5));
+  EXPECT_EQ(s.triangles[2].v[0], glm::vec3(8, -2, 5));  // corner (-1, -1) scaled by 2, then moved by 10
+  // Turned 90 degrees about z: (-1, -1) to (1, -1), moved up by 10.
+  EXPECT_NEAR(s.triangles[4].v[0].x, 1.0f, 1e-6f);
+  EXPECT_NEAR(s.triangles[4].v[0].y, 9.0f, 1e-6f);
+  b.doc["nodes"][node]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] = b.accessor({1, 1, 1}, "VEC3");
+  expect_error(b, "EXT_mesh_gpu_instancing.attributes.SCALE: 1 instances, where another attribute has 3");
+}
+
 TEST(GltfTest, AFlatteningScaleKeepsWhatStaysInThePlane) {
   GltfBuilder b;
   const int quad = b.quad();
@@ -724,7 +831,8 @@ TEST_F(GltfFileTest, TheFileAsAWholeSceneGetsACameraAndLight) {
   std::string all;
   for (const auto& w : framed.warnings) all += w + "\n";
   EXPECT_NE(all.find("no perspective camera"), std::string::npos) << all;
-  EXPECT_NE(all.find("the file brings no light: vkray adds a point light at the camera"), std::string::npos) << all;
+  EXPECT_NE(all.find("the file brings no light (emissive surfaces do not count): vkray adds a point light at the camera"),
+            std::string::npos) << all;
 
   b.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.6}, {"znear", 0.1}, {"aspectRatio", 1.5}}}}};
   b.doc["nodes"].push_back({{"camera", 0}, {"translation", {0, 0, 4}}});
@@ -735,7 +843,18 @@ TEST_F(GltfFileTest, TheFileAsAWholeSceneGetsACameraAndLight) {
   EXPECT_EQ(lit.camera.position, glm::vec3(0, 0, 4));
   EXPECT_EQ(lit.image.width, 768u);  // 512 high, 1.5 wide
   EXPECT_EQ(lit.image.height, 512u);
-  EXPECT_TRUE(lit.lights.empty());  // it emits: no light added
+  EXPECT_EQ(lit.lights.size(), 1u);  // emission does not count: the light at the camera is added
+
+  // A point light of its own: none added.
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 5}}};
+  b.doc["nodes"].push_back({{"translation", {0, 2, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  b.doc["scenes"][0]["nodes"].push_back(2);
+  test::write_file(dir_ / "lamp.gltf", b.gltf());
+  const Scene lamp = load_scene(dir_ / "lamp.gltf");
+  ASSERT_EQ(lamp.lights.size(), 1u);
+  EXPECT_EQ(lamp.lights[0].position, glm::vec3(0, 2, 2));
+  for (const auto& w : lamp.warnings) EXPECT_EQ(w.find("brings no light"), std::string::npos) << w;
 }
 
 // The shipped Khronos models: what each file holds, as their READMEs describe them.

@@ -29,8 +29,8 @@ using glm::dmat4;
 using glm::dvec3;
 
 // Extensions whose content vkray reads; a file that requires any other is refused.
-const std::set<std::string> kReadExtensions = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior",
-                                               "KHR_materials_transmission", "KHR_texture_transform"};
+const std::set<std::string> kReadExtensions = {"EXT_mesh_gpu_instancing", "KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                               "KHR_materials_ior", "KHR_materials_transmission", "KHR_texture_transform"};
 // Extensions that carry metadata only (XMP packets: authors, licences), with nothing to render.
 const std::set<std::string> kMetadataExtensions = {"KHR_xmp", "KHR_xmp_json_ld"};
 
@@ -49,7 +49,7 @@ struct Skip {
   std::string what;
 };
 
-// An accessor's elements, checked to lie inside their buffer.
+// An accessor's elements, checked to lie inside their buffer, with a sparse accessor's substitutions.
 struct AccessorView {
   const unsigned char* data = nullptr;  // null: every element is zero (an accessor without a buffer view)
   size_t count = 0;
@@ -57,11 +57,27 @@ struct AccessorView {
   int component_type = 0;
   int components = 0;
   bool normalized = false;
+  // A sparse accessor's (glTF 3.6.2.3): element sparse_indices[k] (strictly increasing) is the k-th
+  // element at sparse_values, tightly packed, instead of its element in `data`. Both hold as many
+  // entries as the file stores, so a small file describes no large allocation.
+  std::vector<uint32_t> sparse_indices;
+  const unsigned char* sparse_values = nullptr;
+
+  size_t element_size() const;
+  // Where element i's bytes are; null where it is zero.
+  const unsigned char* element(size_t i) const {
+    if (!sparse_indices.empty()) {
+      const auto at = std::lower_bound(sparse_indices.begin(), sparse_indices.end(), i);
+      if (at != sparse_indices.end() && *at == i) return sparse_values + size_t(at - sparse_indices.begin()) * element_size();
+    }
+    return data ? data + i * stride : nullptr;
+  }
+  bool all_zero() const { return !data && sparse_indices.empty(); }
 
   // Component c of element i, normalized integers mapped to [0, 1] or [-1, 1] as glTF defines.
   double get(size_t i, int c) const {
-    if (!data) return 0.0;
-    const unsigned char* p = data + i * stride;
+    const unsigned char* p = element(i);
+    if (!p) return 0.0;
     switch (component_type) {
       case TINYGLTF_COMPONENT_TYPE_FLOAT: {
         float f;
@@ -93,9 +109,10 @@ struct AccessorView {
     return 0.0;
   }
 
-  uint32_t index(size_t i) const {
-    if (!data) return 0;
-    const unsigned char* p = data + i * stride;
+  uint32_t index(size_t i) const { return index_at(element(i), component_type); }
+  // An unsigned index of the given component type at p (0 where p is null).
+  static uint32_t index_at(const unsigned char* p, int component_type) {
+    if (!p) return 0;
     if (component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) return p[0];
     if (component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
       uint16_t v;
@@ -105,6 +122,23 @@ struct AccessorView {
     uint32_t v;
     std::memcpy(&v, p, 4);
     return v;
+  }
+};
+
+// A vertex attribute with its morph targets' displacements added at their weights (glTF 3.7.2.2):
+// base + sum of weight * target, in double.
+struct MorphedAttribute {
+  AccessorView base;
+  std::vector<std::pair<double, AccessorView>> targets;  // those of a weight other than 0
+
+  double get(size_t i, int c) const {
+    double v = base.get(i, c);
+    for (const auto& [weight, target] : targets)
+      if (c < target.components) v += weight * target.get(i, c);  // a tangent's target has no w
+    return v;
+  }
+  bool all_zero() const {
+    return base.all_zero() && std::all_of(targets.begin(), targets.end(), [](const auto& t) { return t.second.all_zero(); });
   }
 };
 
@@ -122,6 +156,8 @@ size_t component_size(int type) {
   }
   return 0;
 }
+
+size_t AccessorView::element_size() const { return component_size(component_type) * size_t(components); }
 
 const char* type_name(int type) {
   switch (type) {
@@ -161,10 +197,22 @@ class GltfReader {
   // component must be normalized (texture coordinates).
   AccessorView accessor(int index, const std::string& where, std::initializer_list<int> types,
                         std::initializer_list<int> component_types, bool integers = false) const;
+  // The bytes of `count` elements of `element_size` from `byte_offset` in a buffer view, checked to lie
+  // inside it; `stride` receives the view's byteStride, or element_size where it has none. Null for 0.
+  const unsigned char* view_bytes(int buffer_view, size_t byte_offset, size_t element_size, size_t count, size_t* stride,
+                                  const std::string& name) const;
   dmat4 local_transform(size_t node) const;
   void walk_nodes();
-  void add_mesh(size_t mesh_index, const dmat4& world);
-  void add_primitive(const tinygltf::Primitive& p, const std::string& where, const dmat4& world);
+  // The mesh of a node placed once for each instance its EXT_mesh_gpu_instancing lists.
+  void add_instances(size_t node, const dmat4& world);
+  // The mesh of a node (with its morph weights), placed by `world`.
+  void add_mesh(size_t node, const dmat4& world);
+  void add_primitive(const tinygltf::Primitive& p, const std::string& where, const dmat4& world, const std::vector<double>& weights);
+  // A primitive's attribute `name` with its morph targets' displacements at `weights`; nullopt where
+  // the primitive has no such attribute. Each has `vertices` elements.
+  std::optional<MorphedAttribute> attribute(const tinygltf::Primitive& p, const std::string& name, const std::string& where,
+                                            const std::vector<double>& weights, size_t vertices, std::initializer_list<int> types,
+                                            std::initializer_list<int> component_types) const;
   uint32_t material(int index, const std::string& where);
   TextureRef texture(const tinygltf::TextureInfo& info, const std::string& where, bool srgb);
   int32_t image_texture(int image, const std::string& where, bool srgb);
@@ -251,6 +299,33 @@ void GltfReader::warn_used_extensions() {
       warn_once("extension " + name, "extensionsUsed", printable(name) + " is not read; what it adds is not rendered");
 }
 
+const unsigned char* GltfReader::view_bytes(int buffer_view, size_t byte_offset, size_t element_size, size_t count, size_t* stride,
+                                            const std::string& name) const {
+  if (buffer_view < 0 || size_t(buffer_view) >= model_.bufferViews.size())
+    fail(name, "bufferViews[" + std::to_string(buffer_view) + "] does not exist (the file has " +
+                   std::to_string(model_.bufferViews.size()) + ")");
+  const tinygltf::BufferView& bv = model_.bufferViews[size_t(buffer_view)];
+  const std::string bv_name = element("bufferViews", size_t(buffer_view));
+  if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size())
+    fail(bv_name, "buffers[" + std::to_string(bv.buffer) + "] does not exist (the file has " + std::to_string(model_.buffers.size()) + ")");
+  const std::vector<unsigned char>& data = model_.buffers[size_t(bv.buffer)].data;
+  if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
+    fail(bv_name, "bytes " + std::to_string(bv.byteOffset) + " + " + std::to_string(bv.byteLength) + " run past the end of buffers[" +
+                      std::to_string(bv.buffer) + "] (" + std::to_string(data.size()) + " bytes)");
+  *stride = element_size;
+  if (bv.byteStride != 0) {
+    if (bv.byteStride < element_size) fail(bv_name, "byteStride " + std::to_string(bv.byteStride) + " is less than an element of " + name);
+    *stride = bv.byteStride;
+  }
+  if (count == 0) return nullptr;
+  const size_t room = bv.byteLength;
+  const bool fits = byte_offset <= room && element_size <= room - byte_offset && (count - 1) <= (room - byte_offset - element_size) / *stride;
+  if (!fits)
+    fail(name, std::to_string(count) + " elements from byte " + std::to_string(byte_offset) + " run past the end of " + bv_name + " (" +
+                   std::to_string(room) + " bytes)");
+  return data.data() + bv.byteOffset + byte_offset;
+}
+
 AccessorView GltfReader::accessor(int index, const std::string& where, std::initializer_list<int> types,
                                   std::initializer_list<int> component_types, bool integers) const {
   if (index < 0 || size_t(index) >= model_.accessors.size())
@@ -266,38 +341,42 @@ AccessorView GltfReader::accessor(int index, const std::string& where, std::init
     fail(name, "componentType " + std::to_string(a.componentType) + " is not one glTF allows here");
   if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && !integers && !a.normalized)
     fail(name, "integer components here must be normalized (KHR_mesh_quantization is not read)");
-  if (a.sparse.isSparse) throw Skip{"sparse", name + ": sparse accessors are not read"};
   AccessorView view;
   view.count = a.count;
   view.component_type = a.componentType;
   view.components = a.type == TINYGLTF_TYPE_SCALAR ? 1 : a.type;  // VEC2..VEC4 are 2..4
   view.normalized = a.normalized;
-  const size_t element_size = component_size(a.componentType) * size_t(view.components);
+  const size_t element_size = view.element_size();
   view.stride = element_size;
-  if (a.bufferView < 0) return view;  // zeros
-  if (size_t(a.bufferView) >= model_.bufferViews.size())
-    fail(name, "bufferViews[" + std::to_string(a.bufferView) + "] does not exist (the file has " +
-                   std::to_string(model_.bufferViews.size()) + ")");
-  const tinygltf::BufferView& bv = model_.bufferViews[size_t(a.bufferView)];
-  const std::string bv_name = element("bufferViews", size_t(a.bufferView));
-  if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size())
-    fail(bv_name, "buffers[" + std::to_string(bv.buffer) + "] does not exist (the file has " + std::to_string(model_.buffers.size()) + ")");
-  const std::vector<unsigned char>& data = model_.buffers[size_t(bv.buffer)].data;
-  if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
-    fail(bv_name, "bytes " + std::to_string(bv.byteOffset) + " + " + std::to_string(bv.byteLength) + " run past the end of buffers[" +
-                      std::to_string(bv.buffer) + "] (" + std::to_string(data.size()) + " bytes)");
-  if (bv.byteStride != 0) {
-    if (bv.byteStride < element_size) fail(bv_name, "byteStride " + std::to_string(bv.byteStride) + " is less than an element of " + name);
-    view.stride = bv.byteStride;
-  }
-  if (a.count > 0) {
-    const size_t room = bv.byteLength;
-    const bool fits = a.byteOffset <= room && element_size <= room - a.byteOffset &&
-                      (a.count - 1) <= (room - a.byteOffset - element_size) / view.stride;
-    if (!fits)
-      fail(name, std::to_string(a.count) + " elements from byte " + std::to_string(a.byteOffset) + " run past the end of " + bv_name +
-                     " (" + std::to_string(room) + " bytes)");
-    view.data = data.data() + bv.byteOffset + a.byteOffset;
+  if (a.bufferView >= 0) view.data = view_bytes(a.bufferView, a.byteOffset, element_size, a.count, &view.stride, name);
+  if (a.sparse.isSparse) {
+    // Indices and values tightly packed in views without a stride (glTF 3.6.2.3); the indices strictly
+    // increase and name elements of the accessor.
+    const std::string at = name + ".sparse";
+    const auto count = size_t(a.sparse.count);
+    if (count < 1 || count > a.count)
+      fail(at + ".count", std::to_string(a.sparse.count) + " substitutions for an accessor of " + std::to_string(a.count) + " elements");
+    const int index_type = a.sparse.indices.componentType;
+    if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      fail(at + ".indices.componentType", std::to_string(index_type) + " is not an unsigned integer type");
+    for (const auto& [view_index, what] : {std::pair{a.sparse.indices.bufferView, "indices"}, std::pair{a.sparse.values.bufferView, "values"}})
+      if (view_index >= 0 && size_t(view_index) < model_.bufferViews.size() && model_.bufferViews[size_t(view_index)].byteStride != 0)
+        fail(at + "." + what, element("bufferViews", size_t(view_index)) + " has a byteStride; a sparse accessor's may not");
+    size_t stride = 0;
+    const unsigned char* indices = view_bytes(a.sparse.indices.bufferView, size_t(std::max(a.sparse.indices.byteOffset, 0)),
+                                              component_size(index_type), count, &stride, at + ".indices");
+    view.sparse_values = view_bytes(a.sparse.values.bufferView, size_t(std::max(a.sparse.values.byteOffset, 0)), element_size, count,
+                                    &stride, at + ".values");
+    view.sparse_indices.reserve(count);
+    for (size_t k = 0; k < count; ++k) {
+      const uint32_t i = AccessorView::index_at(indices + k * component_size(index_type), index_type);
+      if (i >= a.count) fail(at + ".indices", "index " + std::to_string(i) + " at " + std::to_string(k) + " is past the accessor's " +
+                                                  std::to_string(a.count) + " elements");
+      if (!view.sparse_indices.empty() && i <= view.sparse_indices.back())
+        fail(at + ".indices", "index " + std::to_string(i) + " at " + std::to_string(k) + " does not increase on the one before");
+      view.sparse_indices.push_back(i);
+    }
   }
   return view;
 }
@@ -381,60 +460,147 @@ void GltfReader::walk_nodes() {
         fail(element("nodes", node) + ".mesh", "meshes[" + std::to_string(n.mesh) + "] does not exist (the file has " +
                                                   std::to_string(model_.meshes.size()) + ")");
       if (n.skin >= 0) warn_once("skin", element("nodes", node), "skins are not rendered: the mesh is shown in its bind pose");
-      add_mesh(size_t(n.mesh), world);
+      if (n.extensions.count("EXT_mesh_gpu_instancing"))
+        add_instances(node, world);
+      else
+        add_mesh(node, world);
     }
     for (auto child = n.children.rbegin(); child != n.children.rend(); ++child) stack.emplace_back(size_t(*child), world);
   }
 }
 
-void GltfReader::add_mesh(size_t mesh_index, const dmat4& world) {
+void GltfReader::add_instances(size_t node, const dmat4& world) {
+  // Each instance is the node's mesh placed by the instance's translation, rotation and scale (T R S),
+  // then by the node's world transform; absent attributes are the identity's.
+  const std::string where = element("nodes", node) + ".extensions.EXT_mesh_gpu_instancing";
+  const tinygltf::Value& ext = model_.nodes[node].extensions.at("EXT_mesh_gpu_instancing");
+  if (!ext.Has("attributes") || !ext.Get("attributes").IsObject()) fail(where, "expected an object \"attributes\"");
+  const tinygltf::Value& attributes = ext.Get("attributes");
+  std::optional<AccessorView> translation, rotation, scale;
+  size_t count = 0;
+  bool counted = false;
+  for (const std::string& key : attributes.Keys()) {
+    const tinygltf::Value& v = attributes.Get(key);
+    if (!v.IsInt()) fail(where + ".attributes." + key, "expected the index of an accessor");
+    const std::string at = where + ".attributes." + key;
+    std::optional<AccessorView>* slot = key == "TRANSLATION" ? &translation : key == "ROTATION" ? &rotation : key == "SCALE" ? &scale : nullptr;
+    if (!slot) continue;  // an application's own attribute (its name starts with an underscore): nothing to render
+    *slot = key == "ROTATION" ? accessor(v.GetNumberAsInt(), at, {TINYGLTF_TYPE_VEC4},
+                                         {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT})
+                              : accessor(v.GetNumberAsInt(), at, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+    if (counted && (*slot)->count != count)
+      fail(at, std::to_string((*slot)->count) + " instances, where another attribute has " + std::to_string(count));
+    count = (*slot)->count;
+    counted = true;
+  }
+  const auto finite = [&](const char* key, size_t i, std::initializer_list<double> values) {
+    for (const double v : values)
+      if (!(std::abs(v) <= FLT_MAX)) fail(where + ".attributes." + key, "instance " + std::to_string(i) + " is not finite");
+  };
+  for (size_t i = 0; i < count; ++i) {
+    if (i % 256 == 0) throw_if_interrupted();
+    dmat4 m(1.0);
+    if (translation) {
+      const dvec3 t(translation->get(i, 0), translation->get(i, 1), translation->get(i, 2));
+      finite("TRANSLATION", i, {t.x, t.y, t.z});
+      m = glm::translate(m, t);
+    }
+    if (rotation) {
+      const glm::dquat q(rotation->get(i, 3), rotation->get(i, 0), rotation->get(i, 1), rotation->get(i, 2));  // x, y, z, w
+      finite("ROTATION", i, {q.x, q.y, q.z, q.w});
+      if (!(glm::length(q) > 0)) fail(where + ".attributes.ROTATION", "instance " + std::to_string(i) + ": a zero quaternion is no rotation");
+      m *= glm::mat4_cast(glm::normalize(q));
+    }
+    if (scale) {
+      const dvec3 s(scale->get(i, 0), scale->get(i, 1), scale->get(i, 2));
+      finite("SCALE", i, {s.x, s.y, s.z});
+      m = glm::scale(m, s);
+    }
+    const size_t before = scene_.triangles.size();
+    add_mesh(node, world * m);
+    // A mesh that places nothing places nothing however often: the rest of a long list is not walked.
+    if (scene_.triangles.size() == before) break;
+  }
+}
+
+void GltfReader::add_mesh(size_t node, const dmat4& world) {
+  const auto mesh_index = size_t(model_.nodes[node].mesh);
   const tinygltf::Mesh& mesh = model_.meshes[mesh_index];
+  // The morph targets' weights: the node's, else the mesh's, else none (glTF 3.7.2.2); animations,
+  // which would change them, are not played.
+  const std::vector<double>& weights = model_.nodes[node].weights.empty() ? mesh.weights : model_.nodes[node].weights;
+  const std::string weights_at = model_.nodes[node].weights.empty() ? element("meshes", mesh_index) + ".weights" : element("nodes", node) + ".weights";
+  for (const double w : weights)
+    if (!(std::abs(w) <= 1e6)) fail(weights_at, "a weight that is not a number of at most 1e6 in magnitude");
   for (size_t p = 0; p < mesh.primitives.size(); ++p) {
     const std::string where = element("meshes", mesh_index) + "." + element("primitives", p);
+    if (!weights.empty() && weights.size() != mesh.primitives[p].targets.size())
+      fail(weights_at, std::to_string(weights.size()) + " weights for the " + std::to_string(mesh.primitives[p].targets.size()) +
+                           " morph targets of " + where);
     try {
-      add_primitive(mesh.primitives[p], where, world);
+      add_primitive(mesh.primitives[p], where, world, weights);
     } catch (const Skip& skip) {
       warn_once(skip.kind, "", skip.what + "; the primitive is left out");
     }
   }
 }
 
-void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& where, const dmat4& world) {
+std::optional<MorphedAttribute> GltfReader::attribute(const tinygltf::Primitive& p, const std::string& name, const std::string& where,
+                                                      const std::vector<double>& weights, size_t vertices, std::initializer_list<int> types,
+                                                      std::initializer_list<int> component_types) const {
+  const auto at = p.attributes.find(name);
+  if (at == p.attributes.end()) return std::nullopt;
+  MorphedAttribute a{accessor(at->second, where + ".attributes." + name, types, component_types), {}};
+  if (a.base.count != vertices)
+    fail(where + ".attributes." + name, std::to_string(a.base.count) + " elements, where POSITION has " + std::to_string(vertices));
+  // A target displaces positions, normals and tangents by 3-vectors (a tangent's w stays), and takes
+  // signed normalized integers for the rest (glTF 3.7.2.2).
+  const bool direction = name == "POSITION" || name == "NORMAL" || name == "TANGENT";
+  for (size_t t = 0; t < weights.size(); ++t) {
+    const auto target = p.targets[t].find(name);
+    if (weights[t] == 0.0 || target == p.targets[t].end()) continue;
+    const std::string target_at = where + "." + element("targets", t) + "." + name;
+    AccessorView d = direction ? accessor(target->second, target_at, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT})
+                               : accessor(target->second, target_at, types,
+                                          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                           TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+    if (d.count != vertices) fail(target_at, std::to_string(d.count) + " elements, where POSITION has " + std::to_string(vertices));
+    a.targets.emplace_back(weights[t], std::move(d));
+  }
+  return a;
+}
+
+void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& where, const dmat4& world, const std::vector<double>& weights) {
   const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
   if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
     if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP)
       throw Skip{"points and lines", where + ": points and lines (mode " + std::to_string(mode) + ") are not rendered"};
     fail(where + ".mode", "unknown mode " + std::to_string(mode));
   }
-  if (!p.targets.empty()) warn_once("morph targets", where, "morph targets are not rendered: the mesh is shown unmorphed");
   const auto position_at = p.attributes.find("POSITION");
   if (position_at == p.attributes.end()) fail(where + ".attributes", "no POSITION");
-  const AccessorView positions = accessor(position_at->second, where + ".attributes.POSITION", {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
-  if (!positions.data) return;  // every vertex at the origin: nothing to see
-  const size_t vertices = positions.count;
+  const size_t vertices = model_.accessors.size() > size_t(std::max(position_at->second, 0)) ? model_.accessors[size_t(position_at->second)].count : 0;
+  const std::optional<MorphedAttribute> positions =
+      attribute(p, "POSITION", where, weights, vertices, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  if (positions->all_zero()) return;  // every vertex at the origin: nothing to see
 
   const uint32_t mat = material(p.material, where + ".material");
+  const std::optional<MorphedAttribute> normals =
+      attribute(p, "NORMAL", where, weights, vertices, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
   const int set = texcoord_sets_[p.material];
-  std::optional<AccessorView> normals, uvs;
-  if (const auto at = p.attributes.find("NORMAL"); at != p.attributes.end())
-    normals = accessor(at->second, where + ".attributes.NORMAL", {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
   const std::string uv_name = "TEXCOORD_" + std::to_string(set);
+  std::optional<MorphedAttribute> uvs;
   if (scene_.materials[mat].textured()) {
-    if (const auto at = p.attributes.find(uv_name); at != p.attributes.end())
-      uvs = accessor(at->second, where + ".attributes." + uv_name, {TINYGLTF_TYPE_VEC2},
-                     {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
-    else
+    uvs = attribute(p, uv_name, where, weights, vertices, {TINYGLTF_TYPE_VEC2},
+                    {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+    if (!uvs)
       warn_once("no " + uv_name, where + ".attributes", "no " + uv_name + " for its material's texture: every point takes the texture's value at (0, 0)");
   }
   // Tangents where the material has a normal map and the primitive has normals (without them, glTF
   // says a file's tangents are ignored); MikkTSpace's otherwise (load/scene_loader.cpp).
-  std::optional<AccessorView> tangents;
+  std::optional<MorphedAttribute> tangents;
   if (normals && scene_.materials[mat].normal_texture.present())
-    if (const auto at = p.attributes.find("TANGENT"); at != p.attributes.end())
-      tangents = accessor(at->second, where + ".attributes.TANGENT", {TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
-  for (const auto* a : {normals ? &*normals : nullptr, uvs ? &*uvs : nullptr, tangents ? &*tangents : nullptr})
-    if (a && a->count != vertices)
-      fail(where + ".attributes", "an attribute has " + std::to_string(a->count) + " elements, POSITION has " + std::to_string(vertices));
+    tangents = attribute(p, "TANGENT", where, weights, vertices, {TINYGLTF_TYPE_VEC4}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
 
   // The corners: indexed, or the vertices in order.
   std::optional<AccessorView> indices;
@@ -473,7 +639,7 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
   const glm::dmat3 normal_matrix = det < 0 ? -cofactor : cofactor;
   const bool mirrored = det < 0;
   const auto position = [&](uint32_t v) {
-    const dvec3 p_local(positions.get(v, 0), positions.get(v, 1), positions.get(v, 2));
+    const dvec3 p_local(positions->get(v, 0), positions->get(v, 1), positions->get(v, 2));
     if (!std::isfinite(p_local.x) || !std::isfinite(p_local.y) || !std::isfinite(p_local.z))
       fail(where + ".attributes.POSITION", "vertex " + std::to_string(v) + " is not finite");
     return glm::vec3(dvec3(world * glm::dvec4(p_local, 1.0)));
@@ -868,6 +1034,9 @@ GltfScene GltfReader::read(std::string_view bytes) {
   }
   scene_.files = files.read();
   warn_used_extensions();
+  if (!model_.animations.empty())
+    warn_once("animations", "animations", std::to_string(model_.animations.size()) +
+                                              " animations are not played: the file is shown at rest (its nodes' transforms, its default morph weights)");
   walk_nodes();
   return std::move(scene_);
 }

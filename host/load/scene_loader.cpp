@@ -172,9 +172,9 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
   if (aspect > 0.0f)
     scene.image.width = uint32_t(std::clamp(std::lround(double(scene.image.height) * aspect), 1l, long(kMaxImageSide)));
   // A file that brings no light is lit from the camera, so that it is seen at all (docs/scene-format.md):
-  // a point light whose irradiance at the scene's centre, straight on, is 1.
-  const bool emitters = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissive(); });
-  if (scene.lights.empty() && !emitters && !scene.triangles.empty()) {
+  // a point light whose irradiance at the scene's centre, straight on, is 1. Emissive surfaces do not
+  // count: a model's glowing parts (a helmet's visor lights) rarely light the rest of it.
+  if (scene.lights.empty() && !scene.triangles.empty()) {
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (const Triangle& t : scene.triangles)
       for (const glm::vec3& p : t.v) {
@@ -183,7 +183,7 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
       }
     const float distance = std::max(glm::length((lo + hi) / 2.0f - scene.camera.position), 1e-6f);
     scene.lights.push_back(PointLight{scene.camera.position, glm::vec3(glm::pi<float>() * distance * distance)});
-    scene.warnings.push_back(file.string() + ": the file brings no light: vkray adds a point light at the camera");
+    scene.warnings.push_back(file.string() + ": the file brings no light (emissive surfaces do not count): vkray adds a point light at the camera");
   }
   finish_scene(scene);
   return scene;

@@ -17,7 +17,7 @@ namespace vkray {
 Scene load_scene(const std::filesystem::path& file, MeshCache* meshes = nullptr);
 
 // A glTF file (.gltf or .glb, gltf/gltf.h) as a whole scene: its first camera, or one that frames its
-// geometry from the front; its point lights, or a point light at the camera when it brings no light;
+// geometry from the front; its point lights, or a point light at the camera when it brings none (emission aside);
 // a 512-pixel-high image in its camera's aspect ratio; the direct model. load_scene calls it for a
 // file with either extension.
 Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes = nullptr);
