@@ -410,6 +410,29 @@ TEST(GltfTest, TransmissionIsThinWalledWithItsFactorAndTheRedOfItsTexture) {
   }
 }
 
+// KHR_materials_unlit: the base colour (factor times texture) is what the surface sends, and it
+// scatters nothing; its alpha stays.
+TEST(GltfTest, AnUnlitMaterialShowsItsBaseColourAndScattersNothing) {
+  GltfBuilder b;
+  const int texture = b.texture(test::png_bytes(test::four_colours()));
+  b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", texture}}}, {"baseColorFactor", {0.5, 1, 0.25, 0.5}}}},
+                     {"alphaMode", "BLEND"}, {"emissiveFactor", {1, 1, 1}}, {"extensions", {{"KHR_materials_unlit", json::object()}}}}));
+  b.doc["extensionsUsed"] = {"KHR_materials_unlit"};
+  b.doc["extensionsRequired"] = {"KHR_materials_unlit"};
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.materials.size(), 1u);
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.type, MaterialType::diffuse);
+  EXPECT_EQ(m.albedo, glm::vec3(0.0f));
+  EXPECT_EQ(m.emission, glm::vec3(0.5f, 1.0f, 0.25f));  // the base colour, not the emissive factor
+  EXPECT_EQ(m.emission_texture.texture, 0);
+  EXPECT_FALSE(m.albedo_texture.present());
+  EXPECT_EQ(m.alpha_mode, AlphaMode::blend);
+  EXPECT_EQ(m.opacity, 0.5f);
+  EXPECT_EQ(m.opacity_texture.texture, 0);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+}
+
 TEST(GltfTest, AMaterialsTexturesShareTheFirstTexturesCoordinateSet) {
   // The first texture read gives the set; one that asks for another is named in one warning.
   GltfBuilder b;

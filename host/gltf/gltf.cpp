@@ -29,8 +29,9 @@ using glm::dmat4;
 using glm::dvec3;
 
 // Extensions whose content vkray reads; a file that requires any other is refused.
-const std::set<std::string> kReadExtensions = {"EXT_mesh_gpu_instancing", "KHR_lights_punctual", "KHR_materials_emissive_strength",
-                                               "KHR_materials_ior", "KHR_materials_transmission", "KHR_texture_transform"};
+const std::set<std::string> kReadExtensions = {"EXT_mesh_gpu_instancing",    "KHR_lights_punctual",        "KHR_materials_emissive_strength",
+                                               "KHR_materials_ior",          "KHR_materials_transmission", "KHR_materials_unlit",
+                                               "KHR_texture_transform"};
 // Extensions that carry metadata only (XMP packets: authors, licences), with nothing to render.
 const std::set<std::string> kMetadataExtensions = {"KHR_xmp", "KHR_xmp_json_ld"};
 
@@ -808,6 +809,23 @@ uint32_t GltfReader::material(int index, const std::string& where) {
       fail(name + ".pbrMetallicRoughness.baseColorFactor", "an alpha outside [0, 1]");
     m.opacity = float(pbr.baseColorFactor[3]);
     if (m.alpha_mode != AlphaMode::opaque) m.opacity_texture = m.albedo_texture;
+    if (g.extensions.count("KHR_materials_unlit")) {
+      // KHR_materials_unlit: the surface shows its base colour (factor times texture) and scatters
+      // nothing; its other properties are for lit materials and are not used. Its base colour becomes
+      // its emission, seen from its front as every emission is, and lighting the rest like any other.
+      Material unlit;
+      unlit.name = m.name;
+      unlit.type = MaterialType::diffuse;
+      unlit.albedo = glm::vec3(0.0f);
+      unlit.emission = m.albedo;
+      unlit.emission_texture = m.albedo_texture;
+      unlit.double_sided = m.double_sided;
+      unlit.alpha_mode = m.alpha_mode;
+      unlit.opacity = m.opacity;
+      unlit.alpha_cutoff = m.alpha_cutoff;
+      unlit.opacity_texture = m.opacity_texture;
+      m = std::move(unlit);
+    }
   }
   const auto at = uint32_t(scene_.materials.size());
   scene_.materials.push_back(std::move(m));
