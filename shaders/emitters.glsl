@@ -54,6 +54,10 @@ LightPoint sample_area_light(inout uint stream) {
     bool sphere = SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u;  // spheres have no texture coordinates
     if (!sphere && has_texture(emission_texture)) light.radiance *= sample_texture(emission_texture, slot, triangle_texcoord(prim, w.yz));
   }
+  // An unlit emitter's vertex colours are part of its base colour, which it emits.
+  if (SCENE_HAS_VERTEX_COLOURS && (flags & VKRAY_PRIM_COLOURED) != 0u &&
+      vertex_colours_emit_of(texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_OPACITY)))
+    light.radiance *= vertex_colour(prim, w.yz).rgb;
   // Of a see-through emitter, only the part that is there sends light (shared/materials.h, alpha_coverage).
   if (SCENE_HAS_ALPHA && (flags & VKRAY_PRIM_ALPHA) != 0u) {
     vec4 alpha;

@@ -15,6 +15,13 @@ float intersect_primitive(Ray ray, RayShear shear, vec4 a, vec4 b, vec4 c, float
   return intersect_triangle(ray, shear, a.xyz, b.xyz, c.xyz, t_min, t_max);
 }
 
+// ---- Vertex colours (shared/scene_layout.h) ----------------------------------------------------------------
+// The colour of the coloured triangle in slot `prim` at barycentrics b: its vertices' interpolated.
+vec4 vertex_colour(uint prim, vec2 b) {
+  int base = int(prim) * VKRAY_TEXELS_PER_PRIMITIVE;
+  return (1.0 - b.x - b.y) * texelFetch(colours, base) + b.x * texelFetch(colours, base + 1) + b.y * texelFetch(colours, base + 2);
+}
+
 // ---- Alpha (shared/materials.h) ----------------------------------------------------------------------------
 // The opacity of the primitive in slot `prim`, its flags `flags`, at barycentrics b (a triangle's; a
 // sphere has no texture coordinates, and its material's factor is its opacity); `alpha`: its
@@ -27,6 +34,7 @@ float opacity_at(uint prim, uint flags, vec2 b, out vec4 alpha) {
     vec4 header = texelFetch(materials, material + VKRAY_MATERIAL_OPACITY_TEXTURE);
     if (has_texture(header)) opacity *= sample_texture_rgba(header, material + VKRAY_MATERIAL_OPACITY_TEXTURE, triangle_texcoord(prim, b)).a;
   }
+  if (SCENE_HAS_VERTEX_COLOURS && (flags & VKRAY_PRIM_COLOURED) != 0u) opacity *= vertex_colour(prim, b).a;
   return opacity;
 }
 
@@ -147,13 +155,21 @@ Surface hit_surface(Hit hit, Ray ray) {
   }
   bool textured = SCENE_HAS_TEXTURES && (has_texture(albedo_texture) || has_texture(emission_texture) || has_texture(layers_texture) ||
                                          has_texture(normal_texture) || has_texture(transmission_texture));
-  if (!smooth_normals && !textured) return s;
+  bool coloured = SCENE_HAS_VERTEX_COLOURS && (flags & VKRAY_PRIM_COLOURED) != 0u;
+  if (!smooth_normals && !textured && !coloured) return s;
   vec2 b = triangle_hit_barycentrics(ray, a.xyz, v1, v2);
+  if (coloured) {  // glTF's COLOR_0: it multiplies the base colour, which an unlit material emits
+    vec3 colour = vertex_colour(hit.prim, b).rgb;
+    if (vertex_colours_emit_of(texelFetch(materials, material + VKRAY_MATERIAL_OPACITY)))
+      s.emission *= colour;
+    else
+      s.albedo *= colour;
+  }
   if (smooth_normals)
     s.shading_normal = normalize((1.0 - b.x - b.y) * texelFetch(normals, base).xyz + b.x * texelFetch(normals, base + 1).xyz +
                                  b.y * texelFetch(normals, base + 2).xyz);
   if (textured) {
-    vec2 uv = triangle_texcoord(hit.prim, b);
+    TexCoords uv = triangle_texcoord(hit.prim, b);
     if (has_texture(albedo_texture)) s.albedo *= sample_texture(albedo_texture, material + VKRAY_MATERIAL_ALBEDO_TEXTURE, uv);
     if (has_texture(emission_texture)) s.emission *= sample_texture(emission_texture, material + VKRAY_MATERIAL_EMISSION_TEXTURE, uv);
     if (has_texture(layers_texture)) {  // glTF's metallicRoughnessTexture: metalness in blue, roughness in green

@@ -17,6 +17,7 @@ layout(set = 0, binding = VKRAY_BINDING_EMITTERS) uniform samplerBuffer emitters
 layout(set = 0, binding = VKRAY_BINDING_TEXCOORDS) uniform samplerBuffer texcoords;
 layout(set = 0, binding = VKRAY_BINDING_TEXTURES) uniform samplerBuffer textures;
 layout(set = 0, binding = VKRAY_BINDING_TANGENTS) uniform samplerBuffer tangents;
+layout(set = 0, binding = VKRAY_BINDING_COLOURS) uniform samplerBuffer colours;
 
 // The frame's constants as every function reads them: a private copy of the uniform block, made
 // by load_frame() before anything else in main. llvmpipe reads a uniform block lane by lane at

@@ -27,11 +27,19 @@ int wrap_texel(int i, int size, uint wrap) {
 
 vec4 texture_fetch(TextureHeader t, int x, int y) { return texelFetch(textures, int(t.first + uint(y) * t.width + uint(x))); }
 
+// A primitive's two texture coordinate sets at a point: a texture reads the one its header names.
+struct TexCoords {
+  vec2 first;
+  vec2 second;
+};
+
 // The texture of the material's texture slot whose first texel (the header, texture_texel) is
-// header_texel, at index `slot` in the materials buffer, at the primitive's texture coordinate uv:
-// mapped by the slot's transform first where the header says it has one. Colour and alpha.
-vec4 sample_texture_rgba(vec4 header_texel, int slot, vec2 uv) {
+// header_texel, at index `slot` in the materials buffer, at the primitive's texture coordinates:
+// the set the header names, mapped by the slot's transform first where the header says it has one.
+// Colour and alpha.
+vec4 sample_texture_rgba(vec4 header_texel, int slot, TexCoords coords) {
   TextureHeader t = texture_header(header_texel);
+  vec2 uv = texture_texcoord_set(t.mode) == 0u ? coords.first : coords.second;
   if (texture_transformed(t.mode)) {
     vec3 p = vec3(uv, 1.0);
     uv = vec2(dot(texelFetch(materials, slot + 1).xyz, p), dot(texelFetch(materials, slot + 2).xyz, p));
@@ -54,17 +62,20 @@ vec4 sample_texture_rgba(vec4 header_texel, int slot, vec2 uv) {
 }
 
 // The same, colour only.
-vec3 sample_texture(vec4 header_texel, int slot, vec2 uv) { return sample_texture_rgba(header_texel, slot, uv).rgb; }
+vec3 sample_texture(vec4 header_texel, int slot, TexCoords coords) { return sample_texture_rgba(header_texel, slot, coords).rgb; }
 
 // Whether a material texel names a texture (its width is not 0).
 bool has_texture(vec4 header_texel) { return floatBitsToUint(header_texel.y) != 0u; }
 
-// The texture coordinate at barycentrics (b1, b2) of the triangle in primitive slot `prim`.
-vec2 triangle_texcoord(uint prim, vec2 b) {
+// The two texture coordinate sets at barycentrics (b1, b2) of the triangle in primitive slot `prim`.
+TexCoords triangle_texcoord(uint prim, vec2 b) {
   int base = int(prim) * VKRAY_TEXELS_PER_TEXCOORDS;
-  vec4 first = texelFetch(texcoords, base);
-  vec2 uv2 = texelFetch(texcoords, base + 1).xy;
-  return (1.0 - b.x - b.y) * first.xy + b.x * first.zw + b.y * uv2;
+  vec4 t0 = texelFetch(texcoords, base), t1 = texelFetch(texcoords, base + 1), t2 = texelFetch(texcoords, base + 2);
+  float b0 = 1.0 - b.x - b.y;
+  TexCoords c;
+  c.first = b0 * t0.xy + b.x * t0.zw + b.y * t1.xy;
+  c.second = b0 * t1.zw + b.x * t2.xy + b.y * t2.zw;
+  return c;
 }
 
 #endif

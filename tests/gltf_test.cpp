@@ -433,20 +433,68 @@ TEST(GltfTest, AnUnlitMaterialShowsItsBaseColourAndScattersNothing) {
   EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
 }
 
-TEST(GltfTest, AMaterialsTexturesShareTheFirstTexturesCoordinateSet) {
-  // The first texture read gives the set; one that asks for another is named in one warning.
+TEST(GltfTest, TexturesReadTheirOwnTextureCoordinateSets) {
+  // The first two sets a material's textures name become the triangles' uv and uv1, in the order its
+  // textures are read; a third is named in one warning and reads the first.
   GltfBuilder b;
   const int picture = b.texture(test::png_bytes({1, 1, {128, 128, 128}}));
-  b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", picture}}},
-                                               {"metallicRoughnessTexture", {{"index", picture}, {"texCoord", 1}}}}},
-                     {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1}, {"transmissionTexture", {{"index", picture}, {"texCoord", 1}}}}}}}}));
+  b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", picture}, {"texCoord", 1}}},
+                                               {"metallicRoughnessTexture", {{"index", picture}}}}},
+                     {"emissiveTexture", {{"index", picture}, {"texCoord", 1}}}, {"emissiveFactor", {1, 1, 1}},
+                     {"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1}, {"transmissionTexture", {{"index", picture}, {"texCoord", 2}}}}}}}}));
   b.doc["extensionsUsed"] = {"KHR_materials_transmission"};
+  auto& attributes = b.doc["meshes"][0]["primitives"][0]["attributes"];
+  attributes["TEXCOORD_1"] = b.accessor({5, 6, 7, 8, 9, 10, 11, 12}, "VEC2");
+  attributes["TEXCOORD_2"] = b.accessor({0, 0, 0, 0, 0, 0, 0, 0}, "VEC2");
   const GltfScene s = parse(b.gltf());
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.albedo_texture.texcoord, 0u);  // TEXCOORD_1, read first: uv
+  EXPECT_EQ(m.emission_texture.texcoord, 0u);
+  EXPECT_EQ(m.metallic_roughness_texture.texcoord, 1u);  // TEXCOORD_0: uv1
+  EXPECT_EQ(m.transmission_texture.texcoord, 0u);        // TEXCOORD_2: a third, read as the first
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.triangles[0].uv[1], glm::vec2(7, 8));   // vertex 1 of TEXCOORD_1
+  EXPECT_EQ(s.triangles[0].uv1[1], glm::vec2(1, 1));  // vertex 1 of the quad's TEXCOORD_0
   ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("the metallicRoughnessTexture's texCoord differs from the other textures': all use TEXCOORD_0"),
+  EXPECT_NE(s.warnings[0].find("the transmissionTexture reads TEXCOORD_2; vkray reads two sets for a material's textures (here "
+                               "TEXCOORD_1 and TEXCOORD_0), and it reads TEXCOORD_1"),
             std::string::npos)
       << s.warnings[0];
-  EXPECT_TRUE(s.materials[0].transmission_texture.present());
+}
+
+// COLOR_0: normalized integers or floats, three components or four, each clamped to [0, 1]; white
+// where a primitive has none.
+TEST(GltfTest, VertexColoursAreReadAsTheSpecificationSays) {
+  GltfBuilder b;
+  b.quad();
+  b.doc["accessors"].push_back({{"bufferView", 0}, {"componentType", 5121}, {"normalized", true}, {"count", 4}, {"type", "VEC4"}});
+  std::string bytes = {char(255), 0, 0, char(255), 0, char(51), 0, char(255), 0, 0, char(255), char(128), char(255), char(255), char(255), 0};
+  while (b.bin.size() % 4) b.bin += '\0';
+  b.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", b.bin.size()}, {"byteLength", bytes.size()}});
+  b.bin += bytes;
+  const int bytes_accessor = int(b.doc["accessors"].size()) - 1;
+  b.doc["accessors"][bytes_accessor]["bufferView"] = int(b.doc["bufferViews"].size()) - 1;
+  b.doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = bytes_accessor;
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.triangles.size(), 2u);
+  EXPECT_EQ(s.triangles[0].colours[0], glm::vec4(1, 0, 0, 1));
+  EXPECT_EQ(s.triangles[0].colours[1], glm::vec4(0, 0.2f, 0, 1));
+  EXPECT_EQ(s.triangles[0].colours[2], glm::vec4(0, 0, 1, 128 / 255.0f));
+  EXPECT_EQ(s.triangles[1].colours[2], glm::vec4(1, 1, 1, 0));
+  EXPECT_TRUE(s.triangles[0].coloured());
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  // Floats, three components: alpha 1, and a value past 1 clamped.
+  b.doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = b.accessor({1.5f, 0.5f, 0, 0, 0, 0, 0, 0, 0, 0.25f, 0.25f, 0.25f}, "VEC3");
+  const GltfScene f = parse(b.gltf());
+  EXPECT_EQ(f.triangles[0].colours[0], glm::vec4(1, 0.5f, 0, 1));
+  EXPECT_EQ(f.triangles[1].colours[2], glm::vec4(0.25f, 0.25f, 0.25f, 1));
+  // None: white.
+  b.doc["meshes"][0]["primitives"][0]["attributes"].erase("COLOR_0");
+  EXPECT_FALSE(parse(b.gltf()).triangles[0].coloured());
+  // Integers that are not normalized are not colours.
+  b.doc["accessors"][bytes_accessor]["normalized"] = false;
+  b.doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = bytes_accessor;
+  expect_error(b, "COLOR_0: accessors[" + std::to_string(bytes_accessor) + "]: integer components here must be normalized");
 }
 
 TEST(GltfTest, AMetallicRoughnessTextureIsLinearDataWhereTheSamePictureAsBaseColourIsSrgb) {
@@ -916,6 +964,34 @@ TEST(ShippedGltfTest, KhronosModelsLoadAsDescribed) {
   const GltfScene cameras = load_gltf(dir / "Cameras/glTF/Cameras.gltf");
   ASSERT_TRUE(cameras.camera);  // the perspective one
   EXPECT_NEAR(cameras.camera->focal_length, 0.5f / std::tan(0.35f), 1e-5f);  // yfov 0.7
+  // The models of glTF's rarer features: each read whole, with nothing warned of but what is not
+  // rendered (SimpleMorph's animation).
+  const GltfScene instancing = load_gltf(dir / "SimpleInstancing/glTF-Binary/SimpleInstancing.glb");
+  EXPECT_EQ(instancing.triangles.size(), 125u * 12u);  // 125 cubes of one mesh
+  EXPECT_TRUE(instancing.warnings.empty()) << instancing.warnings[0];
+  const GltfScene sparse = load_gltf(dir / "SimpleSparseAccessor/glTF-Embedded/SimpleSparseAccessor.gltf");
+  float top = 0;
+  for (const Triangle& t : sparse.triangles)
+    for (const glm::vec3& v : t.v) top = std::max(top, v.y);
+  EXPECT_EQ(top, 4.0f);  // the highest substituted vertex, (5, 4, 0)
+  EXPECT_TRUE(sparse.warnings.empty()) << sparse.warnings[0];
+  const GltfScene morph = load_gltf(dir / "SimpleMorph/glTF-Embedded/SimpleMorph.gltf");
+  ASSERT_EQ(morph.triangles.size(), 1u);
+  // The mesh's weights 0.5 and 0.5: the apex (0.5, 0.5, 0) moved by half of each target's (0, 1, 0).
+  const std::array<glm::vec3, 3>& v = morph.triangles[0].v;
+  EXPECT_TRUE(std::find(v.begin(), v.end(), glm::vec3(0.5f, 1.5f, 0.0f)) != v.end()) << v[0].y << " " << v[1].y << " " << v[2].y;
+  ASSERT_EQ(morph.warnings.size(), 1u);
+  EXPECT_NE(morph.warnings[0].find("animations are not played"), std::string::npos) << morph.warnings[0];
+  const GltfScene unlit = load_gltf(dir / "UnlitTest/glTF-Binary/UnlitTest.glb");
+  ASSERT_EQ(unlit.materials.size(), 2u);
+  for (const Material& m : unlit.materials) EXPECT_TRUE(m.vertex_colours_emit && m.albedo == glm::vec3(0.0f) && m.emissive());
+  const GltfScene colours = load_gltf(dir / "VertexColorTest/glTF-Binary/VertexColorTest.glb");
+  EXPECT_TRUE(std::any_of(colours.triangles.begin(), colours.triangles.end(), [](const Triangle& t) { return t.coloured(); }));
+  EXPECT_TRUE(colours.warnings.empty()) << colours.warnings[0];
+  const GltfScene uv = load_gltf(dir / "MultiUVTest/glTF-Binary/MultiUVTest.glb");
+  ASSERT_FALSE(uv.materials.empty());
+  EXPECT_NE(uv.materials[0].albedo_texture.texcoord, uv.materials[0].emission_texture.texcoord);
+  EXPECT_TRUE(uv.warnings.empty()) << uv.warnings[0];
 }
 
 }  // namespace

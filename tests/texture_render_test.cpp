@@ -212,7 +212,14 @@ INSTANTIATE_TEST_SUITE_P(Khronos, ShippedModelTest,
                                            "NormalTangentTest/glTF/NormalTangentTest.gltf",
                                            "NormalTangentMirrorTest/glTF/NormalTangentMirrorTest.gltf", "TwoSidedPlane/glTF/TwoSidedPlane.gltf",
                                            "AlphaBlendModeTest/glTF/AlphaBlendModeTest.gltf",
-                                           "TransmissionTest/glTF-Binary/TransmissionTest.glb"),
+                                           "TransmissionTest/glTF-Binary/TransmissionTest.glb",
+                                           "BoxVertexColors/glTF-Binary/BoxVertexColors.glb",
+                                           "VertexColorTest/glTF-Binary/VertexColorTest.glb",
+                                           "SimpleSparseAccessor/glTF-Embedded/SimpleSparseAccessor.gltf",
+                                           "SimpleMorph/glTF-Embedded/SimpleMorph.gltf",
+                                           "SimpleInstancing/glTF-Binary/SimpleInstancing.glb", "UnlitTest/glTF-Binary/UnlitTest.glb",
+                                           "MultiUVTest/glTF-Binary/MultiUVTest.glb",
+                                           "TextureEncodingTest/glTF-Binary/TextureEncodingTest.glb"),
                          [](const auto& p) {
                            std::string name = std::filesystem::path(p.param).parent_path().string();
                            for (char& c : name)

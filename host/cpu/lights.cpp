@@ -91,10 +91,13 @@ LightPoint Lights::sample_area_light(uint32_t& stream) const {
   light.pdf_area = area_pdf(m.emission);
   if (p < scene.triangles.size() && m.emission_texture.present()) {
     const Triangle& t = scene.triangles[p];
-    light.radiance *= sample_texture(scene, m.emission_texture, b.x * glm::dvec2(t.uv[0]) + b.y * glm::dvec2(t.uv[1]) + b.z * glm::dvec2(t.uv[2]));
+    light.radiance *= sample_texture(scene, m.emission_texture, triangle_texcoord(t, m.emission_texture, b.y, b.z));
   }
+  // An unlit emitter's vertex colours are part of its base colour, which it emits.
+  if (p < scene.triangles.size() && m.vertex_colours_emit && scene.triangles[p].coloured())
+    light.radiance *= dvec3(vertex_colour(scene.triangles[p], b.y, b.z));
   // Of a see-through emitter, only the part that is there sends light.
-  if (m.see_through())
+  if (p < scene.triangles.size() ? scene.see_through(scene.triangles[p]) : m.see_through())
     light.radiance *= double(gpu::alpha_coverage(uint32_t(m.alpha_mode), float(opacity_at(scene, p, b.y, b.z)), m.alpha_cutoff));
   return light;
 }

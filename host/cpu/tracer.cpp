@@ -70,9 +70,14 @@ double opacity_at(const Scene& scene, size_t p, double u, double v) {
   if (p >= scene.triangles.size()) return scene.materials[scene.spheres[p - scene.triangles.size()].material].opacity;
   const Triangle& tri = scene.triangles[p];
   const Material& m = scene.materials[tri.material];
-  if (!m.opacity_texture.present()) return m.opacity;
-  const glm::dvec2 uv = (1 - u - v) * glm::dvec2(tri.uv[0]) + u * glm::dvec2(tri.uv[1]) + v * glm::dvec2(tri.uv[2]);
-  return m.opacity * sample_texture_rgba(scene, m.opacity_texture, uv).a;
+  double opacity = m.opacity;
+  if (m.opacity_texture.present()) opacity *= sample_texture_rgba(scene, m.opacity_texture, triangle_texcoord(tri, m.opacity_texture, u, v)).a;
+  if (tri.coloured()) opacity *= vertex_colour(tri, u, v).a;
+  return opacity;
+}
+
+glm::dvec4 vertex_colour(const Triangle& tri, double u, double v) {
+  return (1 - u - v) * glm::dvec4(tri.colours[0]) + u * glm::dvec4(tri.colours[1]) + v * glm::dvec4(tri.colours[2]);
 }
 
 uint32_t Tracer::alpha_key(uint32_t& stream) const { return see_through_ ? gpu::next_word(stream) : 0; }
@@ -92,7 +97,7 @@ bool Tracer::solid(const Ray& ray, const Hit& hit, uint32_t alpha_key) const {
   const auto p = size_t(hit.primitive);
   const bool sphere = p >= scene_.triangles.size();
   const Material& m = scene_.materials[sphere ? scene_.spheres[p - scene_.triangles.size()].material : scene_.triangles[p].material];
-  if (!m.see_through()) return true;
+  if (sphere ? !m.see_through() : !scene_.see_through(scene_.triangles[p])) return true;
   // A sphere is two surfaces to a ray: the side it enters by and the side it leaves by.
   const bool far_side =
       sphere && glm::dot(ray.dir, ray.origin + hit.t * ray.dir - dvec3(scene_.spheres[p - scene_.triangles.size()].center)) > 0;
@@ -213,16 +218,19 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
   if (tri.smooth)
     s.shading_normal = glm::normalize((1 - hit.u - hit.v) * dvec3(tri.normals[0]) + hit.u * dvec3(tri.normals[1]) +
                                       hit.v * dvec3(tri.normals[2]));
+  // Vertex colours (glTF's COLOR_0) multiply the base colour, which an unlit material emits.
+  if (tri.coloured()) (m.vertex_colours_emit ? s.emission : s.albedo) *= dvec3(vertex_colour(tri, hit.u, hit.v));
   if (!m.textured()) return s;
-  const glm::dvec2 uv = (1 - hit.u - hit.v) * glm::dvec2(tri.uv[0]) + hit.u * glm::dvec2(tri.uv[1]) + hit.v * glm::dvec2(tri.uv[2]);
-  if (m.albedo_texture.present()) s.albedo *= sample_texture(scene_, m.albedo_texture, uv);
-  if (m.emission_texture.present()) s.emission *= sample_texture(scene_, m.emission_texture, uv);
+  // Each texture at the texture coordinate of the set it reads.
+  const auto at = [&](const TextureRef& ref) { return sample_texture(scene_, ref, triangle_texcoord(tri, ref, hit.u, hit.v)); };
+  if (m.albedo_texture.present()) s.albedo *= at(m.albedo_texture);
+  if (m.emission_texture.present()) s.emission *= at(m.emission_texture);
   if (m.metallic_roughness_texture.present()) {  // metalness in blue, roughness in green
-    const dvec3 layers = sample_texture(scene_, m.metallic_roughness_texture, uv);
+    const dvec3 layers = at(m.metallic_roughness_texture);
     s.metallic *= layers.b;
     s.roughness *= layers.g;
   }
-  if (m.transmission_texture.present()) s.transmission *= sample_texture(scene_, m.transmission_texture, uv).r;
+  if (m.transmission_texture.present()) s.transmission *= at(m.transmission_texture).r;
   // A normal map in MikkTSpace's frame: the tangent interpolated and not normalized, the bitangent
   // its sign times normal x tangent, the map's red and green scaled (glTF's formula).
   if (m.normal_texture.present() && tri.has_tangents()) {
@@ -234,7 +242,7 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
       sign += weight[k] * double(tri.tangents[k].w);
     }
     const dvec3 bitangent = (sign < 0 ? -1.0 : 1.0) * glm::cross(s.shading_normal, tangent);
-    const dvec3 mapped = (2.0 * sample_texture(scene_, m.normal_texture, uv) - 1.0) * dvec3(m.normal_scale, m.normal_scale, 1.0);
+    const dvec3 mapped = (2.0 * at(m.normal_texture) - 1.0) * dvec3(m.normal_scale, m.normal_scale, 1.0);
     const dvec3 n = mapped.x * tangent + mapped.y * bitangent + mapped.z * s.shading_normal;
     if (glm::dot(n, n) > 0) s.shading_normal = n / std::sqrt(glm::dot(n, n));
   }

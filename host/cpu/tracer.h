@@ -58,8 +58,11 @@ Facing facing(const SurfacePoint& s, const dvec3& dir, bool front);
 dvec3 valid_reflection_normal(const dvec3& ng, const dvec3& wo, const dvec3& n);
 
 // The opacity of primitive p (the scene's numbering) at barycentrics (u, v) of a triangle: its
-// material's factor times its opacity texture's alpha (a sphere's: the factor).
+// material's factor times its opacity texture's alpha times its vertex colours' (a sphere's: the factor).
 double opacity_at(const Scene& scene, size_t p, double u, double v);
+
+// A triangle's vertex colour at barycentrics (u, v).
+glm::dvec4 vertex_colour(const Triangle& tri, double u, double v);
 
 class Tracer {
  public:

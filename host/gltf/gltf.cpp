@@ -226,7 +226,7 @@ class GltfReader {
   GltfScene scene_;
   std::set<std::string> warned_;
   std::map<int, uint32_t> materials_;     // glTF material (-1: the default) -> scene_.materials
-  std::map<int, int> texcoord_sets_;      // glTF material -> the TEXCOORD_n its textures use
+  std::map<int, std::vector<int>> texcoord_sets_;  // glTF material -> the TEXCOORD_n its textures read, as uv and uv1
   // A picture is decoded once for each way it is read: as sRGB colour, or as linear data.
   std::map<std::pair<int, bool>, int32_t> image_textures_;  // (glTF image, sRGB) -> scene_.textures
   std::map<std::pair<std::string, bool>, int32_t> sources_;  // (where its bytes are: "view 3", "file /x/y.png"; sRGB) -> scene_.textures
@@ -588,15 +588,23 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
   const uint32_t mat = material(p.material, where + ".material");
   const std::optional<MorphedAttribute> normals =
       attribute(p, "NORMAL", where, weights, vertices, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
-  const int set = texcoord_sets_[p.material];
-  const std::string uv_name = "TEXCOORD_" + std::to_string(set);
-  std::optional<MorphedAttribute> uvs;
-  if (scene_.materials[mat].textured()) {
-    uvs = attribute(p, uv_name, where, weights, vertices, {TINYGLTF_TYPE_VEC2},
-                    {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
-    if (!uvs)
-      warn_once("no " + uv_name, where + ".attributes", "no " + uv_name + " for its material's texture: every point takes the texture's value at (0, 0)");
+  // The texture coordinate sets the material's textures read, as uv and uv1.
+  std::array<std::optional<MorphedAttribute>, 2> uvs;
+  std::array<std::string, 2> uv_names;
+  const std::vector<int> sets = scene_.materials[mat].textured() ? texcoord_sets_[p.material] : std::vector<int>{};
+  for (size_t k = 0; k < sets.size(); ++k) {
+    uv_names[k] = "TEXCOORD_" + std::to_string(sets[k]);
+    uvs[k] = attribute(p, uv_names[k], where, weights, vertices, {TINYGLTF_TYPE_VEC2},
+                       {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+    if (!uvs[k])
+      warn_once("no " + uv_names[k], where + ".attributes",
+                "no " + uv_names[k] + " for its material's texture: every point takes the texture's value at (0, 0)");
   }
+  // COLOR_0 multiplies the base colour (its alpha the base colour's alpha); later sets are for an
+  // application's own use (glTF 3.7.2.1).
+  const std::optional<MorphedAttribute> colours =
+      attribute(p, "COLOR_0", where, weights, vertices, {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4},
+                {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
   // Tangents where the material has a normal map and the primitive has normals (without them, glTF
   // says a file's tangents are ignored); MikkTSpace's otherwise (load/scene_loader.cpp).
   std::optional<MorphedAttribute> tangents;
@@ -661,10 +669,20 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
     const float sign = (t.w < 0) != mirrored ? -1.0f : 1.0f;
     return length > 0 && std::isfinite(length) ? glm::vec4(glm::vec3(d / length), sign) : glm::vec4(0.0f);
   };
-  const auto uv = [&](uint32_t v) {
-    const glm::dvec2 t(uvs->get(v, 0), uvs->get(v, 1));
+  // A colour's components in [0, 1] (a float file's, or a morphed one's, may stray; glTF allows clamping).
+  const auto colour = [&](uint32_t v) {
+    glm::vec4 c(1.0f);
+    for (int k = 0; k < colours->base.components; ++k) {
+      const double x = colours->get(v, k);
+      if (!std::isfinite(x)) fail(where + ".attributes.COLOR_0", "colour " + std::to_string(v) + " is not finite");
+      c[k] = float(std::clamp(x, 0.0, 1.0));
+    }
+    return c;
+  };
+  const auto uv = [&](size_t set, uint32_t v) {
+    const glm::dvec2 t(uvs[set]->get(v, 0), uvs[set]->get(v, 1));
     if (!(std::abs(t.x) <= kMaxCoordinate && std::abs(t.y) <= kMaxCoordinate))
-      fail(where + ".attributes." + uv_name, "texture coordinate " + std::to_string(v) + " is not finite or past +-1e9");
+      fail(where + ".attributes." + uv_names[set], "texture coordinate " + std::to_string(v) + " is not finite or past +-1e9");
     return glm::vec2(t);
   };
   reserve_more(scene_.triangles, triangles);
@@ -685,7 +703,9 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
     for (size_t k = 0; k < 3; ++k) {
       tri.v[k] = position(c[k]);
       if (normals) tri.normals[k] = normal(c[k]);
-      if (uvs) tri.uv[k] = uv(c[k]);
+      if (uvs[0]) tri.uv[k] = uv(0, c[k]);
+      if (uvs[1]) tri.uv1[k] = uv(1, c[k]);
+      if (colours) tri.colours[k] = colour(c[k]);
     }
     tri.smooth = normals.has_value() && std::all_of(tri.normals.begin(), tri.normals.end(), [](const glm::vec3& n) { return n != glm::vec3(0.0f); });
     // A triangle with a zero tangent at a corner, or not smooth, takes MikkTSpace's instead.
@@ -746,26 +766,35 @@ uint32_t GltfReader::material(int index, const std::string& where) {
              "emissiveFactor times emissiveStrength passes the largest 32-bit float (3.4e38)");
       m.emission = glm::vec3(emission);
     }
-    // A material's textures share one texture coordinate set: the first texture read gives it, and
-    // one that asks for another is named in a warning.
-    std::optional<int> set;
-    const auto share_set = [&](const tinygltf::TextureInfo& info, const char* which) {
-      if (!set) set = texcoord_of(info);
-      else if (texcoord_of(info) != *set)
-        warn_once("texcoord sets", name, std::string("the ") + which + "'s texCoord differs from the other textures': all use TEXCOORD_" +
-                                             std::to_string(*set));
+    // The texture coordinate sets its textures read: the first two distinct ones, in the order the
+    // textures are read here, become the triangles' uv and uv1 (TextureRef::texcoord 0 and 1); a
+    // texture that asks for a third is named in a warning and reads the first.
+    std::vector<int> sets;
+    const auto set_of = [&](const tinygltf::TextureInfo& info, const char* which) -> uint32_t {
+      const int set = texcoord_of(info);
+      if (set < 0 || set > 7) fail(name + "." + which, "texCoord " + std::to_string(set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
+      for (size_t i = 0; i < sets.size(); ++i)
+        if (sets[i] == set) return uint32_t(i);
+      if (sets.size() < 2) {
+        sets.push_back(set);
+        return uint32_t(sets.size() - 1);
+      }
+      warn_once("texcoord sets", name, std::string("the ") + which + " reads TEXCOORD_" + std::to_string(set) +
+                                           "; vkray reads two sets for a material's textures (here TEXCOORD_" + std::to_string(sets[0]) +
+                                           " and TEXCOORD_" + std::to_string(sets[1]) + "), and it reads TEXCOORD_" + std::to_string(sets[0]));
+      return 0;
     };
     if (pbr.baseColorTexture.index >= 0) {
       m.albedo_texture = texture(pbr.baseColorTexture, name + ".pbrMetallicRoughness.baseColorTexture", true);
-      share_set(pbr.baseColorTexture, "baseColorTexture");
+      m.albedo_texture.texcoord = set_of(pbr.baseColorTexture, "baseColorTexture");
     }
     if (g.emissiveTexture.index >= 0 && m.emission != glm::vec3(0.0f)) {
       m.emission_texture = texture(g.emissiveTexture, name + ".emissiveTexture", true);
-      share_set(g.emissiveTexture, "emissiveTexture");
+      m.emission_texture.texcoord = set_of(g.emissiveTexture, "emissiveTexture");
     }
     if (pbr.metallicRoughnessTexture.index >= 0) {  // data, not colour: linear
       m.metallic_roughness_texture = texture(pbr.metallicRoughnessTexture, name + ".pbrMetallicRoughness.metallicRoughnessTexture", false);
-      share_set(pbr.metallicRoughnessTexture, "metallicRoughnessTexture");
+      m.metallic_roughness_texture.texcoord = set_of(pbr.metallicRoughnessTexture, "metallicRoughnessTexture");
     }
     if (g.normalTexture.index >= 0) {  // data, not colour: linear
       tinygltf::TextureInfo info;
@@ -776,7 +805,7 @@ uint32_t GltfReader::material(int index, const std::string& where) {
       if (!(std::abs(g.normalTexture.scale) <= 1e6))
         fail(name + ".normalTexture.scale", "expected a number of at most 1e6 in magnitude, got " + brief(nlohmann::json(g.normalTexture.scale)));
       m.normal_scale = float(g.normalTexture.scale);
-      share_set(info, "normalTexture");
+      m.normal_texture.texcoord = set_of(info, "normalTexture");
     }
     if (const auto ext = g.extensions.find("KHR_materials_transmission"); ext != g.extensions.end()) {
       // Thin-walled, as the extension is without KHR_materials_volume (which vkray does not read): the
@@ -792,12 +821,10 @@ uint32_t GltfReader::material(int index, const std::string& where) {
         if (t.Has("extensions"))
           for (const std::string& key : t.Get("extensions").Keys()) info.extensions[key] = t.Get("extensions").Get(key);
         m.transmission_texture = texture(info, name + "." + at + ".transmissionTexture", false);
-        share_set(info, "transmissionTexture");
+        m.transmission_texture.texcoord = set_of(info, "transmissionTexture");
       }
     }
-    if (set.value_or(0) < 0 || set.value_or(0) > 7)
-      fail(name, "texCoord " + std::to_string(*set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
-    texcoord_sets_[index] = set.value_or(0);
+    texcoord_sets_[index] = sets;
     if (g.occlusionTexture.index >= 0) warn_once("occlusionTexture", name, "occlusion textures are not rendered (light transport computes occlusion)");
     // Alpha: the base colour's, factor times texture (the texture's alpha, or 1 where it has none).
     // (gltf_schema.cpp has checked the mode's name.)
@@ -824,6 +851,7 @@ uint32_t GltfReader::material(int index, const std::string& where) {
       unlit.opacity = m.opacity;
       unlit.alpha_cutoff = m.alpha_cutoff;
       unlit.opacity_texture = m.opacity_texture;
+      unlit.vertex_colours_emit = true;
       m = std::move(unlit);
     }
   }

@@ -33,6 +33,7 @@ constexpr BindingSlot kTraceBindings[] = {
     {VKRAY_BINDING_TEXCOORDS, kTexel, "texcoords"},
     {VKRAY_BINDING_TEXTURES, kTexel, "textures"},
     {VKRAY_BINDING_TANGENTS, kTexel, "tangents"},
+    {VKRAY_BINDING_COLOURS, kTexel, "colours"},
 };
 
 // Two rows of one id would give the shader's constant whichever value Vulkan takes first.

@@ -61,7 +61,8 @@ TexelBuffer make_texture_buffer(const Context& ctx, const std::vector<uint16_t>&
 // Refuses, before allocating anything, a scene whose buffers cannot fit the device's memory.
 void check_memory(const Context& ctx, const PackedScene& packed) {
   uint64_t texels = packed.nodes.size();
-  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.texcoords, &packed.tangents, &packed.materials, &packed.lights, &packed.emitters})
+  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.texcoords, &packed.tangents, &packed.colours, &packed.materials,
+                             &packed.lights, &packed.emitters})
     texels = checked_add(texels, buffer->size(), "scene buffers");
   const uint64_t bytes = checked_add(checked_mul(texels, sizeof(glm::vec4), "scene buffers"),
                                      checked_mul(packed.textures.size(), sizeof(uint16_t), "textures"), "scene buffers");
@@ -78,7 +79,7 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
 }  // namespace
 
 struct SceneBuffers::Geometry {
-  TexelBuffer primitives, normals, nodes, texcoords, textures, tangents;
+  TexelBuffer primitives, normals, nodes, texcoords, textures, tangents, colours;
   std::vector<uint32_t> order;  // the BVH's leaf order: the lighting's area lights name slots in it
 };
 
@@ -101,6 +102,7 @@ SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<c
   primitive_count_ = uint32_t(bvh.order.size());
   const PackedScene packed = pack_scene(*scene_, bvh);
   vertex_normals_ = !packed.normals.empty();
+  vertex_colours_ = !packed.colours.empty();
   if (primitive_count_ <= kMaxInlinePrimitives) inline_scene_ = inline_scene_glsl(packed);
   check_memory(*ctx_, packed);
   geometry_ = std::make_shared<const Geometry>(Geometry{make_texel_buffer(*ctx_, packed.primitives, "primitive"),
@@ -108,7 +110,8 @@ SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<c
                                                         make_texel_buffer(*ctx_, packed.nodes, "BVH node"),
                                                         make_texel_buffer(*ctx_, packed.texcoords, "texture coordinate"),
                                                         make_texture_buffer(*ctx_, packed.textures),
-                                                        make_texel_buffer(*ctx_, packed.tangents, "tangent"), bvh.order});
+                                                        make_texel_buffer(*ctx_, packed.tangents, "tangent"),
+                                                        make_texel_buffer(*ctx_, packed.colours, "vertex colour"), bvh.order});
   lighting_ = std::make_unique<Lighting>(*ctx_, packed);
   lighting_frame_ = packed.frame;
   // A BVH built beforehand (perhaps while the shaders compiled) still counts: the upload stage
@@ -123,7 +126,8 @@ SceneBuffers::SceneBuffers(const SceneBuffers& same, std::shared_ptr<const Scene
       primitive_count_(same.primitive_count_),
       inline_scene_(same.inline_scene_),
       shares_geometry_(true),
-      vertex_normals_(same.vertex_normals_) {
+      vertex_normals_(same.vertex_normals_),
+      vertex_colours_(same.vertex_colours_) {
   if (!same_geometry(same.scene(), *scene_)) throw InternalError("a scene shares the device buffers of one with other geometry");
   const auto start = Clock::now();
   const PackedLighting packed = pack_lighting(*scene_, geometry_->order);
@@ -143,7 +147,8 @@ void SceneBuffers::bind(DescriptorWriter& writer) const {
       .texel_buffer(VKRAY_BINDING_EMITTERS, *lighting_->emitters.view)
       .texel_buffer(VKRAY_BINDING_TEXCOORDS, *geometry_->texcoords.view)
       .texel_buffer(VKRAY_BINDING_TEXTURES, *geometry_->textures.view)
-      .texel_buffer(VKRAY_BINDING_TANGENTS, *geometry_->tangents.view);
+      .texel_buffer(VKRAY_BINDING_TANGENTS, *geometry_->tangents.view)
+      .texel_buffer(VKRAY_BINDING_COLOURS, *geometry_->colours.view);
 }
 
 }  // namespace vkray::gpu

@@ -41,6 +41,7 @@ class SceneBuffers {
   const LightingFrame& lighting() const { return lighting_frame_; }
   // Whether some triangle is shaded with its vertex normals (Triangle::smooth).
   bool vertex_normals() const { return vertex_normals_; }
+  bool vertex_colours() const { return vertex_colours_; }
 
   // Adds the scene's buffers at their bindings (shared/types.h).
   void bind(DescriptorWriter& writer) const;
@@ -58,6 +59,7 @@ class SceneBuffers {
   double bvh_seconds_ = 0, upload_seconds_ = 0;
   bool shares_geometry_ = false;
   bool vertex_normals_ = false;
+  bool vertex_colours_ = false;
 };
 
 }  // namespace vkray::gpu

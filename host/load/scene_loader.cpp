@@ -39,7 +39,8 @@ void apply_shared_texture_transforms(Scene& scene) {
   }
   for (Triangle& t : scene.triangles)
     if (shared[t.material])
-      for (glm::vec2& uv : t.uv) uv = glm::vec2(shared[t.material]->map(glm::dvec2(uv)));
+      for (auto* set : {&t.uv, &t.uv1})
+        for (glm::vec2& uv : *set) uv = glm::vec2(shared[t.material]->map(glm::dvec2(uv)));
   for (size_t i = 0; i < scene.materials.size(); ++i)
     if (shared[i])
       for (TextureRef* ref : scene.materials[i].textures()) ref->to_u = glm::vec3(1, 0, 0), ref->to_v = glm::vec3(0, 1, 0);
@@ -62,9 +63,11 @@ void recentre_texture_coordinates(Scene& scene) {
     };
     for (int axis = 0; axis < 2; ++axis) {
       if (!repeats(axis == 0)) continue;
-      const float lowest = std::min({t.uv[0][axis], t.uv[1][axis], t.uv[2][axis]});
-      const float shift = 2.0f * std::floor(lowest / 2.0f);
-      for (glm::vec2& uv : t.uv) uv[axis] -= shift;
+      for (auto* set : {&t.uv, &t.uv1}) {
+        const float lowest = std::min({(*set)[0][axis], (*set)[1][axis], (*set)[2][axis]});
+        const float shift = 2.0f * std::floor(lowest / 2.0f);
+        for (glm::vec2& uv : *set) uv[axis] -= shift;
+      }
     }
   }
 }
@@ -89,7 +92,7 @@ void add_missing_tangents(Scene& scene) {
     input.reserve(triangles.size());
     for (const size_t i : triangles) {
       const Triangle& t = scene.triangles[i];
-      TangentTriangle m{t.v, t.normals, t.uv};
+      TangentTriangle m{t.v, t.normals, t.texcoords(scene.materials[t.material].normal_texture.texcoord)};
       if (!t.smooth) {
         const glm::dvec3 n = glm::cross(glm::dvec3(t.v[1]) - glm::dvec3(t.v[0]), glm::dvec3(t.v[2]) - glm::dvec3(t.v[0]));
         const double length = glm::length(n);

@@ -76,12 +76,7 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
     if (!std::all_of(t.tangents.begin(), t.tangents.end(), [](const glm::vec4& corner) { return corner.w != 0.0f; })) t.tangents = {};
     if (t.smooth && !std::all_of(t.normals.begin(), t.normals.end(), [](const glm::vec3& n) { return std::isfinite(n.x) && glm::length(n) > 0.5f; }))
       t.smooth = false;
-    if (mirrors) {
-      std::swap(t.v[1], t.v[2]);
-      std::swap(t.normals[1], t.normals[2]);
-      std::swap(t.uv[1], t.uv[2]);
-      std::swap(t.tangents[1], t.tangents[2]);
-    }
+    if (mirrors) t.swap_corners();
   }
   add_triangles(at, placed);
   for (PointLight light : gltf.lights) {
@@ -308,9 +303,7 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
   }
   if (flip_normals(v))
     for (Triangle& t : triangles) {  // the other winding, and the vertex normals turned with it
-      std::swap(t.v[1], t.v[2]);
-      std::swap(t.normals[1], t.normals[2]);
-      std::swap(t.uv[1], t.uv[2]);
+      t.swap_corners();
       for (glm::vec3& n : t.normals) n = -n;
     }
   add_triangles(file_value, triangles);

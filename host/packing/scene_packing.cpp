@@ -225,6 +225,8 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
   if (normal_mapped) packed.tangents.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
   if (any_smooth) packed.normals.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
   if (textured) packed.texcoords.resize(bvh.order.size() * VKRAY_TEXELS_PER_TEXCOORDS, glm::vec4(0.0f));
+  const bool coloured = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.coloured(); });
+  if (coloured) packed.colours.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(1.0f));
   for_blocks(bvh.order.size(), [&](size_t begin, size_t end) {
     throw_if_interrupted();
     for (size_t slot = begin; slot < end; ++slot) {
@@ -234,7 +236,9 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
         const Triangle& t = scene.triangles[p];
         const Material& m = scene.materials[t.material];
         const uint32_t flags = t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u) | (m.double_sided ? 0u : VKRAY_PRIM_SINGLE_SIDED) |
-                               (m.see_through() ? VKRAY_PRIM_ALPHA : 0u);
+                               (scene.see_through(t) ? VKRAY_PRIM_ALPHA : 0u) | (t.coloured() ? VKRAY_PRIM_COLOURED : 0u);
+        if (t.coloured())
+          for (size_t k = 0; k < 3; ++k) packed.colours[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = t.colours[k];
         texels = triangle_texels(t.v[0], t.v[1], t.v[2], flags, p, t.object);
         if (t.smooth)
           for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
@@ -242,7 +246,8 @@ PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
           for (size_t k = 0; k < 3; ++k) packed.tangents[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = t.tangents[k];
         if (textured) {
           packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS] = glm::vec4(t.uv[0], t.uv[1]);
-          packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS + 1] = glm::vec4(t.uv[2], 0.0f, 0.0f);
+          packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS + 1] = glm::vec4(t.uv[2], t.uv1[0]);
+          packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS + 2] = glm::vec4(t.uv1[1], t.uv1[2]);
         }
       } else {
         const Sphere& sphere = scene.spheres[p - triangle_count];
@@ -305,7 +310,7 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     }
     const Texture& t = *scene.textures[size_t(ref.texture)];
     texels[0] = texture_texel(offsets[size_t(ref.texture)], t.width, t.height, uint32_t(ref.wrap_s), uint32_t(ref.wrap_t),
-                              uint32_t(ref.filter), ref.transformed() ? 1u : 0u);
+                              uint32_t(ref.filter), ref.transformed() ? 1u : 0u, ref.texcoord);
     texels[1] = glm::vec4(ref.to_u, 0.0f);
     texels[2] = glm::vec4(ref.to_v, 0.0f);
   };
@@ -324,8 +329,7 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     texture_slot(texels + VKRAY_MATERIAL_EMISSION_TEXTURE, m.emission_texture);
     texture_slot(texels + VKRAY_MATERIAL_LAYERS_TEXTURE, m.metallic_roughness_texture);
     texture_slot(texels + VKRAY_MATERIAL_NORMAL_TEXTURE, m.normal_texture);
-    texels[VKRAY_MATERIAL_OPACITY] =
-        opacity_texel(m.opacity, m.alpha_cutoff, uint32_t(m.see_through() ? m.alpha_mode : AlphaMode::opaque));
+    texels[VKRAY_MATERIAL_OPACITY] = opacity_texel(m.opacity, m.alpha_cutoff, uint32_t(m.alpha_mode), m.vertex_colours_emit);
     texture_slot(texels + VKRAY_MATERIAL_OPACITY_TEXTURE, m.opacity_texture);
     texture_slot(texels + VKRAY_MATERIAL_TRANSMISSION_TEXTURE, m.transmission_texture);
     // In double on the host, then one rounding: no 1 / total power in float that could overflow.

@@ -62,6 +62,7 @@ struct PackedGeometry {
   std::vector<glm::uvec4> nodes;      // VKRAY_TEXELS_PER_NODE texels each (pack_nodes)
   std::vector<glm::vec4> texcoords;   // VKRAY_TEXELS_PER_TEXCOORDS texels each; empty when nothing is textured
   std::vector<glm::vec4> tangents;    // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when no material has a normal map
+  std::vector<glm::vec4> colours;     // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when no triangle is coloured
   // Every texture's texels, in Scene::textures order: half floats, 4 a texel (an RGBA16F texel buffer).
   std::vector<uint16_t> textures;
 };

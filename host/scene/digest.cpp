@@ -13,9 +13,9 @@ static_assert(sizeof(Camera) == 48, "a Camera field is not in scene_digest");
 static_assert(sizeof(Integrator) == 12, "an Integrator field is not in scene_digest");
 static_assert(sizeof(PointLight) == 24, "a PointLight field is not in scene_digest");
 static_assert(sizeof(Sphere) == 28, "a Sphere field is not in scene_digest");
-static_assert(sizeof(Triangle) == 156, "a Triangle field is not in scene_digest");
-static_assert(sizeof(TextureRef) == 40, "a TextureRef field is not in scene_digest");
-static_assert(sizeof(Material) == 368, "a Material field is not in scene_digest");
+static_assert(sizeof(Triangle) == 228, "a Triangle field is not in scene_digest");
+static_assert(sizeof(TextureRef) == 44, "a TextureRef field is not in scene_digest");
+static_assert(sizeof(Material) == 400, "a Material field is not in scene_digest");
 static_assert(sizeof(Scene) == 376, "a Scene field is not in scene_digest");
 
 // Hasher with glm's vectors, component by component.
@@ -33,6 +33,7 @@ void add(SceneHasher& h, const TextureRef& t) {
   h.add(t.wrap_s);
   h.add(t.wrap_t);
   h.add(t.filter);
+  h.add(t.texcoord);
   h.add(t.to_u);
   h.add(t.to_v);
 }
@@ -42,7 +43,7 @@ void add(SceneHasher& h, const TextureRef& t) {
 std::string scene_digest(const Scene& scene) {
   auto h = std::make_unique<SceneHasher>();  // its buffer is too large for a thread's stack to hold lightly
   // A version of this layout: bump it when the order or the meaning of what is hashed changes.
-  h->add(std::string("vkray scene digest 8"));
+  h->add(std::string("vkray scene digest 9"));
   const Camera& c = scene.camera;
   h->add(c.position), h->add(c.forward), h->add(c.up), h->add(c.focal_length), h->add(c.aperture_radius),
       h->add(c.focus_distance);
@@ -61,6 +62,7 @@ std::string scene_digest(const Scene& scene) {
     h->add(m.alpha_mode), h->add(m.opacity), h->add(m.alpha_cutoff);
     add(*h, m.opacity_texture);
     add(*h, m.transmission_texture);
+    h->add(m.vertex_colours_emit);
   }
   h->add(uint64_t(scene.textures.size()));
   for (const auto& t : scene.textures) {
@@ -77,7 +79,9 @@ std::string scene_digest(const Scene& scene) {
     h->add(t.material), h->add(t.object), h->add(t.smooth);
     for (const glm::vec3& n : t.normals) h->add(n);
     for (const glm::vec2& uv : t.uv) h->add(uv);
+    for (const glm::vec2& uv : t.uv1) h->add(uv);
     for (const glm::vec4& tangent : t.tangents) h->add(tangent);
+    for (const glm::vec4& colour : t.colours) h->add(colour);
   }
   return h->hex();
 }

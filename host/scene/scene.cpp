@@ -42,7 +42,8 @@ bool same_bits(const glm::vec3& a, const glm::vec3& b) { return std::memcmp(&a, 
 bool same_bits(const Triangle& a, const Triangle& b) {
   for (size_t k = 0; k < 3; ++k)
     if (!same_bits(a.v[k], b.v[k]) || !same_bits(a.normals[k], b.normals[k]) ||
-        std::memcmp(&a.uv[k], &b.uv[k], sizeof(glm::vec2)) != 0 || std::memcmp(&a.tangents[k], &b.tangents[k], sizeof(glm::vec4)) != 0)
+        std::memcmp(&a.uv[k], &b.uv[k], sizeof(glm::vec2)) != 0 || std::memcmp(&a.uv1[k], &b.uv1[k], sizeof(glm::vec2)) != 0 ||
+        std::memcmp(&a.tangents[k], &b.tangents[k], sizeof(glm::vec4)) != 0 || std::memcmp(&a.colours[k], &b.colours[k], sizeof(glm::vec4)) != 0)
       return false;
   return a.material == b.material && a.object == b.object && a.smooth == b.smooth;
 }
@@ -71,7 +72,8 @@ bool same_geometry(const Scene& a, const Scene& b) {
   // A primitive's flags also say whether its material is single-sided, and whether it lets rays through.
   const auto same_primitive_flags = [&] {
     for (size_t i = 0; i < a.materials.size(); ++i)
-      if (a.materials[i].double_sided != b.materials[i].double_sided || a.materials[i].see_through() != b.materials[i].see_through())
+      if (a.materials[i].double_sided != b.materials[i].double_sided || a.materials[i].see_through() != b.materials[i].see_through() ||
+          a.materials[i].alpha_mode != b.materials[i].alpha_mode)  // with vertex colours' alpha, the mode decides too
         return false;
     return true;
   };

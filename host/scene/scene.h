@@ -130,6 +130,9 @@ struct Material {
   float alpha_cutoff = 0.5f;
   TextureRef opacity_texture;
   TextureRef transmission_texture;
+  // What a triangle's vertex colours multiply (Triangle::colours): its albedo, or (glTF's
+  // KHR_materials_unlit, whose base colour is its emission) its emission.
+  bool vertex_colours_emit = false;
 
   bool emissive() const { return emission != glm::vec3(0.0f); }
   // Every texture reference, for code that treats them alike.
@@ -185,12 +188,33 @@ struct Triangle {
   // Texture coordinates of the vertices, as glTF has them: (0, 0) is the top left corner of a
   // picture, (1, 1) its bottom right. All zero where the mesh has none.
   std::array<glm::vec2, 3> uv{};
+  // A second set, for the textures that read it (TextureRef::texcoord 1: a glTF material whose
+  // textures use two TEXCOORD_n). All zero where none does.
+  std::array<glm::vec2, 3> uv1{};
   // The vertices' tangents where the material has a normal map (glTF's TANGENT, or MikkTSpace's):
   // xyz the unit tangent along which u grows, w the bitangent's sign: bitangent = w cross(normal,
   // tangent), the direction in which v falls (up the picture). w 0: none.
   std::array<glm::vec4, 3> tangents{};
+  // The vertices' colours (glTF's COLOR_0), each component in [0, 1], interpolated across the
+  // triangle: rgb multiplies the material's base colour (Material::vertex_colours_emit says which),
+  // a its opacity. White where the mesh has none.
+  std::array<glm::vec4, 3> colours{glm::vec4(1.0f), glm::vec4(1.0f), glm::vec4(1.0f)};
 
   bool has_tangents() const { return tangents[0].w != 0.0f; }
+  // The texture coordinates of texture coordinate set `set` (TextureRef::texcoord).
+  const std::array<glm::vec2, 3>& texcoords(uint32_t set) const { return set == 0 ? uv : uv1; }
+  // Turns the winding around (the front face to the back) by swapping corners 1 and 2 of everything
+  // given per corner.
+  void swap_corners() {
+    std::swap(v[1], v[2]);
+    std::swap(normals[1], normals[2]);
+    std::swap(uv[1], uv[2]);
+    std::swap(uv1[1], uv1[2]);
+    std::swap(tangents[1], tangents[2]);
+    std::swap(colours[1], colours[2]);
+  }
+  bool coloured() const { return colours[0] != glm::vec4(1.0f) || colours[1] != glm::vec4(1.0f) || colours[2] != glm::vec4(1.0f); }
+  bool translucent_colours() const { return colours[0].a != 1.0f || colours[1].a != 1.0f || colours[2].a != 1.0f; }
 };
 
 struct Scene {
@@ -220,7 +244,14 @@ struct Scene {
   // Whether some material lets rays through (Material::see_through): every ray then draws a key
   // from its sample's stream (shared/sampling.h, alpha_random), on both renderers.
   bool see_through() const {
-    return std::any_of(materials.begin(), materials.end(), [](const Material& m) { return m.see_through(); });
+    return std::any_of(materials.begin(), materials.end(), [](const Material& m) { return m.see_through(); }) ||
+           std::any_of(triangles.begin(), triangles.end(), [&](const Triangle& t) { return see_through(t); });
+  }
+  // Whether a triangle lets some ray through: its material does, or the material blends or masks and
+  // the triangle's vertex colours are not all opaque.
+  bool see_through(const Triangle& t) const {
+    const Material& m = materials[t.material];
+    return m.see_through() || (m.alpha_mode != AlphaMode::opaque && t.translucent_colours());
   }
 };
 

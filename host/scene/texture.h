@@ -51,6 +51,8 @@ struct TextureRef {
   TextureWrap wrap_s = TextureWrap::repeat;  // along u (the picture's rows)
   TextureWrap wrap_t = TextureWrap::repeat;  // along v (its columns)
   TextureFilter filter = TextureFilter::linear;
+  // The primitive's texture coordinate set it reads: 0, Triangle::uv; 1, Triangle::uv1.
+  uint32_t texcoord = 0;
   // The affine map from a primitive's texture coordinate (u, v) to the texture's: u' = dot(to_u,
   // (u, v, 1)), v' = dot(to_v, (u, v, 1)) (glTF's KHR_texture_transform); the identity by default.
   glm::vec3 to_u{1.0f, 0.0f, 0.0f};

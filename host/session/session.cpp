@@ -185,6 +185,7 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   variant.shading_normals = scene.vertex_normals() || variant.normal_maps;
   variant.point_lights = !s.lights.empty();
   variant.background = variant.path && s.background != glm::vec3(0.0f);  // only paths sample it
+  variant.vertex_colours = scene.vertex_colours();
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))
     variant.inline_scene = scene.inline_scene();
   return variant;

@@ -119,8 +119,9 @@ struct MaterialValues {
 //                                     materials and normal-mapped ones
 //   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
 //                                     an emitter of this material, 0, 0, 0): scene/emitters.h
-//   VKRAY_MATERIAL_OPACITY:           (opacity factor, alpha cutoff, alpha mode as uint bits, 0): read
-//                                     only for primitives with VKRAY_PRIM_ALPHA (opacity_texel)
+//   VKRAY_MATERIAL_OPACITY:           (opacity factor, alpha cutoff, alpha mode as uint bits, 1 where vertex
+//                                     colours multiply the emission rather than the colour): read only for
+//                                     primitives with VKRAY_PRIM_ALPHA or VKRAY_PRIM_COLOURED (opacity_texel)
 // and six texture slots of VKRAY_TEXELS_PER_TEXTURE_SLOT texels each: the texture's header
 // (texture_texel in shared/scene_layout.h), then the two rows of the affine map from a primitive's
 // texture coordinate to the texture's (glTF's KHR_texture_transform), read only where the header says
@@ -193,9 +194,12 @@ VKRAY_INLINE MaterialValues material_values(MaterialValueTexels t) {
   return m;
 }
 
-// A material's alpha in its VKRAY_MATERIAL_OPACITY texel, and back.
-VKRAY_INLINE vec4 opacity_texel(float opacity, float cutoff, uint mode) { return vec4(opacity, cutoff, uintBitsToFloat(mode), 0.0f); }
+// A material's alpha, and what vertex colours multiply, in its VKRAY_MATERIAL_OPACITY texel, and back.
+VKRAY_INLINE vec4 opacity_texel(float opacity, float cutoff, uint mode, bool vertex_colours_emit) {
+  return vec4(opacity, cutoff, uintBitsToFloat(mode), vertex_colours_emit ? 1.0f : 0.0f);
+}
 VKRAY_INLINE uint alpha_mode_of(vec4 opacity_texel) { return floatBitsToUint(opacity_texel.z); }
+VKRAY_INLINE bool vertex_colours_emit_of(vec4 opacity_texel) { return opacity_texel.w != 0.0f; }
 
 VKRAY_SHARED_END
 

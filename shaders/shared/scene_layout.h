@@ -13,7 +13,7 @@ VKRAY_SHARED_BEGIN
 // A triangle is its vertices rather than its edges (every triangle sharing a vertex must see bitwise
 // the same coordinates for the watertight test); a sphere is its centre and radius. Each carries its
 // flags (material index | VKRAY_PRIM_SPHERE | VKRAY_PRIM_SMOOTH | VKRAY_PRIM_INWARD | VKRAY_PRIM_SINGLE_SIDED |
-// VKRAY_PRIM_ALPHA),
+// VKRAY_PRIM_ALPHA | VKRAY_PRIM_COLOURED),
 // its place in the scene, which decides ties (VKRAY_TIE), and the object it belongs to (the `object`
 // pass), as the bits of floats.
 #define VKRAY_TEXELS_PER_PRIMITIVE 3
@@ -24,7 +24,9 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_PRIM_SINGLE_SIDED 0x10000000u
 // A primitive of a material that lets rays through where its alpha says so (shared/materials.h).
 #define VKRAY_PRIM_ALPHA 0x08000000u
-#define VKRAY_PRIM_MATERIAL_MASK 0x07ffffffu
+// A triangle with vertex colours in the colours buffer.
+#define VKRAY_PRIM_COLOURED 0x04000000u
+#define VKRAY_PRIM_MATERIAL_MASK 0x03ffffffu
 
 struct PrimitiveTexels {
   vec4 a;  // triangle: (v0, flags);          sphere: (centre, flags)
@@ -57,13 +59,16 @@ VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 // texel per vertex (xyz), present only when some triangle is smooth.
 
 // Texture coordinates of textured triangles: a buffer in the same slots as the primitives,
-// VKRAY_TEXELS_PER_TEXCOORDS texels each, (u0, v0, u1, v1), (u2, v2, 0, 0), present only when some
-// material has a texture.
-#define VKRAY_TEXELS_PER_TEXCOORDS 2
+// VKRAY_TEXELS_PER_TEXCOORDS texels each, the first set's (u0, v0, u1, v1), (u2, v2, and the second
+// set's s0, t0), (s1, t1, s2, t2), present only when some material has a texture.
+#define VKRAY_TEXELS_PER_TEXCOORDS 3
 
 // Tangents of triangles whose material has a normal map: a buffer in the same slots as the
 // primitives, one texel per vertex, (unit tangent, bitangent sign) as scene/scene.h's Triangle has
 // them (sign 0: none), present only when some material has a normal map.
+// Vertex colours of coloured triangles (VKRAY_PRIM_COLOURED): a buffer in the same slots as the
+// primitives, one texel per vertex (rgba, each in [0, 1]), present only when some triangle is coloured.
+
 // ---- Materials: shared/materials.h ------------------------------------------------------------------
 
 // The material a primitive's flags name.
@@ -72,8 +77,9 @@ VKRAY_INLINE uint primitive_material(uint flags) { return flags & VKRAY_PRIM_MAT
 // ---- Textures: RGBA16F texels in one buffer, each texture's rows one after another ---------------------
 // A material names a texture by one texel, the bits of four uints: (its first texel in the buffer,
 // width, height, mode); width 0: no texture. mode = wrap_s | wrap_t << 2 | filter << 4 |
-// transformed << 5, with the values of vkray::TextureWrap and TextureFilter, which are glTF's sampler
-// modes; transformed: the two texels after it map the texture coordinate (shared/materials.h).
+// transformed << 5 | set << 6, with the values of vkray::TextureWrap and TextureFilter, which are glTF's
+// sampler modes; transformed: the two texels after it map the texture coordinate (shared/materials.h);
+// set: the primitive's texture coordinate set it reads (0 or 1, vkray::TextureRef::texcoord).
 #define VKRAY_WRAP_REPEAT 0u
 #define VKRAY_WRAP_CLAMP_TO_EDGE 1u
 #define VKRAY_WRAP_MIRRORED_REPEAT 2u
@@ -87,9 +93,10 @@ struct TextureHeader {
   uint mode;
 };
 
-VKRAY_INLINE vec4 texture_texel(uint first, uint width, uint height, uint wrap_s, uint wrap_t, uint filter_mode, uint transformed) {
+VKRAY_INLINE vec4 texture_texel(uint first, uint width, uint height, uint wrap_s, uint wrap_t, uint filter_mode, uint transformed,
+                                 uint set) {
   return vec4(uintBitsToFloat(first), uintBitsToFloat(width), uintBitsToFloat(height),
-              uintBitsToFloat(wrap_s | (wrap_t << 2u) | (filter_mode << 4u) | (transformed << 5u)));
+              uintBitsToFloat(wrap_s | (wrap_t << 2u) | (filter_mode << 4u) | (transformed << 5u) | (set << 6u)));
 }
 
 VKRAY_INLINE TextureHeader texture_header(vec4 t) {
@@ -105,6 +112,7 @@ VKRAY_INLINE uint texture_wrap_s(uint mode) { return mode & 3u; }
 VKRAY_INLINE uint texture_wrap_t(uint mode) { return (mode >> 2u) & 3u; }
 VKRAY_INLINE uint texture_filter(uint mode) { return (mode >> 4u) & 1u; }
 VKRAY_INLINE bool texture_transformed(uint mode) { return ((mode >> 5u) & 1u) != 0u; }
+VKRAY_INLINE uint texture_texcoord_set(uint mode) { return (mode >> 6u) & 1u; }
 
 // ---- Emissive primitives: the area lights, one RGBA32F texel each ------------------------------------
 // An alias table (Walker 1977) over the primitives whose material emits, each weighted by its power
