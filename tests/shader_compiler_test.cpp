@@ -98,6 +98,7 @@ TEST(ShaderCompilerTest, ReflectsTheBindingsTheShaderDeclares) {
       {VKRAY_BINDING_TEXCOORDS, {"texcoords", D::eUniformTexelBuffer}},
       {VKRAY_BINDING_TEXTURES, {"textures", D::eUniformTexelBuffer}},
       {VKRAY_BINDING_TANGENTS, {"tangents", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_COLOURS, {"colours", D::eUniformTexelBuffer}},
   };
   EXPECT_EQ(found, expected);
 }
