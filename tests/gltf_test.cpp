@@ -890,6 +890,36 @@ TEST_F(GltfFileTest, AnObjectOfAVkraySceneIsPlacedByItsTransform) {
   EXPECT_NE(missing.find("nothing.glb: glTF file not found"), std::string::npos) << missing;
 }
 
+// "instances": an object placed once for each transform in the list, each then placed by the
+// object's own "transform"; a mesh file and a glTF file alike, each read once.
+TEST_F(GltfFileTest, AnObjectIsPlacedOnceForEachOfItsInstances) {
+  test::write_file(dir_ / "quad.glb", textured_quad().glb());
+  test::write_file(dir_ / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  test::write_file(dir_ / "field.json", R"({"camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "vertical_fov": 40},
+    "materials": {"m": {"albedo": [1, 1, 1]}},
+    "objects": [{"type": "gltf", "file": "quad.glb", "transform": {"translate": [0, 0, 1]},
+                 "instances": [{"translate": [0, 0, 0]}, {"translate": [5, 0, 0]}, {"scale": 2, "translate": [0, 5, 0]}]},
+                {"type": "mesh", "file": "tri.obj", "material": "m", "transform": {"scale": 3},
+                 "instances": [{"translate": [1, 0, 0]}, {"matrix": [0, -1, 0, 0,  1, 0, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]}]}]})");
+  const Scene s = load_scene(dir_ / "field.json");
+  ASSERT_EQ(s.triangles.size(), 3u * 2u + 2u);
+  EXPECT_EQ(s.textures.size(), 1u);  // the file read once
+  EXPECT_EQ(s.triangles[2].v[2], glm::vec3(6, 1, 1));   // quad corner (1, 1, 0), moved by 5 in x, then 1 in z
+  EXPECT_EQ(s.triangles[4].v[2], glm::vec3(2, 7, 1));   // scaled by 2 and moved by 5 in y first
+  EXPECT_EQ(s.triangles[6].v[1], glm::vec3(6, 0, 0));   // (1, 0, 0) moved by 1, then scaled by 3
+  EXPECT_EQ(s.triangles[7].v[1], glm::vec3(0, 3, 0));   // (1, 0, 0) turned to (0, 1, 0), then scaled
+  for (const Triangle& t : s.triangles) EXPECT_EQ(t.object, &t < &s.triangles[6] ? 0u : 1u);
+
+  test::write_file(dir_ / "bad.json", R"({"camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "vertical_fov": 40},
+    "objects": [{"type": "gltf", "file": "quad.glb", "instances": []}]})");
+  const std::string empty = error_of([&] { load_scene(dir_ / "bad.json"); });
+  EXPECT_NE(empty.find("bad.json: /objects/0/instances: expected at least one transform"), std::string::npos) << empty;
+  test::write_file(dir_ / "bad.json", R"({"camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "vertical_fov": 40},
+    "objects": [{"type": "gltf", "file": "quad.glb", "instances": [{"translate": [0, 0, 0]}, {"scale": 0}]}]})");
+  const std::string zero = error_of([&] { load_scene(dir_ / "bad.json"); });
+  EXPECT_NE(zero.find("bad.json: /objects/0/instances/1/scale: "), std::string::npos) << zero;
+}
+
 TEST_F(GltfFileTest, TheFileAsAWholeSceneGetsACameraAndLight) {
   GltfBuilder b = textured_quad();
   test::write_file(dir_ / "quad.glb", b.glb());

@@ -402,6 +402,21 @@ glm::mat4 SceneParser::parse_transform(const Value& v) {
   return compose_transform(translate, rotate, scale);
 }
 
+std::vector<glm::mat4> SceneParser::placements(const Value& v, const glm::mat4& transform) {
+  if (!v.has("instances")) return {transform};
+  // Each instance is a transform that places the object, then its own "transform" places that.
+  const Value instances = v["instances"];
+  expect_array(instances);
+  if (instances.j.empty()) fail(instances, "expected at least one transform");
+  std::vector<glm::mat4> out;
+  out.reserve(instances.j.size());
+  for (size_t i = 0; i < instances.j.size(); ++i) {
+    if (i % 1024 == 0) throw_if_interrupted();
+    out.push_back(transform * parse_transform(instances[i]));
+  }
+  return out;
+}
+
 void SceneParser::parse_object(const Value& v) {
   throw_if_interrupted();
   expect_object(v);
@@ -459,12 +474,12 @@ void SceneParser::parse_object(const Value& v) {
     }
     add_triangles(indices, triangles);
   } else if (type == "mesh") {
-    check_keys(v, {"type", "file", "material", "transform", "smooth", "flip_normals"});
-    parse_mesh(v, transform);
+    check_keys(v, {"type", "file", "material", "transform", "instances", "smooth", "flip_normals"});
+    for (const glm::mat4& placement : placements(v, transform)) parse_mesh(v, placement);
   } else if (type == "gltf") {
-    check_keys(v, {"type", "file", "transform"});
+    check_keys(v, {"type", "file", "transform", "instances"});
     const Value file_value = require(v, "file");
-    add_gltf(&file_value, file_of(file_value), transform);
+    for (const glm::mat4& placement : placements(v, transform)) add_gltf(&file_value, file_of(file_value), placement);
   } else {
     fail(type_value, "unknown object type \"" + printable(type) + "\" (expected \"sphere\", \"triangles\", \"mesh\" or \"gltf\")");
   }

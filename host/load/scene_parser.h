@@ -134,6 +134,9 @@ class SceneParser {
   bool flip_normals(const Value& v) const;
   void parse_light(const Value& v);
   void parse_object(const Value& v);
+  // Where an object goes: its "transform", or once for each of its "instances" (each instance's
+  // transform, then the object's).
+  std::vector<glm::mat4> placements(const Value& v, const glm::mat4& transform);
   glm::mat4 parse_transform(const Value& v);
   uint32_t material_ref(const Value& v) const;
   void parse_mesh(const Value& v, const glm::mat4& transform);
