@@ -190,6 +190,14 @@ TEST(GltfTest, MorphTargetsTakeTheNodesOrTheMeshsDefaultWeights) {
   ASSERT_EQ(animated.warnings.size(), 1u);
   EXPECT_NE(animated.warnings[0].find("animations: 1 animations are not played: the file is shown at rest"), std::string::npos)
       << animated.warnings[0];
+  // Applying them is held to the file's budget: here 2 triangles x 3 corners x 1 displacement (target
+  // 0's POSITION; target 1 weighs 0).
+  GltfLimits budget;
+  budget.max_morph_displacements = 5;
+  const std::string work = error_of([&] { parse_gltf(b.gltf(), "test.gltf", budget); });
+  EXPECT_NE(work.find("morph targets take more than 5 vertex displacements"), std::string::npos) << work;
+  budget.max_morph_displacements = 6;
+  EXPECT_NO_THROW(parse_gltf(b.gltf(), "test.gltf", budget));
   b.doc["nodes"][node]["weights"] = {1};
   expect_error(b, "nodes[0].weights: 1 weights for the 2 morph targets of meshes[0].primitives[0]");
   b.doc["nodes"][node]["weights"] = {1, 1};
@@ -218,6 +226,13 @@ TEST(GltfTest, GpuInstancingPlacesTheMeshOncePerInstance) {
   // Turned 90 degrees about z: (-1, -1) to (1, -1), moved up by 10.
   EXPECT_NEAR(s.triangles[4].v[0].x, 1.0f, 1e-6f);
   EXPECT_NEAR(s.triangles[4].v[0].y, 9.0f, 1e-6f);
+  // More instances than the file may place are refused before they are placed.
+  GltfLimits small;
+  small.max_triangles = 5;
+  const std::string many = error_of([&] { parse_gltf(b.gltf(), "test.gltf", small); });
+  EXPECT_NE(many.find("test.gltf: nodes[0].extensions.EXT_mesh_gpu_instancing: 3 instances of 2 triangles would place more than 5"),
+            std::string::npos)
+      << many;
   b.doc["nodes"][node]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] = b.accessor({1, 1, 1}, "VEC3");
   expect_error(b, "EXT_mesh_gpu_instancing.attributes.SCALE: 1 instances, where another attribute has 3");
 }
@@ -431,6 +446,12 @@ TEST(GltfTest, AnUnlitMaterialShowsItsBaseColourAndScattersNothing) {
   EXPECT_EQ(m.opacity, 0.5f);
   EXPECT_EQ(m.opacity_texture.texture, 0);
   EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  // Double-sided, its back is black (emission is one-sided), and a warning says so.
+  b.doc["materials"][0]["doubleSided"] = true;
+  const GltfScene two = parse(b.gltf());
+  ASSERT_EQ(two.warnings.size(), 1u);
+  EXPECT_NE(two.warnings[0].find("materials[0]: a double-sided unlit material shows its base colour from its front only"), std::string::npos)
+      << two.warnings[0];
 }
 
 TEST(GltfTest, TexturesReadTheirOwnTextureCoordinateSets) {
@@ -900,15 +921,31 @@ TEST_F(GltfFileTest, AnObjectIsPlacedOnceForEachOfItsInstances) {
     "objects": [{"type": "gltf", "file": "quad.glb", "transform": {"translate": [0, 0, 1]},
                  "instances": [{"translate": [0, 0, 0]}, {"translate": [5, 0, 0]}, {"scale": 2, "translate": [0, 5, 0]}]},
                 {"type": "mesh", "file": "tri.obj", "material": "m", "transform": {"scale": 3},
-                 "instances": [{"translate": [1, 0, 0]}, {"matrix": [0, -1, 0, 0,  1, 0, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]}]}]})");
+                 "instances": [{"translate": [1, 0, 0]}, {"matrix": [0, -1, 0, 0,  1, 0, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]},
+                               {"scale": [-1, 1, 1]}]}]})");
   const Scene s = load_scene(dir_ / "field.json");
-  ASSERT_EQ(s.triangles.size(), 3u * 2u + 2u);
+  ASSERT_EQ(s.triangles.size(), 3u * 2u + 3u);
+  // The mirrored placement keeps the triangle's front toward +z, as a glTF file's mirror does.
+  const Triangle& mirrored = s.triangles[8];
+  EXPECT_GT(glm::cross(mirrored.v[1] - mirrored.v[0], mirrored.v[2] - mirrored.v[0]).z, 0.0f);
+  EXPECT_EQ(mirrored.v[2], glm::vec3(-3, 0, 0));
   EXPECT_EQ(s.textures.size(), 1u);  // the file read once
   EXPECT_EQ(s.triangles[2].v[2], glm::vec3(6, 1, 1));   // quad corner (1, 1, 0), moved by 5 in x, then 1 in z
   EXPECT_EQ(s.triangles[4].v[2], glm::vec3(2, 7, 1));   // scaled by 2 and moved by 5 in y first
   EXPECT_EQ(s.triangles[6].v[1], glm::vec3(6, 0, 0));   // (1, 0, 0) moved by 1, then scaled by 3
   EXPECT_EQ(s.triangles[7].v[1], glm::vec3(0, 3, 0));   // (1, 0, 0) turned to (0, 1, 0), then scaled
   for (const Triangle& t : s.triangles) EXPECT_EQ(t.object, &t < &s.triangles[6] ? 0u : 1u);
+
+  // A warning about the mesh is said once, not once per placement.
+  test::write_file(dir_ / "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
+  test::write_file(dir_ / "flat.json", R"({"camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "vertical_fov": 40},
+    "materials": {"m": {"albedo": [1, 1, 1]}},
+    "objects": [{"type": "mesh", "file": "flat.obj", "material": "m", "instances": [{"translate": [0, 0, 0]}, {"translate": [5, 0, 0]}]}]})");
+  const Scene flat = load_scene(dir_ / "flat.json");
+  EXPECT_EQ(flat.triangles.size(), 2u);
+  EXPECT_EQ(std::count_if(flat.warnings.begin(), flat.warnings.end(),
+                          [](const std::string& w) { return w.find("1 degenerate (zero-area) triangles left out") != std::string::npos; }),
+            1);
 
   test::write_file(dir_ / "bad.json", R"({"camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "vertical_fov": 40},
     "objects": [{"type": "gltf", "file": "quad.glb", "instances": []}]})");

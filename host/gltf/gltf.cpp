@@ -58,22 +58,23 @@ struct AccessorView {
   int component_type = 0;
   int components = 0;
   bool normalized = false;
-  // A sparse accessor's (glTF 3.6.2.3): element sparse_indices[k] (strictly increasing) is the k-th
+  // A sparse accessor's (glTF 3.6.2.3): element (*sparse_indices)[k] (strictly increasing) is the k-th
   // element at sparse_values, tightly packed, instead of its element in `data`. Both hold as many
-  // entries as the file stores, so a small file describes no large allocation.
-  std::vector<uint32_t> sparse_indices;
+  // entries as the file stores, so a small file describes no large allocation; the indices are read
+  // once per accessor, however often it is used (GltfReader::sparse_indices_).
+  std::shared_ptr<const std::vector<uint32_t>> sparse_indices;
   const unsigned char* sparse_values = nullptr;
 
   size_t element_size() const;
   // Where element i's bytes are; null where it is zero.
   const unsigned char* element(size_t i) const {
-    if (!sparse_indices.empty()) {
-      const auto at = std::lower_bound(sparse_indices.begin(), sparse_indices.end(), i);
-      if (at != sparse_indices.end() && *at == i) return sparse_values + size_t(at - sparse_indices.begin()) * element_size();
+    if (sparse_indices) {
+      const auto at = std::lower_bound(sparse_indices->begin(), sparse_indices->end(), i);
+      if (at != sparse_indices->end() && *at == i) return sparse_values + size_t(at - sparse_indices->begin()) * element_size();
     }
     return data ? data + i * stride : nullptr;
   }
-  bool all_zero() const { return !data && sparse_indices.empty(); }
+  bool all_zero() const { return !data && !sparse_indices; }
 
   // Component c of element i, normalized integers mapped to [0, 1] or [-1, 1] as glTF defines.
   double get(size_t i, int c) const {
@@ -231,6 +232,10 @@ class GltfReader {
   std::map<std::pair<int, bool>, int32_t> image_textures_;  // (glTF image, sRGB) -> scene_.textures
   std::map<std::pair<std::string, bool>, int32_t> sources_;  // (where its bytes are: "view 3", "file /x/y.png"; sRGB) -> scene_.textures
   uint64_t texels_ = 0;                     // in scene_.textures so far
+  // A sparse accessor's indices, checked and read once (accessor() is const: a cache, not state).
+  mutable std::map<int, std::shared_ptr<const std::vector<uint32_t>>> sparse_indices_;
+  // Morph displacements applied so far (corners times targets): held to GltfLimits::max_morph_displacements.
+  uint64_t morph_work_ = 0;
   bool camera_found_ = false;
 };
 
@@ -369,15 +374,21 @@ AccessorView GltfReader::accessor(int index, const std::string& where, std::init
                                               component_size(index_type), count, &stride, at + ".indices");
     view.sparse_values = view_bytes(a.sparse.values.bufferView, size_t(std::max(a.sparse.values.byteOffset, 0)), element_size, count,
                                     &stride, at + ".values");
-    view.sparse_indices.reserve(count);
-    for (size_t k = 0; k < count; ++k) {
-      const uint32_t i = AccessorView::index_at(indices + k * component_size(index_type), index_type);
-      if (i >= a.count) fail(at + ".indices", "index " + std::to_string(i) + " at " + std::to_string(k) + " is past the accessor's " +
-                                                  std::to_string(a.count) + " elements");
-      if (!view.sparse_indices.empty() && i <= view.sparse_indices.back())
-        fail(at + ".indices", "index " + std::to_string(i) + " at " + std::to_string(k) + " does not increase on the one before");
-      view.sparse_indices.push_back(i);
+    std::shared_ptr<const std::vector<uint32_t>>& read = sparse_indices_[index];
+    if (!read) {
+      auto checked = std::make_shared<std::vector<uint32_t>>();
+      checked->reserve(count);
+      for (size_t k = 0; k < count; ++k) {
+        const uint32_t i = AccessorView::index_at(indices + k * component_size(index_type), index_type);
+        if (i >= a.count) fail(at + ".indices", "index " + std::to_string(i) + " at " + std::to_string(k) + " is past the accessor's " +
+                                                    std::to_string(a.count) + " elements");
+        if (!checked->empty() && i <= checked->back())
+          fail(at + ".indices", "index " + std::to_string(i) + " at " + std::to_string(k) + " does not increase on the one before");
+        checked->push_back(i);
+      }
+      read = std::move(checked);
     }
+    view.sparse_indices = read;
   }
   return view;
 }
@@ -519,8 +530,18 @@ void GltfReader::add_instances(size_t node, const dmat4& world) {
     }
     const size_t before = scene_.triangles.size();
     add_mesh(node, world * m);
-    // A mesh that places nothing places nothing however often: the rest of a long list is not walked.
-    if (scene_.triangles.size() == before) break;
+    if (i > 0) continue;
+    // After the first: a mesh that places nothing places nothing however often, and the rest is
+    // held to the file's limit before any is placed, counting each of the mesh's primitives like a
+    // triangle (each costs the work of reading it again).
+    const size_t placed = scene_.triangles.size() - before;
+    if (placed == 0) break;
+    const size_t per_instance = placed + model_.meshes[size_t(model_.nodes[node].mesh)].primitives.size();
+    const size_t room = limits_.max_triangles - std::min(limits_.max_triangles, scene_.triangles.size());
+    if (count - 1 > room / per_instance)
+      throw LimitError(file_.string() + ": " + where + ": " + std::to_string(count) + " instances of " + std::to_string(placed) +
+                       " triangles would place more than " + std::to_string(limits_.max_triangles) +
+                       " triangles; vkray renders at most that many");
   }
 }
 
@@ -557,6 +578,10 @@ std::optional<MorphedAttribute> GltfReader::attribute(const tinygltf::Primitive&
   // A target displaces positions, normals and tangents by 3-vectors (a tangent's w stays), and takes
   // signed normalized integers for the rest (glTF 3.7.2.2).
   const bool direction = name == "POSITION" || name == "NORMAL" || name == "TANGENT";
+  // Targets that displace nothing (weight 0, or an accessor of zeros) are left out, and targets that
+  // name the same accessor are one, weighed by the sum of their weights: the work per vertex is the
+  // number of distinct displacements.
+  std::map<int, size_t> by_accessor;  // accessor -> its place in a.targets
   for (size_t t = 0; t < weights.size(); ++t) {
     const auto target = p.targets[t].find(name);
     if (weights[t] == 0.0 || target == p.targets[t].end()) continue;
@@ -566,6 +591,12 @@ std::optional<MorphedAttribute> GltfReader::attribute(const tinygltf::Primitive&
                                           {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
                                            TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
     if (d.count != vertices) fail(target_at, std::to_string(d.count) + " elements, where POSITION has " + std::to_string(vertices));
+    if (d.all_zero()) continue;
+    if (const auto same = by_accessor.find(target->second); same != by_accessor.end()) {
+      a.targets[same->second].first += weights[t];
+      continue;
+    }
+    by_accessor[target->second] = a.targets.size();
     a.targets.emplace_back(weights[t], std::move(d));
   }
   return a;
@@ -636,6 +667,16 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
   if (triangles > limits_.max_triangles - std::min(limits_.max_triangles, scene_.triangles.size()))
     throw LimitError(file_.string() + ": " + where + ": the file places more than " + std::to_string(limits_.max_triangles) +
                      " triangles; vkray renders at most that many");
+  // Each corner adds up every displacement of every morphed attribute: held to a budget for the file,
+  // so that many targets on a large mesh (or placed many times) cannot take without end.
+  size_t displacements = 0;
+  for (const std::optional<MorphedAttribute>* a :
+       std::initializer_list<const std::optional<MorphedAttribute>*>{&positions, &normals, &colours, &tangents, &uvs[0], &uvs[1]})
+    if (*a) displacements += (*a)->targets.size();
+  morph_work_ += uint64_t(displacements) * 3 * triangles;
+  if (morph_work_ > limits_.max_morph_displacements)
+    throw LimitError(file_.string() + ": " + where + ": the file's morph targets take more than " +
+                     std::to_string(limits_.max_morph_displacements) + " vertex displacements to apply; vkray applies at most that many");
 
   // Positions and normals in world space: normals by the inverse transpose, here the cofactor matrix
   // (the inverse transpose times the determinant: columns b x c, c x a, a x b) turned by the
@@ -772,7 +813,7 @@ uint32_t GltfReader::material(int index, const std::string& where) {
     std::vector<int> sets;
     const auto set_of = [&](const tinygltf::TextureInfo& info, const char* which) -> uint32_t {
       const int set = texcoord_of(info);
-      if (set < 0 || set > 7) fail(name + "." + which, "texCoord " + std::to_string(set) + " (glTF files name TEXCOORD_0 to TEXCOORD_7 here)");
+      if (set < 0) fail(name + "." + which, "texCoord " + std::to_string(set) + " (a set's number is at least 0)");
       for (size_t i = 0; i < sets.size(); ++i)
         if (sets[i] == set) return uint32_t(i);
       if (sets.size() < 2) {
@@ -852,6 +893,11 @@ uint32_t GltfReader::material(int index, const std::string& where) {
       unlit.alpha_cutoff = m.alpha_cutoff;
       unlit.opacity_texture = m.opacity_texture;
       unlit.vertex_colours_emit = true;
+      if (m.double_sided)
+        warn_once("unlit back", name, "a double-sided unlit material shows its base colour from its front only (vkray's emission is one-sided)");
+      // Its one texture's set is the only one its triangles need.
+      unlit.emission_texture.texcoord = unlit.opacity_texture.texcoord = 0;
+      texcoord_sets_[index] = m.albedo_texture.present() ? std::vector<int>{texcoord_of(pbr.baseColorTexture)} : std::vector<int>{};
       m = std::move(unlit);
     }
   }

@@ -38,6 +38,10 @@ struct GltfLimits {
   // The most texels its pictures may decode to together (each picture's size is read from its
   // header first): more throws LimitError.
   uint64_t max_texels = kMaxSceneTexels;
+  // The most morph-target displacements (a corner's attribute moved by one target) the file may take
+  // to apply: more throws LimitError. Far past a real file's (a million vertices with a hundred
+  // targets), and a few seconds' work.
+  uint64_t max_morph_displacements = uint64_t(1) << 31;
   // Whether buffers and pictures outside the file are read (the fuzz target reads none).
   bool read_files = true;
 };

@@ -103,6 +103,8 @@ SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<c
   const PackedScene packed = pack_scene(*scene_, bvh);
   vertex_normals_ = !packed.normals.empty();
   vertex_colours_ = !packed.colours.empty();
+  for (size_t p = 0; p < packed.primitives.size() && !see_through_; p += VKRAY_TEXELS_PER_PRIMITIVE)
+    see_through_ = (primitive_flags(packed.primitives[p]) & VKRAY_PRIM_ALPHA) != 0u;
   if (primitive_count_ <= kMaxInlinePrimitives) inline_scene_ = inline_scene_glsl(packed);
   check_memory(*ctx_, packed);
   geometry_ = std::make_shared<const Geometry>(Geometry{make_texel_buffer(*ctx_, packed.primitives, "primitive"),
@@ -127,7 +129,8 @@ SceneBuffers::SceneBuffers(const SceneBuffers& same, std::shared_ptr<const Scene
       inline_scene_(same.inline_scene_),
       shares_geometry_(true),
       vertex_normals_(same.vertex_normals_),
-      vertex_colours_(same.vertex_colours_) {
+      vertex_colours_(same.vertex_colours_),
+      see_through_(same.see_through_) {
   if (!same_geometry(same.scene(), *scene_)) throw InternalError("a scene shares the device buffers of one with other geometry");
   const auto start = Clock::now();
   const PackedLighting packed = pack_lighting(*scene_, geometry_->order);

@@ -41,7 +41,10 @@ class SceneBuffers {
   const LightingFrame& lighting() const { return lighting_frame_; }
   // Whether some triangle is shaded with its vertex normals (Triangle::smooth).
   bool vertex_normals() const { return vertex_normals_; }
+  // Whether some triangle has vertex colours (Triangle::colours).
   bool vertex_colours() const { return vertex_colours_; }
+  // Whether some primitive lets rays through (Scene::see_through), read off the packed flags once.
+  bool see_through() const { return see_through_; }
 
   // Adds the scene's buffers at their bindings (shared/types.h).
   void bind(DescriptorWriter& writer) const;
@@ -60,6 +63,7 @@ class SceneBuffers {
   bool shares_geometry_ = false;
   bool vertex_normals_ = false;
   bool vertex_colours_ = false;
+  bool see_through_ = false;
 };
 
 }  // namespace vkray::gpu

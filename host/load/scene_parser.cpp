@@ -6,6 +6,7 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "base/checked.h"
 #include "base/interrupt.h"
 #include "scene/transform.h"
 
@@ -450,7 +451,7 @@ void SceneParser::parse_object(const Value& v) {
     points.reserve(positions.j.size());
     for (size_t i = 0; i < positions.j.size(); ++i) points.push_back(transform_point(transform, three_numbers(positions[i])));
     const uint32_t material = material_ref(require(v, "material"));
-    const bool flip = flip_normals(v);
+    const bool flip = flip_normals(v), mirrors = glm::determinant(glm::mat3(transform)) < 0.0f;
     const Value indices = require(v, "indices");
     expect_array(indices);
     std::vector<Triangle> triangles;
@@ -469,17 +470,28 @@ void SceneParser::parse_object(const Value& v) {
                         std::to_string(points.size()) + " positions)");
         t.v[k] = points[idx.j.get<size_t>()];
       }
-      if (flip) std::swap(t.v[1], t.v[2]);  // the other winding: the normal turned around
+      if (flip != mirrors) std::swap(t.v[1], t.v[2]);  // the other winding: the normal turned around (a mirror turns it too)
       triangles.push_back(t);
     }
     add_triangles(indices, triangles);
   } else if (type == "mesh") {
     check_keys(v, {"type", "file", "material", "transform", "instances", "smooth", "flip_normals"});
-    for (const glm::mat4& placement : placements(v, transform)) parse_mesh(v, placement);
+    const std::vector<glm::mat4> where = placements(v, transform);
+    parse_mesh(v, where[0]);
+    // The rest only within the scene's limit, counted before they are made (degenerate triangles,
+    // which are left out, count too: each costs the work of placing it); a mesh without faces places
+    // nothing however often.
+    const size_t faces = meshes_.get(file_of(require(v, "file")))->triangles.size();
+    if (where.size() > 1 && faces > 0) check_primitive_count(v["instances"], checked_mul(where.size() - 1, faces, "instances"));
+    for (size_t i = 1; i < where.size() && faces > 0; ++i) parse_mesh(v, where[i]);
   } else if (type == "gltf") {
     check_keys(v, {"type", "file", "transform", "instances"});
     const Value file_value = require(v, "file");
-    for (const glm::mat4& placement : placements(v, transform)) add_gltf(&file_value, file_of(file_value), placement);
+    const std::vector<glm::mat4> where = placements(v, transform);
+    add_gltf(&file_value, file_of(file_value), where[0]);
+    const size_t faces = gltf_files_.at(file_of(file_value)).gltf.triangles.size();
+    if (where.size() > 1 && faces > 0) check_primitive_count(v["instances"], checked_mul(where.size() - 1, faces, "instances"));
+    for (size_t i = 1; i < where.size() && faces > 0; ++i) add_gltf(&file_value, file_of(file_value), where[i]);
   } else {
     fail(type_value, "unknown object type \"" + printable(type) + "\" (expected \"sphere\", \"triangles\", \"mesh\" or \"gltf\")");
   }

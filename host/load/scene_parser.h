@@ -55,8 +55,10 @@ class SceneParser {
   [[noreturn]] void fail(const Value& v, const std::string& what) const {
     throw SceneError(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what);
   }
+  // Each warning once: an object placed many times ("instances") would say the same for each placement.
   void warn(const Value& v, const std::string& what) {
-    scene_.warnings.push_back(printable_middle(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what, 500));
+    std::string message = printable_middle(file_.string() + ": " + (v.path.empty() ? "top level" : v.path) + ": " + what, 500);
+    if (warned_.insert(message).second) scene_.warnings.push_back(std::move(message));
   }
 
   // ---- typed readers -----------------------------------------------------------------------------
@@ -167,6 +169,7 @@ class SceneParser {
   std::map<std::string, uint32_t> material_index_;
   MeshCache& meshes_;  // each file loaded once, however often it is used
   std::set<std::filesystem::path> referenced_;  // the files in scene_.referenced_files
+  std::set<std::string> warned_;                 // the warnings in scene_.warnings said by this parser
   std::map<std::pair<std::filesystem::path, TextureUse>, int32_t> texture_files_;  // (file, use) -> Scene::textures
   struct LoadedGltf {
     GltfScene gltf;

@@ -269,13 +269,18 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
 
   std::vector<glm::vec3> points(mesh.positions.size());
   for (size_t i = 0; i < points.size(); ++i) points[i] = transform_point(transform, mesh.positions[i]);
+  // A transform that mirrors turns the winding around: corners 1 and 2 are taken the other way, so
+  // that front faces stay front (as a glTF file's are).
+  const std::array<size_t, 3> corner = glm::determinant(glm::mat3(transform)) < 0.0f ? std::array<size_t, 3>{0, 2, 1}
+                                                                                      : std::array<size_t, 3>{0, 1, 2};
   std::vector<Triangle> triangles(mesh.triangles.size());
   for (size_t i = 0; i < triangles.size(); ++i) {
     const uint32_t named = file_materials.empty() ? Mesh::kNoMaterial : mesh.triangle_materials[i];
     triangles[i].material = named == Mesh::kNoMaterial ? material : file_materials[named];
     triangles[i].object = object_;
-    for (int k = 0; k < 3; ++k) triangles[i].v[size_t(k)] = points[mesh.triangles[i][size_t(k)]];
-    if (!mesh.corner_uvs.empty()) triangles[i].uv = mesh.corner_uvs[i];
+    for (size_t k = 0; k < 3; ++k) triangles[i].v[k] = points[mesh.triangles[i][corner[k]]];
+    if (!mesh.corner_uvs.empty())
+      for (size_t k = 0; k < 3; ++k) triangles[i].uv[k] = mesh.corner_uvs[i][corner[k]];
   }
   if (mesh.corner_uvs.empty() &&
       std::any_of(triangles.begin(), triangles.end(), [&](const Triangle& t) { return scene_.materials[t.material].textured(); }))
@@ -286,7 +291,7 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
       // Normals transform by the inverse transpose.
       const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(transform)));
       for (size_t i = 0; i < triangles.size(); ++i)
-        for (size_t k = 0; k < 3; ++k) triangles[i].normals[k] = glm::normalize(normal_matrix * mesh.corner_normals[i][k]);
+        for (size_t k = 0; k < 3; ++k) triangles[i].normals[k] = glm::normalize(normal_matrix * mesh.corner_normals[i][corner[k]]);
     } else {
       std::vector<std::array<glm::vec3, 3>> corners(triangles.size());
       for (size_t i = 0; i < triangles.size(); ++i) corners[i] = triangles[i].v;

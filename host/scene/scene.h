@@ -241,10 +241,11 @@ struct Scene {
   // The contract's epsilon: the offset of shadow-ray origins and the smallest accepted t. 1e-5 of
   // the scene's extent: far above float rounding at that scale (~1e-7 relative), far below any feature.
   float epsilon() const { return std::max(extent(), 1e-30f) * 1e-5f; }
-  // Whether some material lets rays through (Material::see_through): every ray then draws a key
-  // from its sample's stream (shared/sampling.h, alpha_random), on both renderers.
+  // Whether some primitive lets rays through (its material's alpha, or a triangle's vertex colours'):
+  // every ray then draws a key from its sample's stream (shared/sampling.h, alpha_random), on both
+  // renderers. The GPU's pipeline reads the same off the packed primitives' flags (VKRAY_PRIM_ALPHA).
   bool see_through() const {
-    return std::any_of(materials.begin(), materials.end(), [](const Material& m) { return m.see_through(); }) ||
+    return std::any_of(spheres.begin(), spheres.end(), [&](const Sphere& s) { return materials[s.material].see_through(); }) ||
            std::any_of(triangles.begin(), triangles.end(), [&](const Triangle& t) { return see_through(t); });
   }
   // Whether a triangle lets some ray through: its material does, or the material blends or masks and

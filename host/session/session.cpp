@@ -181,7 +181,7 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   variant.textures = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.textured(); });
   variant.single_sided = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return !m.double_sided; });
   variant.normal_maps = std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.normal_texture.present(); });
-  variant.alpha = s.see_through();
+  variant.alpha = scene.see_through();
   variant.shading_normals = scene.vertex_normals() || variant.normal_maps;
   variant.point_lights = !s.lights.empty();
   variant.background = variant.path && s.background != glm::vec3(0.0f);  // only paths sample it

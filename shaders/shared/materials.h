@@ -70,9 +70,10 @@ VKRAY_INLINE uint material_value_properties(uint type, float transmission) {
 // glTF's base colour texture, an .mtl file's map_d). OPAQUE: every ray meets all of the surface;
 // MASK: where the opacity is at least the cutoff, and nowhere else; BLEND: stochastically, each ray
 // meets it with probability the opacity (shared/sampling.h, alpha_random). The same for every ray:
-// camera, shadow, indirect, and so the first-hit passes. The host packs OPAQUE for a material whose
-// alpha can let no ray through (Material::see_through), and only primitives of the others carry
-// VKRAY_PRIM_ALPHA.
+// camera, shadow, indirect, and so the first-hit passes. A triangle's vertex colours' alpha multiplies
+// the opacity too. Only primitives that can let a ray through carry VKRAY_PRIM_ALPHA (vkray::Scene::
+// see_through of the triangle: its material's alpha, or a blending or masking material's vertex
+// colours), and only they read the mode.
 #define VKRAY_ALPHA_OPAQUE 0u
 #define VKRAY_ALPHA_MASK 1u
 #define VKRAY_ALPHA_BLEND 2u
