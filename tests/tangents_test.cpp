@@ -89,11 +89,12 @@ TEST(NormalMapSceneTest, AMeshFileGetsMikkTSpaceTangentsWhereItsMaterialHasANorm
 
 TEST(NormalMapSceneTest, TangentsAreMadeInWorldSpaceAfterTheTransform) {
   // Mirrored along x: u now grows along -x, up the picture is still -z, and the winding's normal
-  // (which a flat triangle is shaded with) now points down.
+  // (which a flat triangle is shaded with) still points up: a mirror keeps front faces front (the
+  // corners are taken the other way round), so the bitangent's sign turns instead.
   const Scene scene = floor_scene(R"({"albedo": [0.5, 0.5, 0.5], "normal_texture": "textures/bumps-normal.png"})", R"({"scale": [-1, 1, 1]})");
   for (const Triangle& t : scene.triangles) {
     const glm::vec3 n = glm::normalize(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0]));
-    expect_near(n, glm::vec3(0, -1, 0), "normal");
+    expect_near(n, glm::vec3(0, 1, 0), "normal");
     for (const glm::vec4& tangent : t.tangents) {
       expect_near(glm::vec3(tangent), glm::vec3(-1, 0, 0), "tangent");
       expect_near(tangent.w * glm::cross(n, glm::vec3(tangent)), glm::vec3(0, 0, -1), "bitangent");
