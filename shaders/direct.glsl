@@ -32,7 +32,7 @@ vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
     Surface s = hit_surface(hit, ray);
     if (FIRST_HIT_PASSES && bounce == 0u) add_first_hit(hit, x, s);
     bool front = !(dot(s.geometric_normal, ray.dir) > 0.0);  // a grazing ray meets the front, as in shade()
-    if (front) radiance += throughput * s.emission;
+    if (front || s.emits_both_sides) radiance += throughput * s.emission;
     if ((s.properties & VKRAY_BSDF_DELTA) == 0u && !passes_straight_on(s)) {
       radiance += throughput * shade(ray, x, s, stream, rays);
       break;

@@ -15,7 +15,8 @@
 
 struct LightPoint {
   vec3 position;
-  vec3 normal;     // unit, the side that emits
+  vec3 normal;     // unit, the side that emits (with both_sides, the other too)
+  bool both_sides;
   vec3 radiance;   // emitted toward that side
   float pdf_area;  // density of picking this point, per unit area
 };
@@ -47,6 +48,7 @@ LightPoint sample_area_light(inout uint stream) {
   vec4 density = texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_LIGHT);
   // The light is picked by its material's emission; a texture only scales what the point sends.
   light.pdf_area = density.x;
+  light.both_sides = density.y != 0.0;
   light.radiance = emission.rgb;
   if (SCENE_HAS_TEXTURES) {
     int slot = material_texel(primitive_material(flags)) + VKRAY_MATERIAL_EMISSION_TEXTURE;

@@ -58,9 +58,10 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   if (FIRST_HIT_PASSES && p.depth == 0u) add_first_hit(hit, x, s);
   float cos_hit = -dot(s.geometric_normal, p.ray.dir);
   bool front = cos_hit > 0.0;
-  if (SCENE_HAS_EMITTERS && front && s.emission != vec3(0.0)) {  // (0 * a grazing hit's infinite density is NaN)
+  float cos_emitting = s.emits_both_sides ? abs(cos_hit) : cos_hit;  // at the side that sends the light
+  if (SCENE_HAS_EMITTERS && cos_emitting > 0.0 && s.emission != vec3(0.0)) {  // (0 * a grazing hit's infinite density is NaN)
     // Light sampling finds this point with density pdf_area t^2 / cos per unit solid angle.
-    float light_pdf = s.light_pdf_area * hit.t * hit.t / cos_hit;
+    float light_pdf = s.light_pdf_area * hit.t * hit.t / cos_emitting;
     float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, light_pdf);
     p.radiance += p.throughput * s.emission * weight;
   }

@@ -91,6 +91,7 @@ struct Surface {
   float roughness;
   float transmission;     // metallic_roughness
   float light_pdf_area;   // the density per unit area with which light sampling picks this point (emitters.glsl)
+  bool emits_both_sides;  // its emission leaves both sides, not only the geometric normal's
 };
 
 // The surface where `ray` hits: `hit`.
@@ -108,10 +109,10 @@ Surface hit_surface(Hit hit, Ray ray) {
   t.k = vec4(0.0);
   t.layers = vec4(0.0);
   uint properties = material_properties_of(t.color);
-  float light_pdf_area = 0.0;
+  vec4 light = vec4(0.0);
   if (SCENE_HAS_EMITTERS || SCENE_HAS_NON_DIFFUSE) {
     t.emission = texelFetch(materials, material + VKRAY_MATERIAL_EMISSION);
-    light_pdf_area = texelFetch(materials, material + VKRAY_MATERIAL_LIGHT).x;
+    light = texelFetch(materials, material + VKRAY_MATERIAL_LIGHT);
   }
   if (SCENE_HAS_NON_DIFFUSE && (properties & VKRAY_BSDF_GLOSSY) != 0u) {
     t.eta = texelFetch(materials, material + VKRAY_MATERIAL_ETA);
@@ -131,7 +132,8 @@ Surface hit_surface(Hit hit, Ray ray) {
   s.metallic = m.metallic;
   s.roughness = m.roughness;
   s.transmission = m.transmission;
-  s.light_pdf_area = light_pdf_area;
+  s.light_pdf_area = light.x;
+  s.emits_both_sides = light.y != 0.0;
   if (SCENE_HAS_SPHERES && (flags & VKRAY_PRIM_SPHERE) != 0u) {
     s.geometric_normal = (position - a.xyz) / sphere_radius(texelFetch(primitives, base + 1));
     if ((flags & VKRAY_PRIM_INWARD) != 0u) s.geometric_normal = -s.geometric_normal;

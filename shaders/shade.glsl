@@ -105,7 +105,7 @@ AreaLightSample sample_area_light_from(LitPoint p, inout uint stream, inout uint
   vec3 to_light = light.position - p.x;
   float r2 = dot(to_light, to_light);
   vec3 w = to_light * inversesqrt(r2);
-  float cos_l = -dot(light.normal, w);
+  float cos_l = light.both_sides ? abs(dot(light.normal, w)) : -dot(light.normal, w);
   AreaLightSample s = AreaLightSample(vec3(0.0), w, dot(p.n, w), 0.0);
   if (!(faces(p, w) && cos_l > 0.0)) return s;
   if (SHADOW_RAYS) {

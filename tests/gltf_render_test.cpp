@@ -13,12 +13,13 @@ namespace vkray::test {
 namespace {
 
 // A quad facing the camera whose corners have the colours red, green, blue and white (and alphas 1,
-// 1, 0.25, 1 under BLEND), over a grey floor; `unlit`: its material is KHR_materials_unlit, so it
-// shows (and emits, lighting the floor) its base colour times the vertex colours.
+// 1, 0.25, 1 under BLEND), over a grey floor; `unlit`: its material is KHR_materials_unlit and
+// double-sided, so it shows (and emits from both sides, lighting the floor in front of it and
+// behind it) its base colour times the vertex colours.
 Scene coloured_quad(bool unlit, bool path) {
   GltfBuilder b;
   nlohmann::json material = {{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.25, 0.125, 1}}, {"metallicFactor", 0}}},
-                             {"alphaMode", "BLEND"}};
+                             {"alphaMode", "BLEND"}, {"doubleSided", unlit}};
   if (unlit) {
     material["extensions"] = {{"KHR_materials_unlit", nlohmann::json::object()}};
     b.doc["extensionsUsed"] = {"KHR_materials_unlit"};
@@ -57,27 +58,31 @@ INSTANTIATE_TEST_SUITE_P(Materials, VertexColourParityTest,
                          [](const auto& p) { return std::string(p.param.unlit ? "Unlit" : "Lit") + (p.param.path ? "Path" : "Direct"); });
 
 // An unlit surface sends its base colour and nothing else: a quad filling the view, its corners
-// white, shows (0.5, 0.25, 0.125) at every pixel on both renderers, lit or not, under both integrators.
+// white, shows (0.5, 0.25, 0.125) at every pixel on both renderers, lit or not, under both
+// integrators; double-sided, from behind too.
 TEST_F(ParityTest, AnUnlitSurfaceShowsExactlyItsBaseColour) {
-  for (const bool path : {false, true}) {
-    GltfBuilder b;
-    b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.25, 0.125, 1}}}},
-                       {"extensions", {{"KHR_materials_unlit", nlohmann::json::object()}}}}));
-    b.doc["extensionsUsed"] = {"KHR_materials_unlit"};
-    TempDir dir;
-    write_file(dir / "quad.glb", b.glb());
-    write_file(dir / "scene.json", std::string(R"({"camera": {"position": [0, 0, 1], "look_at": [0, 0, 0], "vertical_fov": 60},
-      "integrator": {"type": ")") + (path ? "path" : "direct") + R"("}, "lights": [{"type": "point", "position": [0, 0, 1], "intensity": [5, 5, 5]}],
-      "objects": [{"type": "gltf", "file": "quad.glb"}]})");
-    const ParityResult r = run(load_scene(dir / "scene.json"), {16, 16, 4});
-    for (const Image* image : {&r.gpu.image, &r.cpu.image})
-      for (const auto& [x, y] : {std::pair{8u, 8u}, std::pair{2u, 3u}, std::pair{13u, 12u}}) {
-        const glm::vec3 c = image->at(x, y);
-        EXPECT_NEAR(c.r, 0.5f, 1e-5f) << (image == &r.gpu.image ? "GPU" : "CPU") << (path ? " path" : " direct");
-        EXPECT_NEAR(c.g, 0.25f, 1e-5f) << (image == &r.gpu.image ? "GPU" : "CPU") << (path ? " path" : " direct");
-        EXPECT_NEAR(c.b, 0.125f, 1e-5f) << (image == &r.gpu.image ? "GPU" : "CPU") << (path ? " path" : " direct");
-      }
-  }
+  for (const bool path : {false, true})
+    for (const bool behind : {false, true}) {
+      GltfBuilder b;
+      b.quad(b.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.25, 0.125, 1}}}}, {"doubleSided", behind},
+                         {"extensions", {{"KHR_materials_unlit", nlohmann::json::object()}}}}));
+      b.doc["extensionsUsed"] = {"KHR_materials_unlit"};
+      TempDir dir;
+      write_file(dir / "quad.glb", b.glb());
+      const std::string z = behind ? "-1" : "1";
+      write_file(dir / "scene.json", R"({"camera": {"position": [0, 0, )" + z + R"(], "look_at": [0, 0, 0], "vertical_fov": 60},
+        "integrator": {"type": ")" + (path ? "path" : "direct") + R"("}, "lights": [{"type": "point", "position": [0, 0, )" + z + R"(], "intensity": [5, 5, 5]}],
+        "objects": [{"type": "gltf", "file": "quad.glb"}]})");
+      const ParityResult r = run(load_scene(dir / "scene.json"), {16, 16, 4});
+      for (const Image* image : {&r.gpu.image, &r.cpu.image})
+        for (const auto& [x, y] : {std::pair{8u, 8u}, std::pair{2u, 3u}, std::pair{13u, 12u}}) {
+          const glm::vec3 c = image->at(x, y);
+          const std::string what = std::string(image == &r.gpu.image ? "GPU" : "CPU") + (path ? " path" : " direct") + (behind ? " behind" : "");
+          EXPECT_NEAR(c.r, 0.5f, 1e-5f) << what;
+          EXPECT_NEAR(c.g, 0.25f, 1e-5f) << what;
+          EXPECT_NEAR(c.b, 0.125f, 1e-5f) << what;
+        }
+    }
 }
 
 std::filesystem::path khronos(const char* model) { return std::filesystem::path(VKRAY_SCENE_DIR) / "gltf" / model; }
@@ -103,6 +108,20 @@ class TexCoordSetIgnoredTest : public BrokenShaderParityTest {
 
 TEST_F(TexCoordSetIgnoredTest, FailsParity) {
   const ParityResult r = run(load_scene(khronos("MultiUVTest/glTF-Binary/MultiUVTest.glb")), {96, 96, 1});
+  EXPECT_FALSE(r.metrics.pass);
+}
+
+// And one whose light sampling takes a double-sided unlit emitter's back for its dark side: the floor
+// behind the quad goes unlit.
+class BackOfATwoSidedEmitterIgnoredTest : public BrokenShaderParityTest {
+ protected:
+  BackOfATwoSidedEmitterIgnoredTest()
+      : BrokenShaderParityTest("shade.glsl", "float cos_l = light.both_sides ? abs(dot(light.normal, w)) : -dot(light.normal, w);",
+                               "float cos_l = -dot(light.normal, w);") {}
+};
+
+TEST_F(BackOfATwoSidedEmitterIgnoredTest, FailsParity) {
+  const ParityResult r = run(coloured_quad(true, false), {96, 96, 4});
   EXPECT_FALSE(r.metrics.pass);
 }
 

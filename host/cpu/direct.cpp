@@ -50,7 +50,7 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
     // Both normals face the incoming ray, as the geometric one decides (a grazing ray meets the front).
     const bool front = !(glm::dot(s.geometric_normal, ray.dir) > 0);
     const auto [n_geometric, n] = facing(s, ray.dir, front);
-    if (front) radiance += throughput * s.emission;
+    if (front || material.emits_both_sides) radiance += throughput * s.emission;
     const Bsdf bsdf = bsdf_of(material, s.albedo, s.metallic, s.roughness, s.transmission);
     if (!bsdf.has(VKRAY_BSDF_DELTA) && !passes_straight_on(bsdf)) {
       radiance += throughput * shade(tracer, lights, s, bsdf, -ray.dir, front, n, n_geometric, state, bounce == 0);

@@ -45,7 +45,7 @@ AreaLightSample Lights::sample_area_light_from(const LitPoint& p, uint32_t& stre
   AreaLightSample s;
   s.dir = w;
   s.cos_x = glm::dot(p.n, w);
-  const double cos_l = -glm::dot(light.normal, w);
+  const double cos_l = light.both_sides ? std::abs(glm::dot(light.normal, w)) : -glm::dot(light.normal, w);
   if (!(p.faces(w) && cos_l > 0)) return s;
   if (shadows_) {
     ++rays;
@@ -89,6 +89,7 @@ LightPoint Lights::sample_area_light(uint32_t& stream) const {
   const Material& m = scene.materials[material];
   light.radiance = dvec3(m.emission);
   light.pdf_area = area_pdf(m.emission);
+  light.both_sides = m.emits_both_sides;
   if (p < scene.triangles.size() && m.emission_texture.present()) {
     const Triangle& t = scene.triangles[p];
     light.radiance *= sample_texture(scene, m.emission_texture, triangle_texcoord(t, m.emission_texture, b.y, b.z));

@@ -18,7 +18,8 @@ inline void mix(uint64_t& h, uint64_t v) {
 
 struct LightPoint {
   dvec3 position;
-  dvec3 normal;       // unit, the side that emits
+  dvec3 normal;       // unit, the side that emits (with both_sides, the other too)
+  bool both_sides = false;
   dvec3 radiance;
   double pdf_area;    // density per unit area
 };

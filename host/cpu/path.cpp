@@ -43,8 +43,9 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     const Material& material = scene.materials[s.material];
     const double cos_hit = -glm::dot(s.geometric_normal, ray.dir);
     const bool front = cos_hit > 0;
-    if (front && material.emissive()) {
-      const double light_pdf = lights.area_pdf(material.emission) * hit.t * hit.t / cos_hit;
+    const double cos_emitting = material.emits_both_sides ? std::abs(cos_hit) : cos_hit;  // at the side that sends the light
+    if (cos_emitting > 0 && material.emissive()) {
+      const double light_pdf = lights.area_pdf(material.emission) * hit.t * hit.t / cos_emitting;
       radiance += throughput * s.emission * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, light_pdf));
     }
     if (++depth >= max_depth) break;

@@ -893,8 +893,7 @@ uint32_t GltfReader::material(int index, const std::string& where) {
       unlit.alpha_cutoff = m.alpha_cutoff;
       unlit.opacity_texture = m.opacity_texture;
       unlit.vertex_colours_emit = true;
-      if (m.double_sided)
-        warn_once("unlit back", name, "a double-sided unlit material shows its base colour from its front only (vkray's emission is one-sided)");
+      unlit.emits_both_sides = m.double_sided;  // its base colour shows from both sides
       // Its one texture's set is the only one its triangles need.
       unlit.emission_texture.texcoord = unlit.opacity_texture.texcoord = 0;
       texcoord_sets_[index] = m.albedo_texture.present() ? std::vector<int>{texcoord_of(pbr.baseColorTexture)} : std::vector<int>{};

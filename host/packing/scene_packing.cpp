@@ -333,7 +333,7 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     texture_slot(texels + VKRAY_MATERIAL_OPACITY_TEXTURE, m.opacity_texture);
     texture_slot(texels + VKRAY_MATERIAL_TRANSMISSION_TEXTURE, m.transmission_texture);
     // In double on the host, then one rounding: no 1 / total power in float that could overflow.
-    texels[VKRAY_MATERIAL_LIGHT] = glm::vec4(float(table.density[i]), 0.0f, 0.0f, 0.0f);
+    texels[VKRAY_MATERIAL_LIGHT] = glm::vec4(float(table.density[i]), m.emits_both_sides ? 1.0f : 0.0f, 0.0f, 0.0f);
   }
   // The area lights, their primitives as slots in the primitive buffer.
   if (!table.entries.empty()) {

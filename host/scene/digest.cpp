@@ -63,6 +63,7 @@ std::string scene_digest(const Scene& scene) {
     add(*h, m.opacity_texture);
     add(*h, m.transmission_texture);
     h->add(m.vertex_colours_emit);
+    h->add(m.emits_both_sides);
   }
   h->add(uint64_t(scene.textures.size()));
   for (const auto& t : scene.textures) {

@@ -133,6 +133,9 @@ struct Material {
   // What a triangle's vertex colours multiply (Triangle::colours): its albedo, or (glTF's
   // KHR_materials_unlit, whose base colour is its emission) its emission.
   bool vertex_colours_emit = false;
+  // Whether its emission leaves both sides of the surface, not only the side the geometric normal
+  // faces (a double-sided KHR_materials_unlit material, whose base colour shows from both).
+  bool emits_both_sides = false;
 
   bool emissive() const { return emission != glm::vec3(0.0f); }
   // Every texture reference, for code that treats them alike.

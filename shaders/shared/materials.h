@@ -119,7 +119,8 @@ struct MaterialValues {
 //   VKRAY_MATERIAL_LAYERS:            (metallic, roughness, normal_scale, transmission)  read by GLOSSY
 //                                     materials and normal-mapped ones
 //   VKRAY_MATERIAL_LIGHT:             (density per unit area with which light sampling picks a point of
-//                                     an emitter of this material, 0, 0, 0): scene/emitters.h
+//                                     an emitter of this material, 1 where it emits from both sides, 0,
+//                                     0): scene/emitters.h
 //   VKRAY_MATERIAL_OPACITY:           (opacity factor, alpha cutoff, alpha mode as uint bits, 1 where vertex
 //                                     colours multiply the emission rather than the colour): read only for
 //                                     primitives with VKRAY_PRIM_ALPHA or VKRAY_PRIM_COLOURED (opacity_texel)
