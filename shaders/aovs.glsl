@@ -44,8 +44,10 @@ void add_first_hit(Hit hit, vec3 x, Surface s) {
   first_hits.normal += s.shading_normal;
   first_hits.position += x;
   first_hits.depth += hit.t;
-  if (first_sample)
-    first_hits.object = int(primitive_object(texelFetch(primitives, int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE + 2)));
+  if (first_sample)  // an instance's primitives belong to the object that places it
+    first_hits.object = SCENE_HAS_INSTANCES && hit.instance != NO_INSTANCE
+                            ? int(instance_header(hit.instance).object)
+                            : int(primitive_object(texelFetch(primitives, int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE + 2)));
 }
 
 #endif

@@ -6,6 +6,7 @@
 #ifndef VKRAY_EMITTERS_GLSL
 #define VKRAY_EMITTERS_GLSL
 
+#include "instances.glsl"
 #include "intersect.glsl"
 #include "primitives.glsl"
 #include "resources.glsl"
@@ -28,7 +29,9 @@ LightPoint sample_area_light(inout uint stream) {
   uint entry = alias_entry(u_pick, frame.emitter_count);
   vec4 texel = texelFetch(emitters, int(entry) * VKRAY_TEXELS_PER_EMITTER);
   uint chosen = alias_keeps_entry(u_pick, frame.emitter_count, entry, texel.x) ? entry : floatBitsToUint(texel.y);
-  uint prim = floatBitsToUint(texelFetch(emitters, int(chosen) * VKRAY_TEXELS_PER_EMITTER).z);
+  vec4 light_texel = texelFetch(emitters, int(chosen) * VKRAY_TEXELS_PER_EMITTER);
+  uint prim = floatBitsToUint(light_texel.z);
+  uint entry_plus_one = floatBitsToUint(light_texel.w);  // its instance's entry + 1; 0: none
 
   int base = int(prim) * VKRAY_TEXELS_PER_PRIMITIVE;
   vec4 a = texelFetch(primitives, base), b = texelFetch(primitives, base + 1), c = texelFetch(primitives, base + 2);
@@ -43,6 +46,12 @@ LightPoint sample_area_light(inout uint stream) {
     w = uniform_triangle(u);
     light.position = w.x * a.xyz + w.y * b.xyz + w.z * c.xyz;
     light.normal = triangle_normal(a.xyz, b.xyz, c.xyz);
+    // In an instance, a point uniform on the mesh's triangle is uniform on the placed one too (an
+    // affine map scales every area of a triangle alike); its normal turns by the inverse transpose.
+    if (SCENE_HAS_INSTANCES && entry_plus_one != 0u) {
+      light.position = point_to_world(entry_plus_one - 1u, light.position);
+      light.normal = normal_to_world(entry_plus_one - 1u, light.normal);
+    }
   }
   vec4 emission = texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_EMISSION);
   vec4 density = texelFetch(materials, material_texel(primitive_material(flags)) + VKRAY_MATERIAL_LIGHT);

@@ -3,6 +3,7 @@
 #ifndef VKRAY_PRIMITIVES_GLSL
 #define VKRAY_PRIMITIVES_GLSL
 
+#include "instances.glsl"
 #include "intersect.glsl"
 #include "resources.glsl"
 #include "shared/sampling.h"
@@ -38,21 +39,23 @@ float opacity_at(uint prim, uint flags, vec2 b, out vec4 alpha) {
   return opacity;
 }
 
-// Whether a ray with alpha key `key` (shared/sampling.h) that reaches the primitive in slot `prim` at
-// t meets it there: always, but on a primitive of a see-through material, where its opacity decides
-// (on a sphere, for the side the ray leaves by apart from the side it enters by). scene_index: the
-// primitive's place in the scene, from the texel read here.
-bool meets_slot(Ray ray, uint prim, float t, uint key, out uint scene_index) {
-  int base = int(prim) * VKRAY_TEXELS_PER_PRIMITIVE;
+// Whether a ray with alpha key `key` (shared/sampling.h) that reaches the primitive of `hit` meets it
+// there: always, but on a primitive of a see-through material, where its opacity decides (on a
+// sphere, for the side the ray leaves by apart from the side it enters by). scene_index: the
+// primitive's place in the scene, from the texel read here (and its instance's).
+bool meets_hit(Ray world_ray, Hit hit, uint key, out uint scene_index) {
+  bool placed = SCENE_HAS_INSTANCES && hit.instance != NO_INSTANCE;
+  Ray ray = placed ? ray_to_mesh(hit.instance, world_ray) : world_ray;
+  int base = int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE;
   vec4 a = texelFetch(primitives, base), b = texelFetch(primitives, base + 1), c = texelFetch(primitives, base + 2);
-  scene_index = primitive_scene_index(b);
+  scene_index = primitive_scene_index(b) + (placed ? instance_header(hit.instance).first_index : 0u);
   uint flags = primitive_flags(a);
   if ((flags & VKRAY_PRIM_ALPHA) == 0u) return true;
   bool sphere = (flags & VKRAY_PRIM_SPHERE) != 0u;
-  vec3 x = ray_at(ray, t);
+  vec3 x = ray_at(ray, hit.t);
   vec2 bary = sphere ? vec2(0.0) : triangle_hit_barycentrics(ray, a.xyz, b.xyz, c.xyz);
   vec4 alpha;
-  float opacity = opacity_at(prim, flags, bary, alpha);
+  float opacity = opacity_at(hit.prim, flags, bary, alpha);
   bool far_side = sphere && dot(ray.dir, x - a.xyz) > 0.0;
   return alpha_solid(alpha_mode_of(alpha), opacity, alpha.y, alpha_random(key, scene_index, far_side));
 }
@@ -94,8 +97,8 @@ struct Surface {
   bool emits_both_sides;  // its emission leaves both sides, not only the geometric normal's
 };
 
-// The surface where `ray` hits: `hit`.
-Surface hit_surface(Hit hit, Ray ray) {
+// The surface where `ray` hits: `hit`, with the ray in the space of the hit primitive's own texels.
+Surface local_surface(Hit hit, Ray ray) {
   vec3 position = ray_at(ray, hit.t);
   int base = int(hit.prim) * VKRAY_TEXELS_PER_PRIMITIVE;
   vec4 a = texelFetch(primitives, base);
@@ -184,6 +187,18 @@ Surface hit_surface(Hit hit, Ray ray) {
     if (SCENE_HAS_NORMAL_MAPS && has_texture(normal_texture))
       s.shading_normal = normal_mapped(s.shading_normal, hit.prim, b, sample_texture(normal_texture, material + VKRAY_MATERIAL_NORMAL_TEXTURE, uv),
                                        texelFetch(materials, material + VKRAY_MATERIAL_LAYERS).z);
+  }
+  return s;
+}
+
+// The surface where `ray` hits: `hit`. In an instance, its mesh's surface found with the ray in the
+// mesh's space, its normals turned to world space.
+Surface hit_surface(Hit hit, Ray ray) {
+  bool placed = SCENE_HAS_INSTANCES && hit.instance != NO_INSTANCE;
+  Surface s = local_surface(hit, placed ? ray_to_mesh(hit.instance, ray) : ray);
+  if (placed) {
+    s.geometric_normal = normal_to_world(hit.instance, s.geometric_normal);
+    s.shading_normal = normal_to_world(hit.instance, s.shading_normal);
   }
   return s;
 }

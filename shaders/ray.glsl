@@ -4,7 +4,7 @@
 
 struct Ray {
   vec3 origin;
-  vec3 dir;  // unit length
+  vec3 dir;  // unit length (in world space; an instance's mesh space keeps its t, not its length)
 };
 
 const uint NO_HIT = 0xffffffffu;
@@ -12,7 +12,8 @@ const float FAR = 1e30;  // "no upper bound" for t; larger than any finite scene
 
 struct Hit {
   float t;
-  uint prim;  // the primitive's slot in the primitive buffer (BVH leaf order); NO_HIT when nothing was hit
+  uint prim;      // the primitive's slot in the primitive buffer (BVH leaf order); NO_HIT when nothing was hit
+  uint instance;  // the entry of the instance it belongs to (instances.glsl); NO_INSTANCE for none
 };
 
 vec3 ray_at(Ray ray, float t) { return ray.origin + t * ray.dir; }

@@ -18,6 +18,7 @@ layout(set = 0, binding = VKRAY_BINDING_TEXCOORDS) uniform samplerBuffer texcoor
 layout(set = 0, binding = VKRAY_BINDING_TEXTURES) uniform samplerBuffer textures;
 layout(set = 0, binding = VKRAY_BINDING_TANGENTS) uniform samplerBuffer tangents;
 layout(set = 0, binding = VKRAY_BINDING_COLOURS) uniform samplerBuffer colours;
+layout(set = 0, binding = VKRAY_BINDING_INSTANCES) uniform samplerBuffer instances;
 
 // The frame's constants as every function reads them: a private copy of the uniform block, made
 // by load_frame() before anything else in main. llvmpipe reads a uniform block lane by lane at

@@ -4,6 +4,7 @@
 #ifndef VKRAY_TRAVERSAL_GLSL
 #define VKRAY_TRAVERSAL_GLSL
 
+#include "instances.glsl"
 #include "primitives.glsl"
 #include "resources.glsl"
 
@@ -19,12 +20,13 @@ bool culled(Ray ray, vec4 a, vec4 b, vec4 c) {
 
 // Tests the primitives of a leaf against the ray, keeping the closest hit (ties go to the primitive
 // that comes first in the scene, VKRAY_TIE; hit_index is the best hit's place in the scene).
+// instance, first_index: the instance the leaf belongs to and its first scene index (instances.glsl).
 // Returns true when any_hit and something was hit. cull_back: the ray is a camera ray (culled()).
 // passed_t, passed_index: a surface the ray has passed (trace()), after which the search goes on in
 // the tie rule's order: a primitive that comes later in the scene counts from t_min, any other only
 // past a tie with passed_t (a sphere's far side, say). passed_t 0: none.
 bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max, bool any_hit, bool cull_back, float passed_t,
-                    uint passed_index, inout Hit hit, inout uint hit_index) {
+                    uint passed_index, uint instance, uint first_index, inout Hit hit, inout uint hit_index) {
   uint first = leaf_first(link);
   uint end = first + leaf_count(link);
   // A do-while without `continue` (a leaf is never empty): see the light loop in shade.glsl.
@@ -34,17 +36,17 @@ bool intersect_leaf(Ray ray, RayShear shear, uint link, float t_min, float t_max
     vec4 a = texelFetch(primitives, base), b = texelFetch(primitives, base + 1), c = texelFetch(primitives, base + 2);
     // Anything up to a tie with the best hit so far is still a candidate.
     float limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
-    uint index = primitive_scene_index(b);
+    uint index = primitive_scene_index(b) + (SCENE_HAS_INSTANCES ? first_index : 0u);
     float t_from = SCENE_HAS_ALPHA && index <= passed_index ? max(t_min, passed_t * (1.0 + VKRAY_TIE)) : t_min;
     float t = intersect_primitive(ray, shear, a, b, c, t_from, limit);
     if (SCENE_HAS_SINGLE_SIDED && cull_back && t > 0.0 && culled(ray, a, b, c)) t = -1.0;
     if (t > 0.0) {
       if (any_hit) {
-        hit = Hit(t, prim);
+        hit = Hit(t, prim, instance);
         return true;
       }
       if (hit.prim == NO_HIT || t < hit.t * (1.0 - VKRAY_TIE) || index < hit_index) {
-        hit = Hit(t, prim);
+        hit = Hit(t, prim, instance);
         hit_index = index;
       }
     }
@@ -85,11 +87,20 @@ const float NO_CHILD = 3.4e38;  // beyond any t (FAR)
 vec4 min_no_nan(vec4 a, vec4 b) { return mix(a, b, lessThan(b, a)); }
 vec4 max_no_nan(vec4 a, vec4 b) { return mix(a, b, greaterThan(b, a)); }
 
-Children enter_node(Ray ray, vec3 inv_dir, bvec3 backward, uint node, float t_min, float t_limit) {
+// A node's four texels, fetched together.
+struct NodeTexels {
+  uvec4 t[VKRAY_TEXELS_PER_NODE];
+};
+
+NodeTexels fetch_node(uint node) {
   int base = int(node) * VKRAY_TEXELS_PER_NODE;
-  uvec4 header = texelFetch(nodes, base + VKRAY_NODE_HEADER), links = texelFetch(nodes, base + VKRAY_NODE_LINKS);
-  NodeCorners corners =
-      node_corners(texelFetch(nodes, base + VKRAY_NODE_CORNERS), texelFetch(nodes, base + VKRAY_NODE_CORNERS + 1));
+  return NodeTexels(uvec4[VKRAY_TEXELS_PER_NODE](texelFetch(nodes, base), texelFetch(nodes, base + 1), texelFetch(nodes, base + 2),
+                                                 texelFetch(nodes, base + 3)));
+}
+
+Children enter_node(Ray ray, vec3 inv_dir, bvec3 backward, NodeTexels texels, float t_min, float t_limit) {
+  uvec4 header = texels.t[VKRAY_NODE_HEADER], links = texels.t[VKRAY_NODE_LINKS];
+  NodeCorners corners = node_corners(texels.t[VKRAY_NODE_CORNERS], texels.t[VKRAY_NODE_CORNERS + 1]);
   // The four child boxes, one child per vector component.
   vec3 origin = uintBitsToFloat(header.xyz);
   vec3 scale = node_scale(header.w);
@@ -123,26 +134,32 @@ Children enter_node(Ray ray, vec3 inv_dir, bvec3 backward, uint node, float t_mi
   return Children(vec4(k0, k1, k2, k3), uvec4(l0, l1, l2, l3));
 }
 
-// Closest hit in (t_min, t_max), every surface taken as whole; with any_hit, the first hit found (for
-// shadow rays). cull_back: a camera ray, which passes the back faces of single-sided triangles.
-// passed_t, passed_index: intersect_leaf's.
-Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back, float passed_t, uint passed_index) {
-  Hit hit = Hit(t_max, NO_HIT);
-  uint hit_index = 0u;
-  if (frame.primitive_count == 0u) return hit;
-  RayShear shear = ray_shear(ray.dir);
-#ifdef VKRAY_INLINE_SCENE
-  test_inline_primitives(ray, shear, t_min, t_max, any_hit, SCENE_HAS_SINGLE_SIDED && cull_back, passed_t, passed_index, hit);
-  return hit;
-#endif
-  vec3 inv_dir = safe_inverse(ray.dir);
+// The nearest child of `c` next, the others onto the stack, farthest first; `pop` false when there
+// is a child. A macro rather than a function: a stack passed to a function is copied in and out.
+#define DESCEND(c, stack, depth, node, pop)  \
+  if (c.key.x < NO_CHILD) {                   \
+    stack[depth] = c.link.w;                  \
+    depth += int(c.key.w < NO_CHILD);         \
+    stack[depth] = c.link.z;                  \
+    depth += int(c.key.z < NO_CHILD);         \
+    stack[depth] = c.link.y;                  \
+    depth += int(c.key.y < NO_CHILD);         \
+    node = c.link.x;                          \
+    pop = false;                              \
+  }
+
+// Walks one BVH from `root` with `ray` (in the space of its primitives; shear, inv_dir and backward
+// made from it), keeping the closest hit in `hit` as intersect_leaf does. Returns true when any_hit
+// and something was hit.
+bool walk(Ray ray, RayShear shear, vec3 inv_dir, uint root, uint instance, uint first_index, float t_min, float t_max, bool any_hit,
+          bool cull_back, float passed_t, uint passed_index, inout Hit hit, inout uint hit_index) {
   // The slab test's near plane on each axis is the box's low side when the ray goes up that axis.
   bvec3 backward = lessThan(inv_dir, vec3(0.0));
   // At most VKRAY_TRAVERSAL_STACK entries are in use; the spare ones keep a write at the top (one
   // past the last entry, by a lane whose result is masked off) inside the array.
   uint stack[VKRAY_TRAVERSAL_STACK + VKRAY_NODE_WIDTH];
   int depth = 0;
-  uint node = 0u;
+  uint node = root;
   // One loop step handles one node or one leaf: leaves are entered like nodes (nearest child next,
   // the others on the stack), so the leaf code exists once. On llvmpipe an `if` is not a branch
   // (both sides run, masked), so every step costs the leaf code plus the node code; 4-wide nodes
@@ -152,21 +169,61 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back, fl
   for (;;) {
     bool pop = true;
     if (is_leaf(node)) {
-      if (intersect_leaf(ray, shear, node, t_min, t_max, any_hit, cull_back, passed_t, passed_index, hit, hit_index)) return hit;
+      if (intersect_leaf(ray, shear, node, t_min, t_max, any_hit, cull_back, passed_t, passed_index, instance, first_index, hit, hit_index))
+        return true;
     } else {
       float t_limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
-      Children c = enter_node(ray, inv_dir, backward, node, t_min, t_limit);
-      // The nearest child next, the others onto the stack, farthest first.
-      if (c.key.x < NO_CHILD) {
-        stack[depth] = c.link.w;
-        depth += int(c.key.w < NO_CHILD);
-        stack[depth] = c.link.z;
-        depth += int(c.key.z < NO_CHILD);
-        stack[depth] = c.link.y;
-        depth += int(c.key.y < NO_CHILD);
-        node = c.link.x;
-        pop = false;
-      }
+      Children c = enter_node(ray, inv_dir, backward, fetch_node(node), t_min, t_limit);
+      DESCEND(c, stack, depth, node, pop);
+    }
+    if (pop) {
+      if (depth == 0) break;
+      node = stack[--depth];
+    }
+  }
+  return false;
+}
+
+// Closest hit in (t_min, t_max), every surface taken as whole; with any_hit, the first hit found (for
+// shadow rays). cull_back: a camera ray, which passes the back faces of single-sided triangles.
+// passed_t, passed_index: intersect_leaf's.
+Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back, float passed_t, uint passed_index) {
+  Hit hit = Hit(t_max, NO_HIT, NO_INSTANCE);
+  uint hit_index = 0u;
+  if (frame.primitive_count == 0u) return hit;
+  RayShear shear = ray_shear(ray.dir);
+#ifdef VKRAY_INLINE_SCENE
+  test_inline_primitives(ray, shear, t_min, t_max, any_hit, SCENE_HAS_SINGLE_SIDED && cull_back, passed_t, passed_index, hit);
+  return hit;
+#endif
+  vec3 inv_dir = safe_inverse(ray.dir);
+  if (!SCENE_HAS_INSTANCES) {
+    walk(ray, shear, inv_dir, 0u, NO_INSTANCE, 0u, t_min, t_max, any_hit, cull_back, passed_t, passed_index, hit, hit_index);
+    return hit;
+  }
+  // Two levels: the top BVH, whose leaves are instance nodes (shared/scene_layout.h), one each; at
+  // each, that instance's BVH walked with the ray in its space. Walked apart (a loop in a loop)
+  // rather than as one loop, so that the instance's steps, most of the work, cost what they cost
+  // in a scene without instances.
+  bvec3 backward = lessThan(inv_dir, vec3(0.0));
+  uint stack[VKRAY_TRAVERSAL_STACK + VKRAY_NODE_WIDTH];
+  int depth = 0;
+  uint node = 0u;
+  for (;;) {
+    bool pop = true;
+    NodeTexels texels = fetch_node(is_leaf(node) ? leaf_first(node) : node);
+    if (is_leaf(node)) {
+      InstanceNode entry = instance_node(texels.t[0], texels.t[1], texels.t[2], texels.t[3]);
+      Ray local = Ray(vec3(dot(entry.row0.xyz, ray.origin) + entry.row0.w, dot(entry.row1.xyz, ray.origin) + entry.row1.w,
+                           dot(entry.row2.xyz, ray.origin) + entry.row2.w),
+                      vec3(dot(entry.row0.xyz, ray.dir), dot(entry.row1.xyz, ray.dir), dot(entry.row2.xyz, ray.dir)));
+      if (walk(local, ray_shear(local.dir), safe_inverse(local.dir), entry.root, entry.instance, entry.first_index, t_min, t_max, any_hit,
+               cull_back, passed_t, passed_index, hit, hit_index))
+        return hit;
+    } else {
+      float t_limit = hit.prim == NO_HIT ? t_max : hit.t * (1.0 + VKRAY_TIE);
+      Children c = enter_node(ray, inv_dir, backward, texels, t_min, t_limit);
+      DESCEND(c, stack, depth, node, pop);
     }
     if (pop) {
       if (depth == 0) break;
@@ -198,7 +255,7 @@ Hit trace(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back, inout
     hit = traverse(ray, from, t_max, false, cull_back, passed_t, passed_index);
     // (The primitive's texels are read only for a hit: NO_HIT is no slot, and a read there would fall
     // outside the buffer, which a device without robust buffer access need not survive.)
-    passes = hit.prim != NO_HIT && !meets_slot(ray, hit.prim, hit.t, key, passed_index);
+    passes = hit.prim != NO_HIT && !meets_hit(ray, hit, key, passed_index);
     passed_t = hit.t;
     from = max(t_min, hit.t * (1.0 - VKRAY_TIE));
   } while (passes);

@@ -147,8 +147,8 @@ class BrokenAlpha : public BrokenShaderParityTest {
 class AlphaIgnoredOnShadowRays : public BrokenAlpha {
  protected:
   AlphaIgnoredOnShadowRays()
-      : BrokenAlpha("traversal.glsl", "passes = hit.prim != NO_HIT && !meets_slot(ray, hit.prim, hit.t, key, passed_index);",
-                    "passes = hit.prim != NO_HIT && !meets_slot(ray, hit.prim, hit.t, key, passed_index) && !any_hit;") {}
+      : BrokenAlpha("traversal.glsl", "passes = hit.prim != NO_HIT && !meets_hit(ray, hit, key, passed_index);",
+                    "passes = hit.prim != NO_HIT && !meets_hit(ray, hit, key, passed_index) && !any_hit;") {}
 };
 TEST_F(AlphaIgnoredOnShadowRays, IsCaught) { expect_caught(); }
 

@@ -219,22 +219,51 @@ TEST(GltfTest, GpuInstancingPlacesTheMeshOncePerInstance) {
       {"ROTATION", b.accessor({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0.7071067811865476f, 0.7071067811865476f}, "VEC4")},
       {"_ID", b.accessor({0, 1, 2}, "SCALAR")}};
   const GltfScene s = parse(b.gltf());
-  ASSERT_EQ(s.triangles.size(), 6u);
+  // The quad read once, in its own space, and placed three times.
+  EXPECT_TRUE(s.triangles.empty());
+  ASSERT_EQ(s.meshes.size(), 1u);
+  ASSERT_EQ(s.meshes[0].triangles.size(), 2u);
+  ASSERT_EQ(s.instances.size(), 3u);
   EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
-  EXPECT_EQ(s.triangles[0].v[0], glm::vec3(-1, -1, 5));
-  EXPECT_EQ(s.triangles[2].v[0], glm::vec3(8, -2, 5));  // corner (-1, -1) scaled by 2, then moved by 10
+  const auto placed = [&](size_t instance) { return placed_triangle(s.meshes[0].triangles[0], glm::dmat4(s.instances[instance].to_world)); };
+  EXPECT_EQ(placed(0).v[0], glm::vec3(-1, -1, 5));
+  EXPECT_EQ(placed(1).v[0], glm::vec3(8, -2, 5));  // corner (-1, -1) scaled by 2, then moved by 10
   // Turned 90 degrees about z: (-1, -1) to (1, -1), moved up by 10.
-  EXPECT_NEAR(s.triangles[4].v[0].x, 1.0f, 1e-6f);
-  EXPECT_NEAR(s.triangles[4].v[0].y, 9.0f, 1e-6f);
-  // More instances than the file may place are refused before they are placed.
+  EXPECT_NEAR(placed(2).v[0].x, 1.0f, 1e-6f);
+  EXPECT_NEAR(placed(2).v[0].y, 9.0f, 1e-6f);
+  // More than the file may place are refused.
   GltfLimits small;
-  small.max_triangles = 5;
+  small.max_placed_triangles = 5;
   const std::string many = error_of([&] { parse_gltf(b.gltf(), "test.gltf", small); });
-  EXPECT_NE(many.find("test.gltf: nodes[0].extensions.EXT_mesh_gpu_instancing: 3 instances of 2 triangles would place more than 5"),
+  EXPECT_NE(many.find("test.gltf: nodes[0]: the file places more than 5 triangles"), std::string::npos) << many;
+  small.max_placed_triangles = 2;
+  const std::string instances = error_of([&] { parse_gltf(b.gltf(), "test.gltf", small); });
+  EXPECT_NE(instances.find("test.gltf: nodes[0].extensions.EXT_mesh_gpu_instancing: 3 instances; vkray places at most 2 triangles"),
             std::string::npos)
-      << many;
+      << instances;
   b.doc["nodes"][node]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] = b.accessor({1, 1, 1}, "VEC3");
   expect_error(b, "EXT_mesh_gpu_instancing.attributes.SCALE: 1 instances, where another attribute has 3");
+}
+
+// A mesh that several nodes place is read once and placed by instances; one placed once, or by a
+// transform that cannot be inverted, is read in place as before.
+TEST(GltfTest, NodesSharingAMeshPlaceItByInstances) {
+  GltfBuilder b;
+  b.quad();
+  b.quad();  // a second mesh, placed once
+  for (const auto& [translation, scale] : {std::pair{3.0, 1.0}, std::pair{-3.0, -1.0}, std::pair{0.0, 0.0}}) {
+    b.doc["nodes"].push_back({{"mesh", 0}, {"translation", {translation, 0, 0}}, {"scale", {scale, 1, 1}}});
+    b.doc["scenes"][0]["nodes"].push_back(int(b.doc["nodes"].size()) - 1);
+  }
+  const GltfScene s = parse(b.gltf());
+  ASSERT_EQ(s.meshes.size(), 1u);
+  EXPECT_EQ(s.meshes[0].triangles.size(), 2u);
+  ASSERT_EQ(s.instances.size(), 3u);  // the first node, and the two it shares its mesh with
+  EXPECT_EQ(glm::vec3(s.instances[1].to_world[3]), glm::vec3(3, 0, 0));
+  EXPECT_LT(glm::determinant(glm::mat3(s.instances[2].to_world)), 0.0f);  // mirrored, as the file has it
+  // In place: the second mesh, and the first where a node scales it to nothing (its triangles then
+  // degenerate, which the scene leaves out).
+  EXPECT_EQ(s.triangles.size(), 4u);
 }
 
 TEST(GltfTest, AFlatteningScaleKeepsWhatStaysInThePlane) {
@@ -924,17 +953,24 @@ TEST_F(GltfFileTest, AnObjectIsPlacedOnceForEachOfItsInstances) {
                  "instances": [{"translate": [1, 0, 0]}, {"matrix": [0, -1, 0, 0,  1, 0, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]},
                                {"scale": [-1, 1, 1]}]}]})");
   const Scene s = load_scene(dir_ / "field.json");
-  ASSERT_EQ(s.triangles.size(), 3u * 2u + 3u);
+  // Each object's triangles stored once, as a mesh, and placed by an instance each time.
+  ASSERT_EQ(s.meshes.size(), 2u);
+  ASSERT_EQ(s.instances.size(), 6u);
+  EXPECT_TRUE(s.triangles.empty());
+  EXPECT_EQ(s.meshes[0].triangles.size(), 2u);
+  const auto placed = [&](size_t instance, size_t t) {
+    return placed_triangle(s.meshes[s.instances[instance].mesh].triangles[t], glm::dmat4(s.instances[instance].to_world));
+  };
   // The mirrored placement keeps the triangle's front toward +z, as a glTF file's mirror does.
-  const Triangle& mirrored = s.triangles[8];
+  const Triangle mirrored = placed(5, 0);
   EXPECT_GT(glm::cross(mirrored.v[1] - mirrored.v[0], mirrored.v[2] - mirrored.v[0]).z, 0.0f);
   EXPECT_EQ(mirrored.v[2], glm::vec3(-3, 0, 0));
   EXPECT_EQ(s.textures.size(), 1u);  // the file read once
-  EXPECT_EQ(s.triangles[2].v[2], glm::vec3(6, 1, 1));   // quad corner (1, 1, 0), moved by 5 in x, then 1 in z
-  EXPECT_EQ(s.triangles[4].v[2], glm::vec3(2, 7, 1));   // scaled by 2 and moved by 5 in y first
-  EXPECT_EQ(s.triangles[6].v[1], glm::vec3(6, 0, 0));   // (1, 0, 0) moved by 1, then scaled by 3
-  EXPECT_EQ(s.triangles[7].v[1], glm::vec3(0, 3, 0));   // (1, 0, 0) turned to (0, 1, 0), then scaled
-  for (const Triangle& t : s.triangles) EXPECT_EQ(t.object, &t < &s.triangles[6] ? 0u : 1u);
+  EXPECT_EQ(placed(1, 0).v[2], glm::vec3(6, 1, 1));  // quad corner (1, 1, 0), moved by 5 in x, then 1 in z
+  EXPECT_EQ(placed(2, 0).v[2], glm::vec3(2, 7, 1));  // scaled by 2 and moved by 5 in y first
+  EXPECT_EQ(placed(3, 0).v[1], glm::vec3(6, 0, 0));  // (1, 0, 0) moved by 1, then scaled by 3
+  EXPECT_EQ(placed(4, 0).v[1], glm::vec3(0, 3, 0));  // (1, 0, 0) turned to (0, 1, 0), then scaled
+  for (size_t i = 0; i < s.instances.size(); ++i) EXPECT_EQ(s.instances[i].object, i < 3 ? 0u : 1u);
 
   // A warning about the mesh is said once, not once per placement.
   test::write_file(dir_ / "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
@@ -942,7 +978,9 @@ TEST_F(GltfFileTest, AnObjectIsPlacedOnceForEachOfItsInstances) {
     "materials": {"m": {"albedo": [1, 1, 1]}},
     "objects": [{"type": "mesh", "file": "flat.obj", "material": "m", "instances": [{"translate": [0, 0, 0]}, {"translate": [5, 0, 0]}]}]})");
   const Scene flat = load_scene(dir_ / "flat.json");
-  EXPECT_EQ(flat.triangles.size(), 2u);
+  ASSERT_EQ(flat.meshes.size(), 1u);
+  EXPECT_EQ(flat.meshes[0].triangles.size(), 1u);
+  EXPECT_EQ(flat.instances.size(), 2u);
   EXPECT_EQ(std::count_if(flat.warnings.begin(), flat.warnings.end(),
                           [](const std::string& w) { return w.find("1 degenerate (zero-area) triangles left out") != std::string::npos; }),
             1);
@@ -1034,7 +1072,9 @@ TEST(ShippedGltfTest, KhronosModelsLoadAsDescribed) {
   // The models of glTF's rarer features: each read whole, with nothing warned of but what is not
   // rendered (SimpleMorph's animation).
   const GltfScene instancing = load_gltf(dir / "SimpleInstancing/glTF-Binary/SimpleInstancing.glb");
-  EXPECT_EQ(instancing.triangles.size(), 125u * 12u);  // 125 cubes of one mesh
+  ASSERT_EQ(instancing.meshes.size(), 1u);  // 125 cubes of one mesh, stored once
+  EXPECT_EQ(instancing.meshes[0].triangles.size(), 12u);
+  EXPECT_EQ(instancing.instances.size(), 125u);
   EXPECT_TRUE(instancing.warnings.empty()) << instancing.warnings[0];
   const GltfScene sparse = load_gltf(dir / "SimpleSparseAccessor/glTF-Embedded/SimpleSparseAccessor.gltf");
   float top = 0;

@@ -22,7 +22,7 @@ namespace {
 
 Scene cornell() { return load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / "cornell.json"); }
 
-PackedScene packed(const Scene& scene) { return pack_scene(scene, build_bvh(primitive_boxes(scene))); }
+PackedScene packed(const Scene& scene) { return pack_scene(scene, build_scene_bvh(scene)); }
 
 // What the generated code says, read back.
 struct Generated {

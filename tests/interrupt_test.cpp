@@ -61,7 +61,7 @@ TEST_F(InterruptTest, MeshReadingStops) {
 }
 
 TEST_F(InterruptTest, BvhBuildAndPackingStop) {
-  const Bvh bvh = build_bvh(primitive_boxes(cornell_));
+  const SceneBvh bvh = build_scene_bvh(cornell_);
   request_interrupt();
   EXPECT_THROW(build_bvh(primitive_boxes(cornell_)), Cancelled);
   EXPECT_THROW(gpu::pack_scene(cornell_, bvh), Cancelled);

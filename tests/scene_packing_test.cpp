@@ -63,7 +63,7 @@ TEST(ScenePackingTest, EveryRadianceIsScaledAlike) {
       "lights": [{"type": "point", "position": [0, 1, 0], "intensity": [5, 6, 7]}],
       "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1, "material": "e"}])");
   const int k = radiance_exponent(scene);
-  const PackedLighting packed = pack_lighting(scene, {0});
+  const PackedLighting packed = pack_lighting(scene, PrimitiveSlots{{0}, {}, {}});
   EXPECT_EQ(packed.frame.radiance_exponent, k);
   EXPECT_EQ(packed.materials[VKRAY_MATERIAL_EMISSION].y, std::ldexp(3.0f, k));
   EXPECT_EQ(packed.lights[VKRAY_LIGHT_INTENSITY].z, std::ldexp(7.0f, k));
@@ -80,7 +80,7 @@ TEST(ScenePackingTest, AnAreaLightsDensityIsComputedInDouble) {
   const EmitterTable table = build_emitter_table(scene);
   ASSERT_EQ(table.entries.size(), 1u);
   EXPECT_TRUE(std::isinf(float(1.0 / table.total_weight)));
-  const PackedLighting packed = pack_lighting(scene, {0});
+  const PackedLighting packed = pack_lighting(scene, PrimitiveSlots{{0}, {}, {}});
   const double area = 4.0 * 3.141592653589793 * 1e-8 * 1e-8;
   EXPECT_NEAR(packed.materials[VKRAY_MATERIAL_LIGHT].x, 1.0 / area, 1e-5 / area);
 }
@@ -147,7 +147,7 @@ TEST(ScenePackingTest, EachMaterialsValuesComeBackFromItsTexels) {
 TEST(ScenePackingTest, APackedMaterialCarriesItsTypeAndProperties) {
   const Scene scene = lit_by(R"("materials": {"d": {"albedo": [0.5, 0.5, 0.5]}, "g": {"type": "glass", "ior": 1.7}},
       "objects": [{"type": "sphere", "center": [0, 0, 5], "radius": 1, "material": "g"}])");
-  const PackedLighting packed = pack_lighting(scene, {0});
+  const PackedLighting packed = pack_lighting(scene, PrimitiveSlots{{0}, {}, {}});
   const vec4* glass = &packed.materials[size_t(material_texel(1))];
   EXPECT_EQ(material_type_of(glass[VKRAY_MATERIAL_COLOR]), VKRAY_MATERIAL_GLASS);
   EXPECT_EQ(material_properties_of(glass[VKRAY_MATERIAL_COLOR]), VKRAY_BSDF_DELTA | VKRAY_BSDF_TRANSMISSION | VKRAY_BSDF_CLEAR);

@@ -302,7 +302,7 @@ TEST(TextureTest, PackingNamesEachTextureForTheShader) {
   t.v = {glm::vec3(0, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)};
   t.uv = {glm::vec2(0.1f, 0.2f), glm::vec2(0.3f, 0.4f), glm::vec2(0.5f, 0.6f)};
   scene.triangles.push_back(t);
-  const Bvh bvh = build_bvh(primitive_boxes(scene));
+  const SceneBvh bvh = build_scene_bvh(scene);
   const gpu::PackedScene packed = gpu::pack_scene(scene, bvh);
   ASSERT_EQ(packed.textures.size(), 2u * 4 * 4);  // two 2 x 2 textures, four halves a texel
   const gpu::TextureHeader h = gpu::texture_header(packed.materials[VKRAY_MATERIAL_ALBEDO_TEXTURE]);
@@ -448,7 +448,7 @@ TEST_F(ObjMaterialTest, SceneFileMetallicRoughnessTexturesAreSrgbColourAndLinear
   ASSERT_TRUE(m.albedo_texture.present() && m.metallic_roughness_texture.present());
   EXPECT_NEAR(scene.textures[size_t(m.albedo_texture.texture)]->texel(0, 0).g, 0.2158f, 1e-3f);
   EXPECT_NEAR(scene.textures[size_t(m.metallic_roughness_texture.texture)]->texel(0, 0).b, 128.0f / 255.0f, 1e-3f);
-  const gpu::PackedLighting packed = gpu::pack_lighting(scene, {0, 1});
+  const gpu::PackedLighting packed = gpu::pack_lighting(scene, gpu::PrimitiveSlots{{0, 1}, {}, {}});
   const gpu::TextureHeader h = gpu::texture_header(packed.materials[VKRAY_MATERIAL_LAYERS_TEXTURE]);
   EXPECT_EQ(h.width, 1u);
   EXPECT_EQ(h.first, 1u);  // after the base colour's one texel

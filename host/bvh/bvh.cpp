@@ -5,6 +5,7 @@
 #include <atomic>
 #include <bit>
 #include <chrono>
+#include <cfloat>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -289,14 +290,15 @@ uint32_t partition(PrimRef* refs, const Range& range, const BinMap& map, int axi
 // Splits a range in two, by binned SAH over all three axes or, past kSahDepth or where SAH finds
 // no split cheaper than a leaf too large for the leaf encoding, at the median. Returns false where
 // the range becomes a leaf.
-bool split(PrimRef* refs, const Range& range, uint32_t depth, Range& left, Range& right) {
+bool split(PrimRef* refs, const Range& range, uint32_t depth, uint32_t max_leaf, Range& left, Range& right) {
   const uint32_t count = range.count();
-  if (count <= 2) return false;
+  if (count <= std::min(2u, max_leaf)) return false;
   if (depth <= kSahDepth) {
     const BinMap map(range.centroids);
     Bins bins;
     bin_range(refs, range, map, bins);
-    float best_cost = kIntersectionCost * float(count);  // the cost of a leaf
+    // The cost of a leaf; where the range is too large for one, any split is better.
+    float best_cost = count <= max_leaf ? kIntersectionCost * float(count) : FLT_MAX;
     int best_axis = -1, best_bin = 0;
     const float parent_area = std::max(range.box.half_area(), 1e-30f);
     for (int axis = 0; axis < 3; ++axis) {
@@ -362,7 +364,7 @@ bool split(PrimRef* refs, const Range& range, uint32_t depth, Range& left, Range
       }
     }
   }
-  if (count <= kMaxLeafSize) return false;
+  if (count <= max_leaf) return false;
   // The median along the centroids' longest axis.
   const glm::vec3 extent = range.centroids.max - range.centroids.min;
   const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
@@ -380,7 +382,7 @@ bool split(PrimRef* refs, const Range& range, uint32_t depth, Range& left, Range
 // parent before children and left before right.
 class SubtreeBuilder {
  public:
-  SubtreeBuilder(PrimRef* refs, const std::atomic<bool>* stop) : refs_(refs), stop_(stop) {}
+  SubtreeBuilder(PrimRef* refs, const std::atomic<bool>* stop, uint32_t max_leaf) : refs_(refs), stop_(stop), max_leaf_(max_leaf) {}
 
   // Returns the subtree's link: a leaf, or 0 for nodes()[0].
   uint32_t build(const Range& range, uint32_t depth) {
@@ -391,7 +393,7 @@ class SubtreeBuilder {
     VKRAY_CHECK(range.count() >= 1, "the BVH builder made an empty subtree");
     depth_ = std::max(depth_, depth);
     Range left, right;
-    if (!split(refs_, range, depth, left, right)) return leaf_link(range.begin, range.count());
+    if (!split(refs_, range, depth, max_leaf_, left, right)) return leaf_link(range.begin, range.count());
     const uint32_t index = uint32_t(nodes_.size());
     nodes_.emplace_back();
     const uint32_t left_link = build(left, depth + 1);
@@ -406,6 +408,7 @@ class SubtreeBuilder {
  private:
   PrimRef* refs_;
   const std::atomic<bool>* stop_;
+  uint32_t max_leaf_;
   std::vector<BvhNode> nodes_;
   uint32_t depth_ = 0;
 };
@@ -417,7 +420,7 @@ class SubtreeBuilder {
 // have built, node for node, whatever the number of threads.
 class ParallelBuilder {
  public:
-  ParallelBuilder(PrimRef* refs, const std::atomic<bool>* stop) : refs_(refs), stop_(stop) {}
+  ParallelBuilder(PrimRef* refs, const std::atomic<bool>* stop, uint32_t max_leaf) : refs_(refs), stop_(stop), max_leaf_(max_leaf) {}
 
   Bvh build(const Range& all) {
     Bvh bvh;
@@ -465,7 +468,7 @@ class ParallelBuilder {
     Part p;
     p.box = range.box;
     if (range.count() < kTaskSize) {
-      SubtreeBuilder subtree(refs_, stop_);
+      SubtreeBuilder subtree(refs_, stop_, max_leaf_);
       p.link = subtree.build(range, depth);
       p.nodes = std::move(subtree.nodes());
       p.depth = subtree.depth();
@@ -476,7 +479,7 @@ class ParallelBuilder {
     VKRAY_CHECK(depth < kMaxDepth, "the BVH grew deeper than the GPU's traversal stack holds");
     Range left, right;
     // kTaskSize > kMaxLeafSize: a range this large always splits.
-    VKRAY_CHECK(split(refs_, range, depth, left, right), "the BVH builder left a large range unsplit");
+    VKRAY_CHECK(split(refs_, range, depth, max_leaf_, left, right), "the BVH builder left a large range unsplit");
     p.top = std::make_unique<std::array<Part, 2>>();
     tbb::parallel_invoke([&] { (*p.top)[0] = part(left, depth + 1); }, [&] { (*p.top)[1] = part(right, depth + 1); });
     p.depth = std::max((*p.top)[0].depth, (*p.top)[1].depth);
@@ -503,11 +506,13 @@ class ParallelBuilder {
 
   PrimRef* refs_;
   const std::atomic<bool>* stop_;
+  uint32_t max_leaf_;
 };
 
 }  // namespace
 
-Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads, const std::atomic<bool>* stop) {
+Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads, const std::atomic<bool>* stop, uint32_t max_leaf) {
+  VKRAY_CHECK(max_leaf >= 1 && max_leaf <= kMaxLeafSize, "a BVH leaf size out of range");
   if (boxes.size() > kMaxScenePrimitives)
     throw LimitError("too many primitives for the BVH: " + std::to_string(boxes.size()) + " (at most " +
                      std::to_string(kMaxScenePrimitives) + ")");
@@ -541,7 +546,7 @@ Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads, const std::atomi
         for (uint32_t i = begin; i < end; ++i) refs[i] = {{boxes[i].min + 0.0f, boxes[i].max + 0.0f}, i};
       });
       bound(refs.data(), all);
-      bvh = ParallelBuilder(refs.data(), stop).build(all);
+      bvh = ParallelBuilder(refs.data(), stop, max_leaf).build(all);
       bvh.order.resize(count);
       for_each_block([&](uint32_t begin, uint32_t end) {
         for (uint32_t i = begin; i < end; ++i) bvh.order[i] = refs[i].index;
@@ -584,6 +589,59 @@ std::vector<Aabb> primitive_boxes(const Scene& scene) {
   }
   for (const Sphere& s : scene.spheres) boxes.push_back({s.center - s.radius, s.center + s.radius});
   return boxes;
+}
+
+}  // namespace vkray
+
+namespace vkray {
+
+std::vector<Aabb> instance_boxes(const Scene& scene, const std::vector<Bvh>& meshes) {
+  std::vector<Aabb> boxes;
+  boxes.reserve(scene.instances.size());
+  for (const Instance& instance : scene.instances) {
+    const Bvh& mesh = meshes[instance.mesh];
+    VKRAY_CHECK(!mesh.nodes.empty(), "an instance places a mesh without triangles");
+    Aabb local = mesh.nodes[0].child[0];
+    if (leaf_count(mesh.nodes[0].link[1]) > 0 || !is_leaf(mesh.nodes[0].link[1])) local.grow(mesh.nodes[0].child[1]);
+    // In double, then rounded outward by a float step: the box holds every vertex as the GPU moves
+    // the ray, whatever the rounding.
+    Aabb& world = boxes.emplace_back();
+    const glm::dmat4 m(instance.to_world);
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::dvec3 p((corner & 1) ? local.max.x : local.min.x, (corner & 2) ? local.max.y : local.min.y,
+                         (corner & 4) ? local.max.z : local.min.z);
+      const glm::dvec3 q(m * glm::dvec4(p, 1.0));
+      for (int a = 0; a < 3; ++a) {
+        world.min[a] = std::min(world.min[a], std::nextafter(float(q[a]), -FLT_MAX));
+        world.max[a] = std::max(world.max[a], std::nextafter(float(q[a]), FLT_MAX));
+      }
+    }
+  }
+  return boxes;
+}
+
+SceneBvh build_scene_bvh(const Scene& scene, unsigned threads, const std::atomic<bool>* stop) {
+  SceneBvh bvh;
+  bvh.primitives = build_bvh(primitive_boxes(scene), threads, stop);
+  bvh.build_seconds = bvh.primitives.build_seconds;
+  bvh.meshes.reserve(scene.meshes.size());
+  for (const SharedMesh& mesh : scene.meshes) {
+    std::vector<Aabb> boxes;
+    boxes.reserve(mesh.triangles.size());
+    for (const Triangle& t : mesh.triangles) {
+      Aabb& b = boxes.emplace_back();
+      for (const glm::vec3& v : t.v) b.grow(v);
+    }
+    bvh.meshes.push_back(build_bvh(boxes, threads, stop));
+    bvh.build_seconds += bvh.meshes.back().build_seconds;
+  }
+  if (!scene.instances.empty()) {
+    if (scene.instances.size() > kMaxInstances)
+      throw LimitError("too many instances: " + std::to_string(scene.instances.size()) + " (at most " + std::to_string(kMaxInstances) + ")");
+    bvh.instances = build_bvh(instance_boxes(scene, bvh.meshes), threads, stop, 1);
+    bvh.build_seconds += bvh.instances.build_seconds;
+  }
+  return bvh;
 }
 
 }  // namespace vkray

@@ -60,15 +60,37 @@ struct Bvh {
 // thread). The tree is the same for any number of threads. Throws LimitError beyond
 // kMaxScenePrimitives, and Cancelled on an interrupt request (base/interrupt.h) or once `stop` is
 // set, within milliseconds.
-Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads = 0, const std::atomic<bool>* stop = nullptr);
+// `max_leaf`: the most primitives a leaf holds (the instances' BVH holds one instance a leaf, so that
+// a ray enters only those whose box it meets).
+Bvh build_bvh(const std::vector<Aabb>& boxes, unsigned threads = 0, const std::atomic<bool>* stop = nullptr,
+              uint32_t max_leaf = kMaxLeafSize);
 
 // The tree's SAH cost: the expected cost of a ray through it, in primitive tests (a traversal step
 // costs as much as one), by surface area: every inner node weighted by its area, every leaf by its
 // area times its count, over the root's area. Lower is a better tree.
 double sah_cost(const Bvh& bvh);
 
-// A scene's primitives are numbered triangles first, then spheres: primitive i < triangles.size()
-// is triangles[i], the rest are spheres[i - triangles.size()].
+// The boxes of a scene's own primitives, triangles first, then spheres: box i < triangles.size()
+// is triangles[i]'s, the rest are spheres[i - triangles.size()]'s (PrimitiveNumbering puts the
+// instances' triangles between the two).
 std::vector<Aabb> primitive_boxes(const Scene& scene);
+
+// A scene's whole structure: a BVH over its own primitives (primitive_boxes) and, where it places
+// meshes by instances, one over each mesh's triangles in the mesh's space and one over the
+// instances' world boxes (its Bvh::order names Scene::instances). Both renderers walk the two levels,
+// each its own way.
+struct SceneBvh {
+  Bvh primitives;
+  std::vector<Bvh> meshes;  // one per Scene::meshes
+  Bvh instances;            // empty when the scene has none
+  double build_seconds = 0;
+};
+
+// Builds all of them (threads and stop as build_bvh's).
+SceneBvh build_scene_bvh(const Scene& scene, unsigned threads = 0, const std::atomic<bool>* stop = nullptr);
+
+// The world box of each of the scene's instances: its mesh's box (the root's children's, in `meshes`)
+// with every corner moved by the instance's transform.
+std::vector<Aabb> instance_boxes(const Scene& scene, const std::vector<Bvh>& meshes);
 
 }  // namespace vkray

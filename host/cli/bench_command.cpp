@@ -117,18 +117,18 @@ int run_bench(const BenchArgs& args) {
     auto start = Clock::now();
     const auto scene = std::make_shared<const Scene>(load_scene(scene_dir / (name + ".json")));
     r.load_ms = ms_since(start);
-    r.triangles = scene->triangles.size();
+    r.triangles = PrimitiveNumbering(*scene).sphere_first();  // as placed, instances counted each time
     // Both builds `repeat` times, alternately, each timed from the scene's triangles and with its
     // threads already started (Embree starts them in rtcNewDevice, before its timer): the medians.
     std::vector<double> bvh_ms, embree_build_ms;
-    Bvh bvh;
+    SceneBvh bvh;
 #ifdef VKRAY_HAVE_EMBREE
     std::optional<bench::EmbreeTracer> embree;
 #endif
-    build_bvh(primitive_boxes(*scene), threads);  // starts oneTBB's workers, untimed
+    build_scene_bvh(*scene, threads);  // starts oneTBB's workers, untimed
     for (unsigned round = 0; round < args.repeat; ++round) {
       start = Clock::now();
-      bvh = build_bvh(primitive_boxes(*scene), threads);
+      bvh = build_scene_bvh(*scene, threads);
       bvh_ms.push_back(ms_since(start));
 #ifdef VKRAY_HAVE_EMBREE
       if (with_embree) {
@@ -140,8 +140,8 @@ int run_bench(const BenchArgs& args) {
     }
     r.bvh_ms = median(bvh_ms);
     r.embree_build_ms = median(embree_build_ms);
-    r.bvh_sah_cost = sah_cost(bvh);
-    const auto tree = std::make_shared<const Bvh>(std::move(bvh));
+    r.bvh_sah_cost = sah_cost(bvh.primitives);
+    const auto tree = std::make_shared<const SceneBvh>(std::move(bvh));
     const auto on_device = session.upload(scene, tree);
     r.upload_ms = (on_device.upload_seconds() - on_device.bvh_seconds()) * 1e3;
     // The path the measured renders take, decided once, so that the warm-up renders (lavapipe

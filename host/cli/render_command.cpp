@@ -68,7 +68,7 @@ int run_render(const RenderArgs& args) {
     log("device " + device + (args.device.validate ? ", validation on" : ""));
     double compile_seconds = session.compile_shaders().seconds, upload_seconds = 0;
     {
-      const auto on_device = session.upload(loaded.scene, std::make_shared<const Bvh>(bvh.get()));
+      const auto on_device = session.upload(loaded.scene, std::make_shared<const SceneBvh>(bvh.get()));
       upload_seconds = on_device.upload_seconds();
       // The scene's pipeline compiled now, so that the compile phase counts it (a small scene's own
       // code is compiled only now that the scene is packed).

@@ -24,7 +24,14 @@ LoadedScene load_scene_file(const std::filesystem::path& file) {
 }
 
 std::string describe(const Scene& scene, const ImageSettings& image) {
-  return printable(scene.file.string(), 200) + ": " + std::to_string(scene.triangles.size()) + " triangles, " +
+  std::string instances;
+  if (!scene.instances.empty()) {
+    const PrimitiveNumbering numbering(scene);
+    instances = " (and " + std::to_string(scene.instances.size()) + " instances of " + std::to_string(scene.meshes.size()) +
+                (scene.meshes.size() == 1 ? " mesh" : " meshes") + ", " +
+                std::to_string(numbering.sphere_first() - scene.triangles.size()) + " triangles placed)";
+  }
+  return printable(scene.file.string(), 200) + ": " + std::to_string(scene.triangles.size()) + " triangles" + instances + ", " +
          std::to_string(scene.spheres.size()) + " spheres, " + std::to_string(scene.lights.size()) + " lights; " +
          std::to_string(image.width) + "x" + std::to_string(image.height) + ", " +
          std::to_string(image.samples_per_pixel) + " spp";

@@ -53,10 +53,11 @@ void run_check(Session& session, const CheckOptions& options) {
     if (options.on_scene) options.on_scene(file);
     const auto scene = std::make_shared<const Scene>(load_scene(file));
     // One hierarchy, traversed by both renderers.
-    const auto bvh = std::make_shared<const Bvh>(build_bvh(primitive_boxes(*scene)));
+    const auto bvh = std::make_shared<const SceneBvh>(build_scene_bvh(*scene));
     const DeviceScene on_device = session.upload(scene, bvh);
     std::vector<InlineScene> paths{InlineScene::never};
-    const size_t primitives = scene->triangles.size() + scene->spheres.size();
+    // (A scene with instances is never compiled in.)
+    const size_t primitives = scene->instances.empty() ? scene->triangles.size() + scene->spheres.size() : 0;
     if (primitives > 0 && primitives <= gpu::kMaxInlinePrimitives) paths.push_back(InlineScene::always);
     for (const uint32_t spp : options.samples_per_pixel) {
       RenderOptions render = options.render;

@@ -10,7 +10,7 @@ namespace vkray {
 ParityResult compare_with_reference(Session& session, std::shared_ptr<const Scene> scene, const RenderOptions& options) {
   const ImageSettings image = image_settings(*scene, options);  // a bad override fails before any work
   // One hierarchy, traversed by both.
-  const auto bvh = std::make_shared<const Bvh>(build_bvh(primitive_boxes(*scene)));
+  const auto bvh = std::make_shared<const SceneBvh>(build_scene_bvh(*scene));
   RenderOptions with_aovs = options;  // parity covers the first-hit passes too
   with_aovs.aovs = true;
   RenderResult gpu;

@@ -15,8 +15,7 @@ void add_first_hit(const Tracer& tracer, const Hit& hit, const SurfacePoint& sur
   sums->position += surface.position;
   sums->depth += hit.t;  // along a unit direction
   if (state.first_sample) {
-    const size_t p = size_t(hit.primitive), triangles = scene.triangles.size();
-    sums->object = int32_t(p < triangles ? scene.triangles[p].object : scene.spheres[p - triangles].object);
+    sums->object = int32_t(tracer.numbering().object(uint64_t(hit.primitive)));
   }
 }
 

@@ -67,19 +67,26 @@ LightPoint Lights::sample_area_light(uint32_t& stream) const {
   const uint32_t count = uint32_t(table_.entries.size());
   const uint32_t entry = gpu::alias_entry(u_pick, count);
   const EmitterTable::Entry& e = table_.entries[entry];
-  const uint32_t p = table_.entries[gpu::alias_keeps_entry(u_pick, count, entry, e.probability) ? entry : e.alias].primitive;
+  const uint64_t p = table_.entries[gpu::alias_keeps_entry(u_pick, count, entry, e.probability) ? entry : e.alias].primitive;
 
   LightPoint light;
   uint32_t material;
   dvec3 b(0.0);  // the barycentrics of a point on a triangle
-  if (p < scene.triangles.size()) {
-    const Triangle& t = scene.triangles[p];
+  const PrimitiveNumbering::Placed placed = tracer_.numbering().at(p);
+  if (placed.triangle) {
+    // In an instance, a point uniform on the mesh's triangle is uniform on the placed one too (an
+    // affine map scales every area of a triangle alike); its normal turns by the inverse transpose.
+    const Triangle& t = *placed.triangle;
     b = uniform_triangle(u1, u2);
     light.position = b.x * dvec3(t.v[0]) + b.y * dvec3(t.v[1]) + b.z * dvec3(t.v[2]);
     light.normal = glm::normalize(glm::cross(dvec3(t.v[1]) - dvec3(t.v[0]), dvec3(t.v[2]) - dvec3(t.v[0])));
+    if (placed.instance >= 0) {
+      light.position = tracer_.point_to_world(placed.instance, light.position);
+      light.normal = tracer_.normal_to_world(placed.instance, light.normal);
+    }
     material = t.material;
   } else {
-    const Sphere& s = scene.spheres[p - scene.triangles.size()];
+    const Sphere& s = *placed.sphere;
     const dvec3 d = uniform_sphere(u1, u2);
     light.position = dvec3(s.center) + double(s.radius) * d;
     light.normal = s.inward ? -d : d;
@@ -90,16 +97,14 @@ LightPoint Lights::sample_area_light(uint32_t& stream) const {
   light.radiance = dvec3(m.emission);
   light.pdf_area = area_pdf(m.emission);
   light.both_sides = m.emits_both_sides;
-  if (p < scene.triangles.size() && m.emission_texture.present()) {
-    const Triangle& t = scene.triangles[p];
-    light.radiance *= sample_texture(scene, m.emission_texture, triangle_texcoord(t, m.emission_texture, b.y, b.z));
-  }
+  if (placed.triangle && m.emission_texture.present())
+    light.radiance *= sample_texture(scene, m.emission_texture, triangle_texcoord(*placed.triangle, m.emission_texture, b.y, b.z));
   // An unlit emitter's vertex colours are part of its base colour, which it emits.
-  if (p < scene.triangles.size() && m.vertex_colours_emit && scene.triangles[p].coloured())
-    light.radiance *= dvec3(vertex_colour(scene.triangles[p], b.y, b.z));
+  if (placed.triangle && m.vertex_colours_emit && placed.triangle->coloured())
+    light.radiance *= dvec3(vertex_colour(*placed.triangle, b.y, b.z));
   // Of a see-through emitter, only the part that is there sends light.
-  if (p < scene.triangles.size() ? scene.see_through(scene.triangles[p]) : m.see_through())
-    light.radiance *= double(gpu::alpha_coverage(uint32_t(m.alpha_mode), float(opacity_at(scene, p, b.y, b.z)), m.alpha_cutoff));
+  if (placed.triangle ? scene.see_through(*placed.triangle) : m.see_through())
+    light.radiance *= double(gpu::alpha_coverage(uint32_t(m.alpha_mode), float(opacity_at(scene, placed, b.y, b.z)), m.alpha_cutoff));
   return light;
 }
 

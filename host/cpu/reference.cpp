@@ -33,12 +33,12 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
   result.rays_per_row.assign(region.height(), 0);
   if (options.aovs) result.aovs.emplace(region.width(), region.height());
 
-  Bvh built;
+  SceneBvh built;
   if (options.use_bvh && !options.bvh) {
-    built = build_bvh(primitive_boxes(scene), options.threads);  // --threads holds for the build too
+    built = build_scene_bvh(scene, options.threads);  // --threads holds for the build too
     result.bvh_seconds = built.build_seconds;
   }
-  const Bvh* bvh = options.use_bvh ? (options.bvh ? options.bvh : &built) : nullptr;
+  const SceneBvh* bvh = options.use_bvh ? (options.bvh ? options.bvh : &built) : nullptr;
   const Tracer tracer(scene, bvh);
   const Lights lights(tracer, options.shadows);
   const bool path = scene.integrator.type == Integrator::Type::path;

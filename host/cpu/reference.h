@@ -16,7 +16,7 @@
 #include "scene/scene.h"
 
 namespace vkray {
-struct Bvh;
+struct SceneBvh;
 }
 
 namespace vkray::cpu {
@@ -24,7 +24,7 @@ namespace vkray::cpu {
 struct ReferenceOptions {
   unsigned threads = 0;  // 0: one per hardware thread. The image does not depend on it.
   bool use_bvh = true;   // false: test every primitive (slow; checks the traversal)
-  const Bvh* bvh = nullptr;  // a BVH already built for this scene; null: build one
+  const SceneBvh* bvh = nullptr;  // a BVH already built for this scene; null: build one
   bool shadows = true;   // false: no shadow rays, every light counts as visible (benchmarks)
   bool aovs = false;     // also the first-hit passes (image/aovs.h)
   // Only these pixels of the image (empty: all of them); each pixel's samples are the same as in a

@@ -66,9 +66,9 @@ double intersect_sphere(const Ray& ray, const Sphere& s, double t_min, double t_
 }
 }  // namespace
 
-double opacity_at(const Scene& scene, size_t p, double u, double v) {
-  if (p >= scene.triangles.size()) return scene.materials[scene.spheres[p - scene.triangles.size()].material].opacity;
-  const Triangle& tri = scene.triangles[p];
+double opacity_at(const Scene& scene, const PrimitiveNumbering::Placed& primitive, double u, double v) {
+  if (primitive.sphere) return scene.materials[primitive.sphere->material].opacity;
+  const Triangle& tri = *primitive.triangle;
   const Material& m = scene.materials[tri.material];
   double opacity = m.opacity;
   if (m.opacity_texture.present()) opacity *= sample_texture_rgba(scene, m.opacity_texture, triangle_texcoord(tri, m.opacity_texture, u, v)).a;
@@ -78,6 +78,26 @@ double opacity_at(const Scene& scene, size_t p, double u, double v) {
 
 glm::dvec4 vertex_colour(const Triangle& tri, double u, double v) {
   return (1 - u - v) * glm::dvec4(tri.colours[0]) + u * glm::dvec4(tri.colours[1]) + v * glm::dvec4(tri.colours[2]);
+}
+
+Tracer::Tracer(const Scene& scene, const SceneBvh* bvh)
+    : scene_(scene), bvh_(bvh), numbering_(scene), epsilon_(scene.epsilon()), see_through_(scene.see_through()) {
+  for (const Instance& instance : scene.instances) {
+    const glm::dmat4 to_world(instance.to_world);
+    to_mesh_.push_back(glm::inverse(to_world));
+    normal_matrix_.push_back(glm::transpose(glm::inverse(glm::dmat3(to_world))));
+  }
+}
+
+Ray Tracer::to_mesh(int64_t instance, const Ray& ray) const {
+  const glm::dmat4& m = to_mesh_[size_t(instance)];
+  return {dvec3(m * glm::dvec4(ray.origin, 1.0)), dvec3(m * glm::dvec4(ray.dir, 0.0))};
+}
+
+dvec3 Tracer::normal_to_world(int64_t instance, const dvec3& n) const { return glm::normalize(normal_matrix_[size_t(instance)] * n); }
+
+dvec3 Tracer::point_to_world(int64_t instance, const dvec3& p) const {
+  return dvec3(glm::dmat4(scene_.instances[size_t(instance)].to_world) * glm::dvec4(p, 1.0));
 }
 
 uint32_t Tracer::alpha_key(uint32_t& stream) const { return see_through_ ? gpu::next_word(stream) : 0; }
@@ -94,73 +114,100 @@ Hit Tracer::find(const Ray& ray, double t_min, double t_max, bool any_hit, bool 
 }
 
 bool Tracer::solid(const Ray& ray, const Hit& hit, uint32_t alpha_key) const {
-  const auto p = size_t(hit.primitive);
-  const bool sphere = p >= scene_.triangles.size();
-  const Material& m = scene_.materials[sphere ? scene_.spheres[p - scene_.triangles.size()].material : scene_.triangles[p].material];
-  if (sphere ? !m.see_through() : !scene_.see_through(scene_.triangles[p])) return true;
+  const PrimitiveNumbering::Placed placed = numbering_.at(uint64_t(hit.primitive));
+  const Material& m = scene_.materials[placed.sphere ? placed.sphere->material : placed.triangle->material];
+  if (placed.sphere ? !m.see_through() : !scene_.see_through(*placed.triangle)) return true;
   // A sphere is two surfaces to a ray: the side it enters by and the side it leaves by.
-  const bool far_side =
-      sphere && glm::dot(ray.dir, ray.origin + hit.t * ray.dir - dvec3(scene_.spheres[p - scene_.triangles.size()].center)) > 0;
-  return gpu::alpha_solid(uint32_t(m.alpha_mode), float(opacity_at(scene_, p, hit.u, hit.v)), m.alpha_cutoff,
-                          gpu::alpha_random(alpha_key, uint32_t(p), far_side));
+  const bool far_side = placed.sphere && glm::dot(ray.dir, ray.origin + hit.t * ray.dir - dvec3(placed.sphere->center)) > 0;
+  return gpu::alpha_solid(uint32_t(m.alpha_mode), float(opacity_at(scene_, placed, hit.u, hit.v)), m.alpha_cutoff,
+                          gpu::alpha_random(alpha_key, uint32_t(hit.primitive), far_side));
 }
 
 Hit Tracer::search(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray, const Passed& passed) const {
   Hit best{t_max, -1};
-  const size_t count = scene_.triangles.size() + scene_.spheres.size();
   if (!bvh_) {
-    for (size_t p = 0; p < count && !(any_hit && best.primitive >= 0); ++p) test(ray, p, t_min, t_max, camera_ray, passed, best);
+    for (uint64_t p = 0; p < numbering_.count() && !(any_hit && best.primitive >= 0); ++p) {
+      const int64_t instance = numbering_.at(p).instance;
+      test(instance < 0 ? ray : to_mesh(instance, ray), p, instance, t_min, t_max, camera_ray, passed, best);
+    }
     return best;
   }
-  if (bvh_->nodes.empty()) return best;
-  // 1 / d with zero components replaced by tiny ones, so a slab test never computes 0 * inf.
-  dvec3 inv;
-  for (int a = 0; a < 3; ++a) inv[a] = (ray.dir[a] < 0 ? -1.0 : 1.0) / std::max(std::abs(ray.dir[a]), 1e-300);
-  visit(0, ray, inv, t_min, t_max, any_hit, camera_ray, passed, best);
+  // The scene's own primitives: slot i of their BVH is triangles[i] or, past them, a sphere.
+  const uint64_t triangles = scene_.triangles.size();
+  const auto own = [&](uint32_t slot) {
+    const uint64_t i = bvh_->primitives.order[slot];
+    test(ray, i < triangles ? i : numbering_.sphere_first() + (i - triangles), -1, t_min, t_max, camera_ray, passed, best);
+    return any_hit && best.primitive >= 0;
+  };
+  if (!bvh_->primitives.nodes.empty() && visit(bvh_->primitives, 0, ray, t_min, t_max, best, own)) return best;
+  if (bvh_->instances.nodes.empty()) return best;
+  // Each instance the ray enters: its mesh's BVH, walked with the ray in the mesh's space.
+  const auto instance = [&](uint32_t slot) {
+    const uint32_t k = bvh_->instances.order[slot];
+    const Ray local = to_mesh(k, ray);
+    const Bvh& mesh = bvh_->meshes[scene_.instances[k].mesh];
+    const uint64_t first = numbering_.instance_first(k);
+    return visit(mesh, 0, local, t_min, t_max, best, [&](uint32_t mesh_slot) {
+      test(local, first + mesh.order[mesh_slot], k, t_min, t_max, camera_ray, passed, best);
+      return any_hit && best.primitive >= 0;
+    });
+  };
+  visit(bvh_->instances, 0, ray, t_min, t_max, best, instance);
   return best;
 }
 
 // Tests primitive p, which becomes the best hit when it is closer than the best so far by more
 // than VKRAY_TIE, or ties with it and comes first in the scene.
-void Tracer::test(const Ray& ray, size_t p, double t_min_all, double t_max, bool camera_ray, const Passed& passed, Hit& best) const {
-  Hit candidate{-1, int(p)};
+void Tracer::test(const Ray& ray, uint64_t p, int64_t instance, double t_min_all, double t_max, bool camera_ray, const Passed& passed,
+                  Hit& best) const {
+  Hit candidate{-1, int64_t(p)};
+  candidate.instance = instance;
   // After a surface passed, a primitive that does not come later in the scene counts only past a tie with it.
-  const double t_min = int(p) <= passed.primitive ? std::max(t_min_all, passed.t * (1 + VKRAY_TIE)) : t_min_all;
-  if (p < scene_.triangles.size()) {
-    const Triangle& tri = scene_.triangles[p];
+  const double t_min = int64_t(p) <= passed.primitive ? std::max(t_min_all, passed.t * (1 + VKRAY_TIE)) : t_min_all;
+  const PrimitiveNumbering::Placed placed = numbering_.at(p);
+  if (placed.triangle) {
+    const Triangle& tri = *placed.triangle;
     candidate.t = intersect_triangle(ray, tri, t_min, limit(best, t_max), candidate.u, candidate.v);
-    // A camera ray passes the back face of a single-sided triangle: the side away from its winding's normal.
-    if (camera_ray && candidate.t >= 0 && !scene_.materials[tri.material].double_sided &&
-        glm::dot(ray.dir, glm::cross(dvec3(tri.v[1]) - dvec3(tri.v[0]), dvec3(tri.v[2]) - dvec3(tri.v[0]))) > 0)
-      return;
+    // A camera ray passes the back face of a single-sided triangle: the side away from its winding's
+    // normal (in an instance, turned to world space: a mirroring instance turns it around).
+    if (camera_ray && candidate.t >= 0 && !scene_.materials[tri.material].double_sided) {
+      const dvec3 n = glm::cross(dvec3(tri.v[1]) - dvec3(tri.v[0]), dvec3(tri.v[2]) - dvec3(tri.v[0]));
+      // dot(M^-1 d, n) is dot(d, M^-T n): the same side test in either space, the normal's
+      // direction kept by the inverse transpose, so a mirror keeps front faces front.
+      if (glm::dot(ray.dir, n) > 0) return;
+    }
   } else {
-    candidate.t = intersect_sphere(ray, scene_.spheres[p - scene_.triangles.size()], t_min, limit(best, t_max));
+    candidate.t = intersect_sphere(ray, *placed.sphere, t_min, limit(best, t_max));
   }
   if (candidate.t < 0) return;
   if (best.primitive < 0 || candidate.t < best.t * (1 - VKRAY_TIE) || candidate.primitive < best.primitive) best = candidate;
 }
 
-// Recursive descent, nearer child first. Returns true to stop (any_hit found one).
-bool Tracer::visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, bool camera_ray,
-                   const Passed& passed, Hit& best) const {
-  const BvhNode& n = bvh_->nodes[node];
-  double t_enter[2];
-  const bool hit[2] = {enters(n.child[0], ray, inv, t_min, limit(best, t_max), t_enter[0]),
-                       enters(n.child[1], ray, inv, t_min, limit(best, t_max), t_enter[1])};
-  const int first = (hit[0] && hit[1] && t_enter[1] < t_enter[0]) ? 1 : 0;
-  for (const int c : {first, 1 - first}) {
-    if (!hit[c]) continue;
-    const uint32_t link = n.link[c];
-    if (is_leaf(link)) {
-      for (uint32_t slot = leaf_first(link); slot < leaf_first(link) + leaf_count(link); ++slot) {
-        test(ray, bvh_->order[slot], t_min, t_max, camera_ray, passed, best);
-        if (any_hit && best.primitive >= 0) return true;
+// Recursive descent, nearer child first.
+template <typename Leaf>
+bool Tracer::visit(const Bvh& bvh, uint32_t node, const Ray& ray, double t_min, double t_max, const Hit& best, const Leaf& leaf) const {
+  // 1 / d with zero components replaced by tiny ones, so a slab test never computes 0 * inf.
+  dvec3 inv;
+  for (int a = 0; a < 3; ++a) inv[a] = (ray.dir[a] < 0 ? -1.0 : 1.0) / std::max(std::abs(ray.dir[a]), 1e-300);
+  const auto walk = [&](const auto& self, uint32_t at) -> bool {
+    const BvhNode& n = bvh.nodes[at];
+    double t_enter[2];
+    const bool hit[2] = {enters(n.child[0], ray, inv, t_min, limit(best, t_max), t_enter[0]),
+                         enters(n.child[1], ray, inv, t_min, limit(best, t_max), t_enter[1])};
+    const int first = (hit[0] && hit[1] && t_enter[1] < t_enter[0]) ? 1 : 0;
+    for (const int c : {first, 1 - first}) {
+      if (!hit[c]) continue;
+      const uint32_t link = n.link[c];
+      if (is_leaf(link)) {
+        for (uint32_t slot = leaf_first(link); slot < leaf_first(link) + leaf_count(link); ++slot)
+          if (leaf(slot)) return true;
+      } else if (self(self, link)) {
+        return true;
       }
-    } else if (visit(link, ray, inv, t_min, t_max, any_hit, camera_ray, passed, best)) {
-      return true;
     }
-  }
-  return false;
+    return false;
+  };
+  return walk(walk, node);
 }
 
 dvec3 valid_reflection_normal(const dvec3& ng, const dvec3& wo, const dvec3& n) {
@@ -192,12 +239,23 @@ Facing facing(const SurfacePoint& s, const dvec3& dir, bool front) {
 }
 
 SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
+  if (hit.instance < 0) return local_surface(ray, hit);
+  // An instance's surface is its mesh's, found with the ray in the mesh's space, its normals turned to
+  // world space by the inverse transpose.
+  SurfacePoint s = local_surface(to_mesh(hit.instance, ray), hit);
+  s.position = ray.origin + hit.t * ray.dir;
+  s.geometric_normal = normal_to_world(hit.instance, s.geometric_normal);
+  s.shading_normal = normal_to_world(hit.instance, s.shading_normal);
+  return s;
+}
+
+SurfacePoint Tracer::local_surface(const Ray& ray, const Hit& hit) const {
   SurfacePoint s;
   s.position = ray.origin + hit.t * ray.dir;
-  const auto p = size_t(hit.primitive);
-  const bool triangle = p < scene_.triangles.size();
+  const PrimitiveNumbering::Placed placed = numbering_.at(uint64_t(hit.primitive));
+  const bool triangle = placed.triangle != nullptr;
   // The material's values, then (on a triangle) its textures at the hit.
-  s.material = triangle ? scene_.triangles[p].material : scene_.spheres[p - scene_.triangles.size()].material;
+  s.material = triangle ? placed.triangle->material : placed.sphere->material;
   const Material& m = scene_.materials[s.material];
   s.properties = m.properties();
   s.albedo = dvec3(m.albedo);
@@ -206,13 +264,13 @@ SurfacePoint Tracer::surface(const Ray& ray, const Hit& hit) const {
   s.roughness = m.roughness;
   s.transmission = m.transmission;
   if (!triangle) {
-    const Sphere& sphere = scene_.spheres[p - scene_.triangles.size()];
+    const Sphere& sphere = *placed.sphere;
     s.geometric_normal = (s.position - dvec3(sphere.center)) / double(sphere.radius);
     if (sphere.inward) s.geometric_normal = -s.geometric_normal;
     s.shading_normal = s.geometric_normal;
     return s;
   }
-  const Triangle& tri = scene_.triangles[p];
+  const Triangle& tri = *placed.triangle;
   s.geometric_normal = glm::normalize(glm::cross(dvec3(tri.v[1]) - dvec3(tri.v[0]), dvec3(tri.v[2]) - dvec3(tri.v[0])));
   s.shading_normal = s.geometric_normal;
   if (tri.smooth)

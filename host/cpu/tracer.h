@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -11,6 +12,7 @@
 
 namespace vkray {
 struct Bvh;
+struct SceneBvh;
 }
 
 namespace vkray::cpu {
@@ -24,8 +26,9 @@ struct Ray {
 
 struct Hit {
   double t;
-  int primitive;        // triangle index, then sphere index + triangle count; -1 for none
+  int64_t primitive;    // in the scene's numbering (PrimitiveNumbering); -1 for none
   double u = 0, v = 0;  // barycentrics of a triangle hit: x = v0 + u e1 + v e2
+  int64_t instance = -1;  // the instance it belongs to (Scene::instances), or -1
 };
 
 // The surface where a ray hit.
@@ -57,9 +60,9 @@ Facing facing(const SurfacePoint& s, const dvec3& dir, bool front);
 // r . ng = min(0.9 (ng . wo), 0.01); n itself where r . ng is already at least that.
 dvec3 valid_reflection_normal(const dvec3& ng, const dvec3& wo, const dvec3& n);
 
-// The opacity of primitive p (the scene's numbering) at barycentrics (u, v) of a triangle: its
-// material's factor times its opacity texture's alpha times its vertex colours' (a sphere's: the factor).
-double opacity_at(const Scene& scene, size_t p, double u, double v);
+// The opacity of a primitive at barycentrics (u, v) of a triangle: its material's factor times its
+// opacity texture's alpha times its vertex colours' (a sphere's: the factor).
+double opacity_at(const Scene& scene, const PrimitiveNumbering::Placed& primitive, double u, double v);
 
 // A triangle's vertex colour at barycentrics (u, v).
 glm::dvec4 vertex_colour(const Triangle& tri, double u, double v);
@@ -67,7 +70,7 @@ glm::dvec4 vertex_colour(const Triangle& tri, double u, double v);
 class Tracer {
  public:
   // `bvh` null: every primitive is tested (slow; checks the traversal).
-  Tracer(const Scene& scene, const Bvh* bvh) : scene_(scene), bvh_(bvh), epsilon_(scene.epsilon()), see_through_(scene.see_through()) {}
+  Tracer(const Scene& scene, const SceneBvh* bvh);
 
   // Each query draws the ray's alpha key from the sample's stream, where the scene has see-through
   // materials (Material::see_through), as the shader does (traversal.glsl): the key decides where
@@ -89,6 +92,14 @@ class Tracer {
   SurfacePoint surface(const Ray& ray, const Hit& hit) const;
 
   const Scene& scene() const { return scene_; }
+  const PrimitiveNumbering& numbering() const { return numbering_; }
+  // A world-space ray in instance `instance`'s mesh space: its direction not made unit again, so
+  // that t is the same along both.
+  Ray to_mesh(int64_t instance, const Ray& ray) const;
+  // A mesh-space normal of instance `instance` in world space, unit.
+  dvec3 normal_to_world(int64_t instance, const dvec3& n) const;
+  // A mesh-space point of instance `instance` in world space.
+  dvec3 point_to_world(int64_t instance, const dvec3& p) const;
   // The scene's epsilon (Scene::epsilon, which walks every primitive), computed once.
   double epsilon() const { return epsilon_; }
 
@@ -102,16 +113,25 @@ class Tracer {
   // within a tie of `t` counting only if it comes later in the scene. t 0: none.
   struct Passed {
     double t = 0;
-    int primitive = -1;
+    int64_t primitive = -1;
   };
+  // The surface at a hit, with `ray` in the hit primitive's own space.
+  SurfacePoint local_surface(const Ray& ray, const Hit& hit) const;
   // Every surface taken as whole.
   Hit search(const Ray& ray, double t_min, double t_max, bool any_hit, bool camera_ray, const Passed& passed) const;
-  void test(const Ray& ray, size_t p, double t_min, double t_max, bool camera_ray, const Passed& passed, Hit& best) const;
-  bool visit(uint32_t node, const Ray& ray, const dvec3& inv, double t_min, double t_max, bool any_hit, bool camera_ray,
-             const Passed& passed, Hit& best) const;
+  // Tests primitive p (the scene's numbering), of `instance` (-1: none), with `ray` in its space.
+  void test(const Ray& ray, uint64_t p, int64_t instance, double t_min, double t_max, bool camera_ray, const Passed& passed,
+            Hit& best) const;
+  // Walks `bvh` from `node` with `ray`, calling leaf(slot) for each slot of each leaf it enters (true
+  // from leaf: stop, any_hit found one). Returns true when stopped.
+  template <typename Leaf>
+  bool visit(const Bvh& bvh, uint32_t node, const Ray& ray, double t_min, double t_max, const Hit& best, const Leaf& leaf) const;
 
   const Scene& scene_;
-  const Bvh* bvh_;
+  const SceneBvh* bvh_;
+  PrimitiveNumbering numbering_;
+  std::vector<glm::dmat4> to_mesh_;        // each instance's inverse transform
+  std::vector<glm::dmat3> normal_matrix_;  // each instance's inverse transpose
   double epsilon_;
   bool see_through_;
 };

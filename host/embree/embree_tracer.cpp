@@ -19,11 +19,35 @@ namespace vkray::bench {
 struct EmbreeTracer::State {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
+  std::vector<RTCScene> meshes;  // one per Scene::meshes, which the scene's instance geometries place
   ~State() {
     if (scene) rtcReleaseScene(scene);
+    for (RTCScene mesh : meshes) rtcReleaseScene(mesh);
     if (device) rtcReleaseDevice(device);
   }
 };
+
+namespace {
+
+// Attaches a triangle geometry of `triangles` to `scene`.
+void attach_triangles(RTCDevice device, RTCScene scene, const std::vector<Triangle>& triangles) {
+  if (triangles.empty()) return;
+  RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                               3 * sizeof(float), 3 * triangles.size()));
+  auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                 3 * sizeof(unsigned), triangles.size()));
+  for (size_t i = 0; i < triangles.size(); ++i)
+    for (size_t k = 0; k < 3; ++k) {
+      for (int c = 0; c < 3; ++c) vertices[9 * i + 3 * k + size_t(c)] = triangles[i].v[k][c];
+      indices[3 * i + k] = unsigned(3 * i + k);
+    }
+  rtcCommitGeometry(geometry);
+  rtcAttachGeometry(scene, geometry);
+  rtcReleaseGeometry(geometry);
+}
+
+}  // namespace
 
 EmbreeTracer::EmbreeTracer(const Scene& scene, unsigned threads) : state_(std::make_unique<State>()), scene_(scene) {
   const std::string config = "threads=" + std::to_string(threads);  // the build's threads, as vkray's
@@ -31,17 +55,17 @@ EmbreeTracer::EmbreeTracer(const Scene& scene, unsigned threads) : state_(std::m
   if (!state_->device) throw DeviceError("Embree: rtcNewDevice failed");
   const auto start = std::chrono::steady_clock::now();
   state_->scene = rtcNewScene(state_->device);
-  if (!scene.triangles.empty()) {
-    RTCGeometry geometry = rtcNewGeometry(state_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                 3 * sizeof(float), 3 * scene.triangles.size()));
-    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                   3 * sizeof(unsigned), scene.triangles.size()));
-    for (size_t i = 0; i < scene.triangles.size(); ++i)
-      for (size_t k = 0; k < 3; ++k) {
-        for (int c = 0; c < 3; ++c) vertices[9 * i + 3 * k + size_t(c)] = scene.triangles[i].v[k][c];
-        indices[3 * i + k] = unsigned(3 * i + k);
-      }
+  attach_triangles(state_->device, state_->scene, scene.triangles);
+  // Meshes placed by instances: one scene each, placed by Embree's instance geometries (one level).
+  for (const SharedMesh& mesh : scene.meshes) {
+    RTCScene& placed = state_->meshes.emplace_back(rtcNewScene(state_->device));
+    attach_triangles(state_->device, placed, mesh.triangles);
+    rtcCommitScene(placed);
+  }
+  for (const Instance& instance : scene.instances) {
+    RTCGeometry geometry = rtcNewGeometry(state_->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(geometry, state_->meshes[instance.mesh]);
+    rtcSetGeometryTransform(geometry, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &instance.to_world[0][0]);
     rtcCommitGeometry(geometry);
     rtcAttachGeometry(state_->scene, geometry);
     rtcReleaseGeometry(geometry);

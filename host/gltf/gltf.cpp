@@ -205,8 +205,10 @@ class GltfReader {
                                   const std::string& name) const;
   dmat4 local_transform(size_t node) const;
   void walk_nodes();
-  // The mesh of a node placed once for each instance its EXT_mesh_gpu_instancing lists.
-  void add_instances(size_t node, const dmat4& world);
+  // The transforms that place a node's mesh, one for each instance its EXT_mesh_gpu_instancing lists.
+  std::vector<dmat4> gpu_instances(size_t node, const dmat4& world);
+  // Places every mesh the walk found (placements_): read in place, or read once and placed by instances.
+  void place_meshes();
   // The mesh of a node (with its morph weights), placed by `world`.
   void add_mesh(size_t node, const dmat4& world);
   void add_primitive(const tinygltf::Primitive& p, const std::string& where, const dmat4& world, const std::vector<double>& weights);
@@ -237,6 +239,13 @@ class GltfReader {
   // Morph displacements applied so far (corners times targets): held to GltfLimits::max_morph_displacements.
   uint64_t morph_work_ = 0;
   bool camera_found_ = false;
+  // Where the default scene places meshes: a node with a mesh, and the transform that places it.
+  struct Placement {
+    size_t node;
+    dmat4 world;
+  };
+  std::vector<Placement> placements_;
+  size_t stored_apart_ = 0;  // triangles stored other than in scene_.triangles (meshes'), held to the limit too
 };
 
 // The texture coordinate set a texture reads: KHR_texture_transform's texCoord overrides the
@@ -473,15 +482,15 @@ void GltfReader::walk_nodes() {
                                                   std::to_string(model_.meshes.size()) + ")");
       if (n.skin >= 0) warn_once("skin", element("nodes", node), "skins are not rendered: the mesh is shown in its bind pose");
       if (n.extensions.count("EXT_mesh_gpu_instancing"))
-        add_instances(node, world);
+        for (const dmat4& placed : gpu_instances(node, world)) placements_.push_back({node, placed});
       else
-        add_mesh(node, world);
+        placements_.push_back({node, world});
     }
     for (auto child = n.children.rbegin(); child != n.children.rend(); ++child) stack.emplace_back(size_t(*child), world);
   }
 }
 
-void GltfReader::add_instances(size_t node, const dmat4& world) {
+std::vector<dmat4> GltfReader::gpu_instances(size_t node, const dmat4& world) {
   // Each instance is the node's mesh placed by the instance's translation, rotation and scale (T R S),
   // then by the node's world transform; absent attributes are the identity's.
   const std::string where = element("nodes", node) + ".extensions.EXT_mesh_gpu_instancing";
@@ -509,6 +518,12 @@ void GltfReader::add_instances(size_t node, const dmat4& world) {
     for (const double v : values)
       if (!(std::abs(v) <= FLT_MAX)) fail(where + ".attributes." + key, "instance " + std::to_string(i) + " is not finite");
   };
+  // Every instance a placement: held to the most primitives a scene places before any is made.
+  if (count > limits_.max_placed_triangles)
+    throw LimitError(file_.string() + ": " + where + ": " + std::to_string(count) + " instances; vkray places at most " +
+                     std::to_string(limits_.max_placed_triangles) + " triangles");
+  std::vector<dmat4> placed;
+  placed.reserve(count);
   for (size_t i = 0; i < count; ++i) {
     if (i % 256 == 0) throw_if_interrupted();
     dmat4 m(1.0);
@@ -528,20 +543,57 @@ void GltfReader::add_instances(size_t node, const dmat4& world) {
       finite("SCALE", i, {s.x, s.y, s.z});
       m = glm::scale(m, s);
     }
-    const size_t before = scene_.triangles.size();
-    add_mesh(node, world * m);
-    if (i > 0) continue;
-    // After the first: a mesh that places nothing places nothing however often, and the rest is
-    // held to the file's limit before any is placed, counting each of the mesh's primitives like a
-    // triangle (each costs the work of reading it again).
-    const size_t placed = scene_.triangles.size() - before;
-    if (placed == 0) break;
-    const size_t per_instance = placed + model_.meshes[size_t(model_.nodes[node].mesh)].primitives.size();
-    const size_t room = limits_.max_triangles - std::min(limits_.max_triangles, scene_.triangles.size());
-    if (count - 1 > room / per_instance)
-      throw LimitError(file_.string() + ": " + where + ": " + std::to_string(count) + " instances of " + std::to_string(placed) +
-                       " triangles would place more than " + std::to_string(limits_.max_triangles) +
-                       " triangles; vkray renders at most that many");
+    placed.push_back(world * m);
+  }
+  return placed;
+}
+
+void GltfReader::place_meshes() {
+  // A mesh (with its morph weights) placed more than once is read once, in its own space, and placed
+  // by instances; one placed once, and a placement whose transform cannot be inverted (a zero scale
+  // hides it), is read in place as always.
+  const auto invertible = [](const dmat4& world) {
+    const double det = glm::determinant(glm::dmat3(world));
+    return det != 0 && std::isfinite(det) && std::isfinite(1.0 / det);
+  };
+  const auto key = [&](size_t node) {
+    const tinygltf::Node& n = model_.nodes[node];
+    return std::make_pair(n.mesh, n.weights.empty() ? model_.meshes[size_t(n.mesh)].weights : n.weights);
+  };
+  std::map<std::pair<int, std::vector<double>>, std::vector<const Placement*>> uses;
+  for (const Placement& p : placements_)
+    if (invertible(p.world)) uses[key(p.node)].push_back(&p);
+  std::map<std::pair<int, std::vector<double>>, int64_t> shared;  // key -> scene_.meshes, -1: placed nothing
+  uint64_t placed = 0;
+  for (const Placement& p : placements_) {
+    const auto found = invertible(p.world) ? uses.find(key(p.node)) : uses.end();
+    if (found == uses.end() || found->second.size() < 2) {
+      add_mesh(p.node, p.world);
+      continue;
+    }
+    auto mesh = shared.find(found->first);
+    if (mesh == shared.end()) {
+      // Read once: its triangles gathered apart from the scene's own.
+      std::vector<Triangle> own;
+      std::swap(own, scene_.triangles);
+      stored_apart_ += own.size();  // (the file's own triangles, held to the limit meanwhile)
+      add_mesh(p.node, dmat4(1.0));
+      std::swap(own, scene_.triangles);
+      stored_apart_ -= scene_.triangles.size();
+      int64_t index = -1;
+      if (!own.empty()) {
+        index = int64_t(scene_.meshes.size());
+        stored_apart_ += own.size();
+        scene_.meshes.push_back({std::move(own)});
+      }
+      mesh = shared.emplace(found->first, index).first;
+    }
+    if (mesh->second < 0) continue;
+    placed += scene_.meshes[size_t(mesh->second)].triangles.size();
+    if (placed > limits_.max_placed_triangles)
+      throw LimitError(file_.string() + ": " + element("nodes", p.node) + ": the file places more than " +
+                       std::to_string(limits_.max_placed_triangles) + " triangles; vkray renders at most that many");
+    scene_.instances.push_back({uint32_t(mesh->second), glm::mat4(p.world), 0u});
   }
 }
 
@@ -664,7 +716,7 @@ void GltfReader::add_primitive(const tinygltf::Primitive& p, const std::string& 
   } else {
     triangles = corners >= 3 ? corners - 2 : 0;
   }
-  if (triangles > limits_.max_triangles - std::min(limits_.max_triangles, scene_.triangles.size()))
+  if (triangles > limits_.max_triangles - std::min(limits_.max_triangles, scene_.triangles.size() + stored_apart_))
     throw LimitError(file_.string() + ": " + where + ": the file places more than " + std::to_string(limits_.max_triangles) +
                      " triangles; vkray renders at most that many");
   // Each corner adds up every displacement of every morphed attribute: held to a budget for the file,
@@ -1129,6 +1181,7 @@ GltfScene GltfReader::read(std::string_view bytes) {
     warn_once("animations", "animations", std::to_string(model_.animations.size()) +
                                               " animations are not played: the file is shown at rest (its nodes' transforms, its default morph weights)");
   walk_nodes();
+  place_meshes();
   return std::move(scene_);
 }
 

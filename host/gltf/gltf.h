@@ -21,6 +21,10 @@ namespace vkray {
 
 struct GltfScene {
   std::vector<Triangle> triangles;  // in the file's world space; `material` indexes `materials`, `object` is 0
+  // Meshes the file places more than once (nodes that share a mesh, EXT_mesh_gpu_instancing), each
+  // read once in its own space, and their placements (`object` 0).
+  std::vector<SharedMesh> meshes;
+  std::vector<Instance> instances;
   std::vector<Material> materials;  // their TextureRefs index `textures`
   std::vector<std::shared_ptr<const Texture>> textures;
   std::vector<PointLight> lights;   // KHR_lights_punctual point lights, in world space
@@ -42,6 +46,9 @@ struct GltfLimits {
   // to apply: more throws LimitError. Far past a real file's (a million vertices with a hundred
   // targets), and a few seconds' work.
   uint64_t max_morph_displacements = uint64_t(1) << 31;
+  // The most triangles its meshes may place, counted each time they are placed (a mesh the file places
+  // more than once is stored once): more throws LimitError.
+  uint64_t max_placed_triangles = kMaxPlacedPrimitives;
   // Whether buffers and pictures outside the file are read (the fuzz target reads none).
   bool read_files = true;
 };

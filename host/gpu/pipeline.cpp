@@ -34,6 +34,7 @@ constexpr BindingSlot kTraceBindings[] = {
     {VKRAY_BINDING_TEXTURES, kTexel, "textures"},
     {VKRAY_BINDING_TANGENTS, kTexel, "tangents"},
     {VKRAY_BINDING_COLOURS, kTexel, "colours"},
+    {VKRAY_BINDING_INSTANCES, kTexel, "instances"},
 };
 
 // Two rows of one id would give the shader's constant whichever value Vulkan takes first.

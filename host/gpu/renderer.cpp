@@ -36,7 +36,7 @@ double rays_per_sample(const Scene& scene) {
 // Ray-primitive tests one sample costs through the BVH, roughly: a ray visits on the order of
 // log2(N) nodes and a few leaves.
 double tests_per_sample(const Scene& scene) {
-  const double primitives = double(scene.triangles.size() + scene.spheres.size()) + 1.0;
+  const double primitives = double(PrimitiveNumbering(scene).count()) + 1.0;  // as placed
   return (8.0 + 4.0 * std::log2(primitives)) * rays_per_sample(scene);
 }
 

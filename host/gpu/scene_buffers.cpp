@@ -61,8 +61,8 @@ TexelBuffer make_texture_buffer(const Context& ctx, const std::vector<uint16_t>&
 // Refuses, before allocating anything, a scene whose buffers cannot fit the device's memory.
 void check_memory(const Context& ctx, const PackedScene& packed) {
   uint64_t texels = packed.nodes.size();
-  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.texcoords, &packed.tangents, &packed.colours, &packed.materials,
-                             &packed.lights, &packed.emitters})
+  for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.texcoords, &packed.tangents, &packed.colours, &packed.instances,
+                             &packed.materials, &packed.lights, &packed.emitters})
     texels = checked_add(texels, buffer->size(), "scene buffers");
   const uint64_t bytes = checked_add(checked_mul(texels, sizeof(glm::vec4), "scene buffers"),
                                      checked_mul(packed.textures.size(), sizeof(uint16_t), "textures"), "scene buffers");
@@ -76,11 +76,18 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
                       " MiB, the largest device-local memory heap has " + std::to_string(largest_heap >> 20) + " MiB");
 }
 
+// Primitives stored: the scene's own and each mesh's once.
+size_t packed_primitive_count(const SceneBvh& bvh) {
+  size_t count = bvh.primitives.order.size();
+  for (const Bvh& mesh : bvh.meshes) count += mesh.order.size();
+  return count;
+}
+
 }  // namespace
 
 struct SceneBuffers::Geometry {
-  TexelBuffer primitives, normals, nodes, texcoords, textures, tangents, colours;
-  std::vector<uint32_t> order;  // the BVH's leaf order: the lighting's area lights name slots in it
+  TexelBuffer primitives, normals, nodes, texcoords, textures, tangents, colours, instances;
+  PrimitiveSlots slots;  // the lighting's area lights name slots in the primitive buffer
 };
 
 struct SceneBuffers::Lighting {
@@ -92,20 +99,22 @@ struct SceneBuffers::Lighting {
         emitters(make_texel_buffer(ctx, packed.emitters, "area light")) {}
 };
 
-SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* prebuilt)
+SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const SceneBvh* prebuilt)
     : ctx_(std::move(ctx)), scene_(std::move(scene)) {
   const auto start = Clock::now();
-  Bvh built;
-  if (!prebuilt) built = build_bvh(primitive_boxes(*scene_));
-  const Bvh& bvh = prebuilt ? *prebuilt : built;
+  SceneBvh built;
+  if (!prebuilt) built = build_scene_bvh(*scene_);
+  const SceneBvh& bvh = prebuilt ? *prebuilt : built;
   bvh_seconds_ = bvh.build_seconds;
-  primitive_count_ = uint32_t(bvh.order.size());
-  const PackedScene packed = pack_scene(*scene_, bvh);
+  primitive_count_ = uint32_t(packed_primitive_count(bvh));
+  PackedScene packed = pack_scene(*scene_, bvh);
   vertex_normals_ = !packed.normals.empty();
   vertex_colours_ = !packed.colours.empty();
+  instances_ = !packed.instances.empty();
   for (size_t p = 0; p < packed.primitives.size() && !see_through_; p += VKRAY_TEXELS_PER_PRIMITIVE)
     see_through_ = (primitive_flags(packed.primitives[p]) & VKRAY_PRIM_ALPHA) != 0u;
-  if (primitive_count_ <= kMaxInlinePrimitives) inline_scene_ = inline_scene_glsl(packed);
+  // A scene with instances is walked in two levels; the compiled-in form holds one.
+  if (primitive_count_ <= kMaxInlinePrimitives && !instances_) inline_scene_ = inline_scene_glsl(packed);
   check_memory(*ctx_, packed);
   geometry_ = std::make_shared<const Geometry>(Geometry{make_texel_buffer(*ctx_, packed.primitives, "primitive"),
                                                         make_texel_buffer(*ctx_, packed.normals, "normal"),
@@ -113,7 +122,8 @@ SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<c
                                                         make_texel_buffer(*ctx_, packed.texcoords, "texture coordinate"),
                                                         make_texture_buffer(*ctx_, packed.textures),
                                                         make_texel_buffer(*ctx_, packed.tangents, "tangent"),
-                                                        make_texel_buffer(*ctx_, packed.colours, "vertex colour"), bvh.order});
+                                                        make_texel_buffer(*ctx_, packed.colours, "vertex colour"),
+                                                        make_texel_buffer(*ctx_, packed.instances, "instance"), std::move(packed.slots)});
   lighting_ = std::make_unique<Lighting>(*ctx_, packed);
   lighting_frame_ = packed.frame;
   // A BVH built beforehand (perhaps while the shaders compiled) still counts: the upload stage
@@ -130,10 +140,11 @@ SceneBuffers::SceneBuffers(const SceneBuffers& same, std::shared_ptr<const Scene
       shares_geometry_(true),
       vertex_normals_(same.vertex_normals_),
       vertex_colours_(same.vertex_colours_),
+      instances_(same.instances_),
       see_through_(same.see_through_) {
   if (!same_geometry(same.scene(), *scene_)) throw InternalError("a scene shares the device buffers of one with other geometry");
   const auto start = Clock::now();
-  const PackedLighting packed = pack_lighting(*scene_, geometry_->order);
+  const PackedLighting packed = pack_lighting(*scene_, geometry_->slots);
   lighting_ = std::make_unique<Lighting>(*ctx_, packed);
   lighting_frame_ = packed.frame;
   upload_seconds_ = seconds_since(start);
@@ -151,7 +162,8 @@ void SceneBuffers::bind(DescriptorWriter& writer) const {
       .texel_buffer(VKRAY_BINDING_TEXCOORDS, *geometry_->texcoords.view)
       .texel_buffer(VKRAY_BINDING_TEXTURES, *geometry_->textures.view)
       .texel_buffer(VKRAY_BINDING_TANGENTS, *geometry_->tangents.view)
-      .texel_buffer(VKRAY_BINDING_COLOURS, *geometry_->colours.view);
+      .texel_buffer(VKRAY_BINDING_COLOURS, *geometry_->colours.view)
+      .texel_buffer(VKRAY_BINDING_INSTANCES, *geometry_->instances.view);
 }
 
 }  // namespace vkray::gpu

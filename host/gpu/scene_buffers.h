@@ -14,7 +14,7 @@
 #include "scene/scene.h"
 
 namespace vkray {
-struct Bvh;
+struct SceneBvh;
 }
 
 namespace vkray::gpu {
@@ -23,7 +23,7 @@ class SceneBuffers {
  public:
   // `bvh`: one already built for this scene (parity traverses the same one on the CPU); null builds
   // one. Throws DeviceError naming the limit when a buffer or the whole does not fit the device.
-  SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const Bvh* bvh = nullptr);
+  SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const SceneBvh* bvh = nullptr);
   // `scene`, whose geometry is `same`'s (same_geometry): shares `same`'s BVH and primitive buffers,
   // and uploads only its lighting (materials, lights, area lights).
   SceneBuffers(const SceneBuffers& same, std::shared_ptr<const Scene> scene);
@@ -34,6 +34,7 @@ class SceneBuffers {
   // The code that compiles this scene into the shader (packing/inline_scene.h); empty for a scene
   // with more than kMaxInlinePrimitives primitives, or none.
   const std::string& inline_scene() const { return inline_scene_; }
+  // Primitives stored (a mesh that instances place counted once).
   uint32_t primitive_count() const { return primitive_count_; }
   double bvh_seconds() const { return bvh_seconds_; }
   double upload_seconds() const { return upload_seconds_; }  // BVH build included, prebuilt or not
@@ -43,6 +44,8 @@ class SceneBuffers {
   bool vertex_normals() const { return vertex_normals_; }
   // Whether some triangle has vertex colours (Triangle::colours).
   bool vertex_colours() const { return vertex_colours_; }
+  // Whether the scene places meshes by instances: a BVH of two levels.
+  bool instances() const { return instances_; }
   // Whether some primitive lets rays through (Scene::see_through), read off the packed flags once.
   bool see_through() const { return see_through_; }
 
@@ -63,6 +66,7 @@ class SceneBuffers {
   bool shares_geometry_ = false;
   bool vertex_normals_ = false;
   bool vertex_colours_ = false;
+  bool instances_ = false;
   bool see_through_ = false;
 };
 

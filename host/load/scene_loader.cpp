@@ -1,6 +1,7 @@
 #include "load/scene_loader.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -15,10 +16,19 @@
 #include "base/json_document.h"
 #include "load/scene_parser.h"
 #include "mesh/tangents.h"
+#include "scene/transform.h"
 #include "scene/float_range.h"
 
 namespace vkray {
 namespace {
+
+// Calls f on every triangle the scene stores: its own and its meshes'.
+template <typename F>
+void each_triangle(Scene& scene, const F& f) {
+  for (Triangle& t : scene.triangles) f(t);
+  for (SharedMesh& mesh : scene.meshes)
+    for (Triangle& t : mesh.triangles) f(t);
+}
 
 // Applies the transform (KHR_texture_transform) that all the textures of a material share to its
 // triangles' texture coordinates, once, in double rounded to float: both renderers then read the
@@ -37,10 +47,11 @@ void apply_shared_texture_transforms(Scene& scene) {
     }
     if (first && same && first->transformed()) shared[i] = *first;
   }
-  for (Triangle& t : scene.triangles)
+  each_triangle(scene, [&](Triangle& t) {
     if (shared[t.material])
       for (auto* set : {&t.uv, &t.uv1})
         for (glm::vec2& uv : *set) uv = glm::vec2(shared[t.material]->map(glm::dvec2(uv)));
+  });
   for (size_t i = 0; i < scene.materials.size(); ++i)
     if (shared[i])
       for (TextureRef* ref : scene.materials[i].textures()) ref->to_u = glm::vec3(1, 0, 0), ref->to_v = glm::vec3(0, 1, 0);
@@ -51,9 +62,9 @@ void apply_shared_texture_transforms(Scene& scene) {
 // exact in float, and the texture reads the same, but both renderers then interpolate small
 // numbers, so that a floor tiled 5000 times is not sampled half a texel apart by float and double.
 void recentre_texture_coordinates(Scene& scene) {
-  for (Triangle& t : scene.triangles) {
+  each_triangle(scene, [&](Triangle& t) {
     const Material& m = scene.materials[t.material];
-    if (!m.textured()) continue;
+    if (!m.textured()) return;
     // A texture still transformed (its material's textures have different transforms) maps a whole
     // period of the coordinate to another amount of its own: such coordinates stay where they are.
     const auto repeats = [&](bool s) {
@@ -69,20 +80,21 @@ void recentre_texture_coordinates(Scene& scene) {
         for (glm::vec2& uv : *set) uv[axis] -= shift;
       }
     }
-  }
+  });
 }
 
 // MikkTSpace's tangents for the triangles of normal-mapped materials that have none (a glTF file
 // without TANGENT, an OBJ or PLY file, a scene file's own triangles), each object's together, from
 // the normals they are shaded with and their texture coordinates before any transform maps them
 // (KHR_texture_transform moves where a texture is read, not the mesh's tangent space).
-void add_missing_tangents(Scene& scene) {
+void add_missing_tangents(std::vector<Triangle>& all, const std::vector<Material>& materials, bool by_object) {
   std::vector<std::vector<size_t>> of_object;  // the triangles that need tangents, by object
-  for (size_t i = 0; i < scene.triangles.size(); ++i) {
-    const Triangle& t = scene.triangles[i];
-    if (!scene.materials[t.material].normal_texture.present() || t.has_tangents()) continue;
-    if (t.object >= of_object.size()) of_object.resize(size_t(t.object) + 1);
-    of_object[t.object].push_back(i);
+  for (size_t i = 0; i < all.size(); ++i) {
+    const Triangle& t = all[i];
+    if (!materials[t.material].normal_texture.present() || t.has_tangents()) continue;
+    const size_t object = by_object ? t.object : 0;
+    if (object >= of_object.size()) of_object.resize(object + 1);
+    of_object[object].push_back(i);
   }
   std::vector<TangentTriangle> input;
   for (const std::vector<size_t>& triangles : of_object) {
@@ -91,8 +103,8 @@ void add_missing_tangents(Scene& scene) {
     input.clear();
     input.reserve(triangles.size());
     for (const size_t i : triangles) {
-      const Triangle& t = scene.triangles[i];
-      TangentTriangle m{t.v, t.normals, t.texcoords(scene.materials[t.material].normal_texture.texcoord)};
+      const Triangle& t = all[i];
+      TangentTriangle m{t.v, t.normals, t.texcoords(materials[t.material].normal_texture.texcoord)};
       if (!t.smooth) {
         const glm::dvec3 n = glm::cross(glm::dvec3(t.v[1]) - glm::dvec3(t.v[0]), glm::dvec3(t.v[2]) - glm::dvec3(t.v[0]));
         const double length = glm::length(n);
@@ -101,8 +113,14 @@ void add_missing_tangents(Scene& scene) {
       input.push_back(m);
     }
     const std::vector<std::array<glm::vec4, 3>> tangents = mikktspace_tangents(input);
-    for (size_t k = 0; k < triangles.size(); ++k) scene.triangles[triangles[k]].tangents = tangents[k];
+    for (size_t k = 0; k < triangles.size(); ++k) all[triangles[k]].tangents = tangents[k];
   }
+}
+
+// The scene's own triangles by object; each mesh that instances place, in its own space, as one.
+void add_missing_tangents(Scene& scene) {
+  add_missing_tangents(scene.triangles, scene.materials, true);
+  for (SharedMesh& mesh : scene.meshes) add_missing_tangents(mesh.triangles, scene.materials, false);
 }
 
 // What every scene goes through last, whatever its file type: tangents where normal maps need them,
@@ -133,18 +151,35 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& file,
 
 namespace {
 
+// The box around every triangle the scene places (an instance's: its mesh's box, every corner
+// placed); lo > hi when there are none.
+std::pair<glm::vec3, glm::vec3> placed_bounds(const Scene& scene) {
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  const auto grow = [&](const glm::vec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  };
+  for (const Triangle& t : scene.triangles)
+    for (const glm::vec3& p : t.v) grow(p);
+  std::vector<std::pair<glm::vec3, glm::vec3>> meshes(scene.meshes.size(), {glm::vec3(FLT_MAX), glm::vec3(-FLT_MAX)});
+  for (size_t m = 0; m < scene.meshes.size(); ++m)
+    for (const Triangle& t : scene.meshes[m].triangles)
+      for (const glm::vec3& p : t.v) meshes[m] = {glm::min(meshes[m].first, p), glm::max(meshes[m].second, p)};
+  for (const Instance& instance : scene.instances) {
+    const auto& [a, b] = meshes[instance.mesh];
+    for (int corner = 0; corner < 8; ++corner)
+      grow(transform_point(instance.to_world, glm::vec3((corner & 1) ? b.x : a.x, (corner & 2) ? b.y : a.y, (corner & 4) ? b.z : a.z)));
+  }
+  return {lo, hi};
+}
+
 // The camera vkray frames a glTF scene with when the file has none: a 45-degree vertical field of
 // view from the front (glTF's +z) and a little above, so that the bounding sphere fills the height.
 Camera framing_camera(const Scene& scene) {
   Camera camera;
   camera.focal_length = 0.5f / std::tan(glm::radians(45.0f) / 2);
-  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-  for (const Triangle& t : scene.triangles)
-    for (const glm::vec3& p : t.v) {
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
-    }
-  if (scene.triangles.empty()) {
+  const auto [lo, hi] = placed_bounds(scene);
+  if (lo.x > hi.x) {
     camera.position = glm::vec3(0.0f, 0.0f, 1.0f);
     camera.forward = glm::vec3(0.0f, 0.0f, -1.0f);
     return camera;
@@ -177,13 +212,8 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
   // A file that brings no light is lit from the camera, so that it is seen at all (docs/scene-format.md):
   // a point light whose irradiance at the scene's centre, straight on, is 1. Emissive surfaces do not
   // count: a model's glowing parts (a helmet's visor lights) rarely light the rest of it.
-  if (scene.lights.empty() && !scene.triangles.empty()) {
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    for (const Triangle& t : scene.triangles)
-      for (const glm::vec3& p : t.v) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-      }
+  const auto [lo, hi] = placed_bounds(scene);
+  if (scene.lights.empty() && lo.x <= hi.x) {
     const float distance = std::max(glm::length((lo + hi) / 2.0f - scene.camera.position), 1e-6f);
     scene.lights.push_back(PointLight{scene.camera.position, glm::vec3(glm::pi<float>() * distance * distance)});
     scene.warnings.push_back(file.string() + ": the file brings no light (emissive surfaces do not count): vkray adds a point light at the camera");

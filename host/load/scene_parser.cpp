@@ -54,7 +54,7 @@ void SceneParser::parse(const json& root_json) {
                           "and is ignored");
   const bool emitters = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const Material& m) { return m.emissive(); });
   const bool lit = !scene_.lights.empty() || emitters || (path ? scene_.background : scene_.ambient) != glm::vec3(0.0f);
-  if (!lit && !scene_.triangles.empty())
+  if (!lit && (!scene_.triangles.empty() || !scene_.instances.empty()))
     warn(root, path ? "no lights, no emission and no background: every surface renders black"
                     : "no lights, no emission and no ambient: every surface renders black");
 }
@@ -444,14 +444,17 @@ void SceneParser::parse_object(const Value& v) {
     check_primitive_count(v, 1);
     scene_.spheres.push_back(sphere);
   } else if (type == "triangles") {
-    check_keys(v, {"type", "positions", "indices", "material", "transform", "flip_normals"});
+    check_keys(v, {"type", "positions", "indices", "material", "transform", "instances", "flip_normals"});
+    // Placed once: moved into place. Placed by "instances": stored once, in its own space.
+    const std::vector<glm::mat4> where = placements(v, transform);
+    const glm::mat4 placed = where.size() == 1 ? where[0] : glm::mat4(1.0f);
     const Value positions = require(v, "positions");
     expect_array(positions);
     std::vector<glm::vec3> points;
     points.reserve(positions.j.size());
-    for (size_t i = 0; i < positions.j.size(); ++i) points.push_back(transform_point(transform, three_numbers(positions[i])));
+    for (size_t i = 0; i < positions.j.size(); ++i) points.push_back(transform_point(placed, three_numbers(positions[i])));
     const uint32_t material = material_ref(require(v, "material"));
-    const bool flip = flip_normals(v), mirrors = glm::determinant(glm::mat3(transform)) < 0.0f;
+    const bool flip = flip_normals(v), mirrors = glm::determinant(glm::mat3(placed)) < 0.0f;
     const Value indices = require(v, "indices");
     expect_array(indices);
     std::vector<Triangle> triangles;
@@ -473,25 +476,27 @@ void SceneParser::parse_object(const Value& v) {
       if (flip != mirrors) std::swap(t.v[1], t.v[2]);  // the other winding: the normal turned around (a mirror turns it too)
       triangles.push_back(t);
     }
-    add_triangles(indices, triangles);
+    if (where.size() == 1)
+      add_triangles(indices, triangles);
+    else
+      add_instances(v["instances"], triangles, where);
   } else if (type == "mesh") {
     check_keys(v, {"type", "file", "material", "transform", "instances", "smooth", "flip_normals"});
     const std::vector<glm::mat4> where = placements(v, transform);
-    parse_mesh(v, where[0]);
-    // The rest only within the scene's limit, counted before they are made (degenerate triangles,
-    // which are left out, count too: each costs the work of placing it); a mesh without faces places
-    // nothing however often.
-    const size_t faces = meshes_.get(file_of(require(v, "file")))->triangles.size();
-    if (where.size() > 1 && faces > 0) check_primitive_count(v["instances"], checked_mul(where.size() - 1, faces, "instances"));
-    for (size_t i = 1; i < where.size() && faces > 0; ++i) parse_mesh(v, where[i]);
+    // Placed once: its triangles moved into place. Placed by "instances": stored once, in its own space.
+    std::vector<Triangle> triangles = mesh_triangles(v, where.size() == 1 ? where[0] : glm::mat4(1.0f));
+    if (where.size() == 1)
+      add_triangles(require(v, "file"), triangles);
+    else
+      add_instances(v["instances"], triangles, where);
   } else if (type == "gltf") {
     check_keys(v, {"type", "file", "transform", "instances"});
     const Value file_value = require(v, "file");
     const std::vector<glm::mat4> where = placements(v, transform);
-    add_gltf(&file_value, file_of(file_value), where[0]);
-    const size_t faces = gltf_files_.at(file_of(file_value)).gltf.triangles.size();
-    if (where.size() > 1 && faces > 0) check_primitive_count(v["instances"], checked_mul(where.size() - 1, faces, "instances"));
-    for (size_t i = 1; i < where.size() && faces > 0; ++i) add_gltf(&file_value, file_of(file_value), where[i]);
+    if (where.size() == 1)
+      add_gltf(&file_value, file_of(file_value), where[0]);
+    else
+      add_gltf_instances(file_value, v["instances"], file_of(file_value), where);
   } else {
     fail(type_value, "unknown object type \"" + printable(type) + "\" (expected \"sphere\", \"triangles\", \"mesh\" or \"gltf\")");
   }

@@ -141,7 +141,11 @@ class SceneParser {
   std::vector<glm::mat4> placements(const Value& v, const glm::mat4& transform);
   glm::mat4 parse_transform(const Value& v);
   uint32_t material_ref(const Value& v) const;
-  void parse_mesh(const Value& v, const glm::mat4& transform);
+  // A mesh object's triangles, placed by `transform`.
+  std::vector<Triangle> mesh_triangles(const Value& v, const glm::mat4& transform);
+  // Stores `triangles` once as a mesh (Scene::meshes) and places it by each of `placements`
+  // (Scene::instances, of the current object); `where`: the "instances" array.
+  void add_instances(const Value& where, std::vector<Triangle>& triangles, const std::vector<glm::mat4>& placements);
   // Adds a texture to Scene::textures, counting its texels in scene_texels_.
   void add_texture(std::shared_ptr<const Texture> texture) {
     scene_texels_ += uint64_t(texture->width) * texture->height;
@@ -175,6 +179,17 @@ class SceneParser {
     GltfScene gltf;
     uint32_t material_offset = 0;  // where its materials start in Scene::materials
   };
+  // A glTF file, read the first time it is named: its materials and textures then added to the scene.
+  LoadedGltf& gltf_file(const Value* where, const std::filesystem::path& file);
+  // The meshes a glTF file places by instances, each placed by each of its instances after each of
+  // `placements`.
+  void add_gltf_meshes(const Value& where, const LoadedGltf& loaded, const std::vector<glm::mat4>& placements);
+  // A glTF file's lights, placed by `transform`.
+  void add_gltf_lights(const Value& where, const GltfScene& gltf, const glm::mat4& transform);
+  // A glTF file placed by each of `placements`: its triangles stored once, as a mesh.
+  // `file_value`: the object's "file"; `where`: its "instances".
+  void add_gltf_instances(const Value& file_value, const Value& where, const std::filesystem::path& file,
+                          const std::vector<glm::mat4>& placements);
   std::map<std::filesystem::path, LoadedGltf> gltf_files_;
   struct MeshFileMaterials {
     std::shared_ptr<const Mesh> mesh;  // the mesh they were made for

@@ -1,6 +1,7 @@
 #include "load/scene_parser.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 
@@ -12,8 +13,7 @@
 
 namespace vkray::scene_file {
 
-std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where, const std::filesystem::path& file,
-                                                              const glm::mat4& transform) {
+SceneParser::LoadedGltf& SceneParser::gltf_file(const Value* where, const std::filesystem::path& file) {
   // A file placed several times is read once: its materials and textures are the scene's once, and
   // its warnings said once.
   auto loaded = gltf_files_.find(file);
@@ -46,8 +46,14 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
     for (const auto& t : entry.gltf.textures) add_texture(t);
     loaded = gltf_files_.emplace(file, std::move(entry)).first;
   }
-  const GltfScene& gltf = loaded->second.gltf;
-  const uint32_t material_offset = loaded->second.material_offset;
+  return loaded->second;
+}
+
+std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where, const std::filesystem::path& file,
+                                                              const glm::mat4& transform) {
+  const LoadedGltf& loaded = gltf_file(where, file);
+  const GltfScene& gltf = loaded.gltf;
+  const uint32_t material_offset = loaded.material_offset;
   static const json kNothing;
   const Value root{kNothing, ""};  // where messages point when the file is the scene itself
   const Value& at = where ? *where : root;
@@ -79,11 +85,8 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
     if (mirrors) t.swap_corners();
   }
   add_triangles(at, placed);
-  for (PointLight light : gltf.lights) {
-    light.position = transform_point(transform, light.position);
-    check_coordinates(at, light.position, "a light of the glTF file");
-    scene_.lights.push_back(light);
-  }
+  add_gltf_meshes(at, loaded, {transform});
+  add_gltf_lights(at, gltf, transform);
   std::optional<Camera> camera = gltf.camera;
   if (camera && moved) {
     camera->position = transform_point(transform, camera->position);
@@ -91,6 +94,96 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
     camera->up = glm::normalize(glm::mat3(transform) * camera->up);
   }
   return {camera, gltf.aspect_ratio};
+}
+
+void SceneParser::add_gltf_lights(const Value& where, const GltfScene& gltf, const glm::mat4& transform) {
+  for (PointLight light : gltf.lights) {
+    light.position = transform_point(transform, light.position);
+    check_coordinates(where, light.position, "a light of the glTF file");
+    scene_.lights.push_back(light);
+  }
+}
+
+void SceneParser::add_gltf_instances(const Value& file_value, const Value& where, const std::filesystem::path& file,
+                                     const std::vector<glm::mat4>& placements) {
+  const LoadedGltf& loaded = gltf_file(&file_value, file);
+  std::vector<Triangle> triangles = loaded.gltf.triangles;
+  for (Triangle& t : triangles) t.material += loaded.material_offset;
+  add_instances(where, triangles, placements);
+  add_gltf_meshes(where, loaded, placements);
+  for (const glm::mat4& transform : placements) add_gltf_lights(where, loaded.gltf, transform);
+}
+
+void SceneParser::add_gltf_meshes(const Value& where, const LoadedGltf& loaded, const std::vector<glm::mat4>& placements) {
+  // Each mesh the file places by instances, placed by each of them, each of those moved by each placement.
+  for (size_t m = 0; m < loaded.gltf.meshes.size(); ++m) {
+    std::vector<glm::mat4> transforms;
+    for (const glm::mat4& placement : placements)
+      for (const Instance& instance : loaded.gltf.instances)
+        if (instance.mesh == m) transforms.push_back(placement * instance.to_world);
+    if (transforms.empty()) continue;
+    std::vector<Triangle> triangles = loaded.gltf.meshes[m].triangles;
+    for (Triangle& t : triangles) t.material += loaded.material_offset;
+    add_instances(where, triangles, transforms);
+  }
+}
+
+void SceneParser::add_instances(const Value& where, std::vector<Triangle>& triangles, const std::vector<glm::mat4>& placements) {
+  // The mesh in its own space, its zero-area triangles left out; nothing is placed when none is left.
+  SharedMesh mesh;
+  glm::vec3 lo(FLT_MAX), hi(-FLT_MAX);
+  size_t left_out = 0;
+  for (size_t i = 0; i < triangles.size(); ++i) {
+    if (i % 4096 == 0) throw_if_interrupted();
+    const Triangle& t = triangles[i];
+    for (const glm::vec3& p : t.v) {
+      if (!glm::all(glm::lessThanEqual(glm::abs(p), glm::vec3(kMaxCoordinate))))
+        check_coordinates(where, p, ("triangle " + std::to_string(i) + " of the mesh").c_str());
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    if (glm::length(glm::cross(t.v[1] - t.v[0], t.v[2] - t.v[0])) == 0.0f) {
+      ++left_out;
+      continue;
+    }
+    mesh.triangles.push_back(t);
+  }
+  if (left_out > 0) warn(where, std::to_string(left_out) + " degenerate (zero-area) triangles left out");
+  if (mesh.triangles.empty()) return;
+  // Stored once (within kMaxScenePrimitives with everything else stored), placed many times (within
+  // kMaxPlacedPrimitives, each placement counted).
+  size_t stored = scene_.triangles.size() + scene_.spheres.size() + mesh.triangles.size();
+  uint64_t placed = scene_.triangles.size() + scene_.spheres.size();
+  for (const SharedMesh& m : scene_.meshes) stored += m.triangles.size();
+  for (const Instance& i : scene_.instances) placed += scene_.meshes[i.mesh].triangles.size();
+  if (stored > kMaxScenePrimitives)
+    throw LimitError(file_.string() + ": " + where.path + ": the scene would store " + std::to_string(stored) +
+                     " primitives; vkray renders at most " + std::to_string(kMaxScenePrimitives));
+  if (placements.size() > kMaxInstances - std::min(kMaxInstances, scene_.instances.size()) ||
+      placements.size() > (kMaxPlacedPrimitives - std::min(kMaxPlacedPrimitives, placed)) / mesh.triangles.size())
+    throw LimitError(file_.string() + ": " + where.path + ": " + std::to_string(placements.size()) + " instances of " +
+                     std::to_string(mesh.triangles.size()) + " triangles would place more than " + std::to_string(kMaxPlacedPrimitives) +
+                     " primitives; vkray renders at most that many");
+  const auto mesh_index = uint32_t(scene_.meshes.size());
+  for (size_t i = 0; i < placements.size(); ++i) {
+    if (i % 1024 == 0) throw_if_interrupted();
+    // Renderers move rays by the inverse, in 32-bit floats.
+    const glm::dmat4 inverse = glm::inverse(glm::dmat4(placements[i]));
+    bool invertible = glm::determinant(glm::dmat3(placements[i])) != 0.0;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 3; ++r) invertible = invertible && std::abs(inverse[c][r]) <= double(FLT_MAX);
+    if (!invertible)
+      fail(where.j.is_array() ? where[i] : where, "the transform cannot be inverted in 32-bit floats (a scale of zero, or too near it)");
+    // Every corner of the mesh's box, placed, within the coordinates vkray renders: so is every vertex.
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::vec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
+      const glm::vec3 q = transform_point(placements[i], p);
+      if (!glm::all(glm::lessThanEqual(glm::abs(q), glm::vec3(kMaxCoordinate))))
+        check_coordinates(where.j.is_array() ? where[i] : where, q, "the placed mesh's bounding box");
+    }
+    scene_.instances.push_back({mesh_index, placements[i], object_});
+  }
+  scene_.meshes.push_back(std::move(mesh));
 }
 
 void SceneParser::check_coordinates(const Value& where, const glm::vec3& p, const char* what) const {
@@ -214,7 +307,7 @@ std::vector<uint32_t> SceneParser::mesh_materials(const Value& where, const std:
   return index;
 }
 
-void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
+std::vector<Triangle> SceneParser::mesh_triangles(const Value& v, const glm::mat4& transform) {
   const Value file_value = require(v, "file");
   const std::filesystem::path file = file_of(file_value);
   bool smooth = false;
@@ -311,7 +404,7 @@ void SceneParser::parse_mesh(const Value& v, const glm::mat4& transform) {
       t.swap_corners();
       for (glm::vec3& n : t.normals) n = -n;
     }
-  add_triangles(file_value, triangles);
+  return triangles;
 }
 
 

@@ -86,7 +86,7 @@ std::string inline_scene_glsl(const PackedGeometry& packed) {
     out += "  if (t > 0.0) { best_t = t; best = " + std::to_string(p) +
            "u; bound = any_hit ? bound : t * (1.0 - VKRAY_TIE); }\n";
   }
-  out += "  hit = Hit(best_t, best);\n}\n";
+  out += "  hit = Hit(best_t, best, NO_INSTANCE);\n}\n";
   return out;
 }
 

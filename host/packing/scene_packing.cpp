@@ -204,65 +204,177 @@ FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const Lig
   return f;
 }
 
-PackedScene pack_scene(const Scene& scene, const Bvh& bvh) {
+PackedScene pack_scene(const Scene& scene, const SceneBvh& bvh) {
   PackedScene packed;
   static_cast<PackedGeometry&>(packed) = pack_geometry(scene, bvh);
-  static_cast<PackedLighting&>(packed) = pack_lighting(scene, bvh.order);
+  static_cast<PackedLighting&>(packed) = pack_lighting(scene, packed.slots);
   return packed;
 }
 
-PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh) {
+namespace {
+
+// The links of a BVH's packed nodes moved to where they land in the node buffer: inner nodes by
+// `node_base` wide nodes, leaves by `first_base` primitives (or instance entries). 0 stays "no child".
+void append_nodes(std::vector<glm::uvec4>& out, std::vector<glm::uvec4> texels, uint32_t first_base) {
+  const auto node_base = uint32_t(out.size() / VKRAY_TEXELS_PER_NODE);
+  for (size_t node = 0; node < texels.size(); node += VKRAY_TEXELS_PER_NODE) {
+    glm::uvec4& links = texels[node + VKRAY_NODE_LINKS];
+    for (int c = 0; c < VKRAY_NODE_WIDTH; ++c) {
+      if (links[c] == 0u) continue;
+      links[c] = is_leaf(links[c]) ? leaf_link(leaf_first(links[c]) + first_base, leaf_count(links[c])) : links[c] + node_base;
+    }
+  }
+  out.insert(out.end(), texels.begin(), texels.end());
+}
+
+// The box of everything a BVH holds: its root's children's.
+Aabb root_box(const Bvh& bvh) {
+  Aabb box = bvh.nodes[0].child[0];
+  if (!is_leaf(bvh.nodes[0].link[1]) || leaf_count(bvh.nodes[0].link[1]) > 0) box.grow(bvh.nodes[0].child[1]);
+  return box;
+}
+
+// An affine transform's rows (the last row, 0 0 0 1, left out), as texels.
+void transform_rows(const glm::dmat4& m, glm::vec4* rows) {
+  for (int r = 0; r < 3; ++r) rows[r] = glm::vec4(glm::dvec4(m[0][r], m[1][r], m[2][r], m[3][r]));
+}
+
+}  // namespace
+
+PackedGeometry pack_geometry(const Scene& scene, const SceneBvh& bvh) {
   PackedGeometry packed;
   // A primitive's flags hold its material's index.
   if (scene.materials.size() > size_t(VKRAY_PRIM_MATERIAL_MASK) + 1)
     throw LimitError(scene.file.string() + ": " + std::to_string(scene.materials.size()) + " materials; vkray renders at most " +
                      std::to_string(size_t(VKRAY_PRIM_MATERIAL_MASK) + 1));
   const size_t triangle_count = scene.triangles.size();
-  const bool any_smooth = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.smooth; });
+  const bool any_smooth = scene.any_triangle([](const Triangle& t) { return t.smooth; });
   const bool textured = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.textured(); });
   const bool normal_mapped = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.normal_texture.present(); });
-  packed.primitives.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE);
-  if (normal_mapped) packed.tangents.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
-  if (any_smooth) packed.normals.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
-  if (textured) packed.texcoords.resize(bvh.order.size() * VKRAY_TEXELS_PER_TEXCOORDS, glm::vec4(0.0f));
-  const bool coloured = std::any_of(scene.triangles.begin(), scene.triangles.end(), [](const Triangle& t) { return t.coloured(); });
-  if (coloured) packed.colours.resize(bvh.order.size() * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(1.0f));
-  for_blocks(bvh.order.size(), [&](size_t begin, size_t end) {
+  const bool coloured = scene.any_triangle([](const Triangle& t) { return t.coloured(); });
+  // The slots: the scene's own primitives first, then each mesh's, each in its BVH's leaf order.
+  std::vector<size_t> mesh_base(bvh.meshes.size());
+  size_t slots = bvh.primitives.order.size();
+  for (size_t m = 0; m < bvh.meshes.size(); ++m) {
+    mesh_base[m] = slots;
+    slots += bvh.meshes[m].order.size();
+  }
+  if (slots > kMaxScenePrimitives)
+    throw LimitError(scene.file.string() + ": " + std::to_string(slots) + " primitives stored, meshes that instances place counted once; vkray renders at most " +
+                     std::to_string(kMaxScenePrimitives));
+  packed.primitives.resize(slots * VKRAY_TEXELS_PER_PRIMITIVE);
+  if (normal_mapped) packed.tangents.resize(slots * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
+  if (any_smooth) packed.normals.resize(slots * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(0.0f));
+  if (textured) packed.texcoords.resize(slots * VKRAY_TEXELS_PER_TEXCOORDS, glm::vec4(0.0f));
+  if (coloured) packed.colours.resize(slots * VKRAY_TEXELS_PER_PRIMITIVE, glm::vec4(1.0f));
+  const auto pack_triangle = [&](size_t slot, const Triangle& t, uint32_t scene_index, uint32_t object) {
+    const Material& m = scene.materials[t.material];
+    const uint32_t flags = t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u) | (m.double_sided ? 0u : VKRAY_PRIM_SINGLE_SIDED) |
+                           (scene.see_through(t) ? VKRAY_PRIM_ALPHA : 0u) | (t.coloured() ? VKRAY_PRIM_COLOURED : 0u);
+    if (t.coloured())
+      for (size_t k = 0; k < 3; ++k) packed.colours[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = t.colours[k];
+    if (t.smooth)
+      for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
+    if (normal_mapped)
+      for (size_t k = 0; k < 3; ++k) packed.tangents[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = t.tangents[k];
+    if (textured) {
+      packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS] = glm::vec4(t.uv[0], t.uv[1]);
+      packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS + 1] = glm::vec4(t.uv[2], t.uv1[0]);
+      packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS + 2] = glm::vec4(t.uv1[1], t.uv1[2]);
+    }
+    return triangle_texels(t.v[0], t.v[1], t.v[2], flags, scene_index, object);
+  };
+  const auto store = [&](size_t slot, const PrimitiveTexels& texels) {
+    glm::vec4* out = &packed.primitives[slot * VKRAY_TEXELS_PER_PRIMITIVE];
+    out[0] = texels.a;
+    out[1] = texels.b;
+    out[2] = texels.c;
+  };
+  const PrimitiveNumbering numbering(scene);
+  const std::vector<uint32_t>& order = bvh.primitives.order;
+  for_blocks(order.size(), [&](size_t begin, size_t end) {
     throw_if_interrupted();
     for (size_t slot = begin; slot < end; ++slot) {
-      const uint32_t p = bvh.order[slot];
-      PrimitiveTexels texels;
+      const uint32_t p = order[slot];
       if (p < triangle_count) {
-        const Triangle& t = scene.triangles[p];
-        const Material& m = scene.materials[t.material];
-        const uint32_t flags = t.material | (t.smooth ? VKRAY_PRIM_SMOOTH : 0u) | (m.double_sided ? 0u : VKRAY_PRIM_SINGLE_SIDED) |
-                               (scene.see_through(t) ? VKRAY_PRIM_ALPHA : 0u) | (t.coloured() ? VKRAY_PRIM_COLOURED : 0u);
-        if (t.coloured())
-          for (size_t k = 0; k < 3; ++k) packed.colours[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = t.colours[k];
-        texels = triangle_texels(t.v[0], t.v[1], t.v[2], flags, p, t.object);
-        if (t.smooth)
-          for (size_t k = 0; k < 3; ++k) packed.normals[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = glm::vec4(t.normals[k], 0.0f);
-        if (normal_mapped)
-          for (size_t k = 0; k < 3; ++k) packed.tangents[slot * VKRAY_TEXELS_PER_PRIMITIVE + k] = t.tangents[k];
-        if (textured) {
-          packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS] = glm::vec4(t.uv[0], t.uv[1]);
-          packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS + 1] = glm::vec4(t.uv[2], t.uv1[0]);
-          packed.texcoords[slot * VKRAY_TEXELS_PER_TEXCOORDS + 2] = glm::vec4(t.uv1[1], t.uv1[2]);
-        }
+        store(slot, pack_triangle(slot, scene.triangles[p], p, scene.triangles[p].object));
       } else {
         const Sphere& sphere = scene.spheres[p - triangle_count];
-        texels = sphere_texels(sphere.center, sphere.radius,
-                               sphere.material | (sphere.inward ? VKRAY_PRIM_INWARD : 0u) |
-                                   (scene.materials[sphere.material].see_through() ? VKRAY_PRIM_ALPHA : 0u),
-                               p, sphere.object);
+        store(slot, sphere_texels(sphere.center, sphere.radius,
+                                  sphere.material | (sphere.inward ? VKRAY_PRIM_INWARD : 0u) |
+                                      (scene.materials[sphere.material].see_through() ? VKRAY_PRIM_ALPHA : 0u),
+                                  uint32_t(numbering.sphere_first() + (p - triangle_count)), sphere.object));
       }
-      glm::vec4* out = &packed.primitives[slot * VKRAY_TEXELS_PER_PRIMITIVE];
-      out[0] = texels.a;
-      out[1] = texels.b;
-      out[2] = texels.c;
     }
   });
-  packed.nodes = pack_nodes(bvh);
+  packed.slots.own.resize(order.size());
+  for (size_t slot = 0; slot < order.size(); ++slot) packed.slots.own[order[slot]] = uint32_t(slot);
+  // A mesh's triangles hold their place in the mesh; the instance adds where it starts.
+  packed.slots.meshes.resize(bvh.meshes.size());
+  for (size_t m = 0; m < bvh.meshes.size(); ++m) {
+    const std::vector<uint32_t>& mesh_order = bvh.meshes[m].order;
+    for_blocks(mesh_order.size(), [&](size_t begin, size_t end) {
+      throw_if_interrupted();
+      for (size_t s = begin; s < end; ++s)
+        store(mesh_base[m] + s, pack_triangle(mesh_base[m] + s, scene.meshes[m].triangles[mesh_order[s]], mesh_order[s], 0u));
+    });
+    packed.slots.meshes[m].resize(mesh_order.size());
+    for (size_t s = 0; s < mesh_order.size(); ++s) packed.slots.meshes[m][mesh_order[s]] = uint32_t(mesh_base[m] + s);
+  }
+  if (scene.instances.empty()) {
+    packed.nodes = pack_nodes(bvh.primitives);
+  } else {
+    // Two levels: a top BVH over the instances and, as one more entry, the scene's own primitives.
+    std::vector<Aabb> boxes = instance_boxes(scene, bvh.meshes);
+    const bool own = !bvh.primitives.nodes.empty();
+    if (own) boxes.push_back(root_box(bvh.primitives));
+    const Bvh top = build_bvh(boxes, 0, nullptr, 1);
+    uint32_t deepest = own ? bvh.primitives.depth : 0;
+    for (const Bvh& mesh : bvh.meshes) deepest = std::max(deepest, mesh.depth);
+    // The GPU's stack holds one BVH kMaxDepth deep; the top's levels and an entry's come one after
+    // the other, with one more for the rest of a top leaf.
+    if (top.depth + deepest > kMaxDepth - 4)
+      throw LimitError(scene.file.string() + ": the instances' BVH (" + std::to_string(top.depth) + " levels) over meshes of up to " +
+                       std::to_string(deepest) + " levels is deeper than the GPU's traversal holds (" + std::to_string(kMaxDepth - 4) +
+                       " together)");
+    // The node buffer: the top BVH, its leaves' instance nodes, then each entry's BVH.
+    const std::vector<glm::uvec4> top_nodes = pack_nodes(top);
+    const auto instance_nodes = uint32_t(top_nodes.size() / VKRAY_TEXELS_PER_NODE);
+    append_nodes(packed.nodes, top_nodes, instance_nodes);
+    packed.nodes.resize(packed.nodes.size() + top.order.size() * VKRAY_TEXELS_PER_NODE);
+    std::vector<uint32_t> root(bvh.meshes.size());
+    uint32_t own_root = 0;
+    if (own) {
+      own_root = uint32_t(packed.nodes.size() / VKRAY_TEXELS_PER_NODE);
+      append_nodes(packed.nodes, pack_nodes(bvh.primitives), 0);
+    }
+    for (size_t m = 0; m < bvh.meshes.size(); ++m) {
+      root[m] = uint32_t(packed.nodes.size() / VKRAY_TEXELS_PER_NODE);
+      append_nodes(packed.nodes, pack_nodes(bvh.meshes[m]), uint32_t(mesh_base[m]));
+    }
+    packed.instances.resize(top.order.size() * VKRAY_TEXELS_PER_INSTANCE);
+    packed.slots.instances.resize(scene.instances.size());
+    for (size_t entry = 0; entry < top.order.size(); ++entry) {
+      glm::vec4* texels = &packed.instances[entry * VKRAY_TEXELS_PER_INSTANCE];
+      glm::uvec4* node = &packed.nodes[(instance_nodes + entry) * VKRAY_TEXELS_PER_NODE];
+      const uint32_t k = top.order[entry];
+      const bool own_entry = k == scene.instances.size();  // the scene's own primitives
+      const glm::dmat4 to_world = own_entry ? glm::dmat4(1.0) : glm::dmat4(scene.instances[k].to_world);
+      transform_rows(glm::inverse(to_world), texels + VKRAY_INSTANCE_TO_MESH);
+      transform_rows(to_world, texels + VKRAY_INSTANCE_TO_WORLD);
+      for (int r = 0; r < 3; ++r) node[r] = floatBitsToUint(texels[VKRAY_INSTANCE_TO_MESH + r]);
+      if (own_entry) {
+        texels[VKRAY_INSTANCE_HEADER] = instance_header_texel(own_root, 0u, 0u, 0u);
+        node[3] = glm::uvec4(own_root, 0u, VKRAY_NO_INSTANCE, 0u);
+        continue;
+      }
+      const Instance& instance = scene.instances[k];
+      const auto first = uint32_t(numbering.instance_first(k));
+      texels[VKRAY_INSTANCE_HEADER] = instance_header_texel(root[instance.mesh], first, instance.object, 1u);
+      node[3] = glm::uvec4(root[instance.mesh], first, uint32_t(entry), 0u);
+      packed.slots.instances[k] = uint32_t(entry);
+    }
+  }
   const std::vector<uint32_t> offsets = texture_offsets(scene);
   packed.textures.resize(scene.textures.empty() ? 0 : (size_t(offsets.back()) + scene.textures.back()->texels.size() / 4) * 4);
   for (size_t i = 0; i < scene.textures.size(); ++i)
@@ -296,7 +408,7 @@ int radiance_exponent(const Scene& scene) {
 
 glm::vec3 unscale_radiance(glm::vec3 scaled, int radiance_exponent) { return RadianceUnscale(radiance_exponent)(scaled); }
 
-PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& order) {
+PackedLighting pack_lighting(const Scene& scene, const PrimitiveSlots& slots) {
   PackedLighting packed;
   const int exponent = radiance_exponent(scene);
   const EmitterTable table = build_emitter_table(scene);
@@ -335,12 +447,22 @@ PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& or
     // In double on the host, then one rounding: no 1 / total power in float that could overflow.
     texels[VKRAY_MATERIAL_LIGHT] = glm::vec4(float(table.density[i]), m.emits_both_sides ? 1.0f : 0.0f, 0.0f, 0.0f);
   }
-  // The area lights, their primitives as slots in the primitive buffer.
+  // The area lights, their primitives as slots in the primitive buffer (and an instance's as its entry).
   if (!table.entries.empty()) {
-    std::vector<uint32_t> slot_of(order.size());
-    for (size_t slot = 0; slot < order.size(); ++slot) slot_of[order[slot]] = uint32_t(slot);
-    for (const EmitterTable::Entry& e : table.entries)
-      packed.emitters.push_back(glm::vec4(e.probability, uintBitsToFloat(e.alias), uintBitsToFloat(slot_of[e.primitive]), 0.0f));
+    const PrimitiveNumbering numbering(scene);
+    const uint64_t triangles = scene.triangles.size();
+    for (const EmitterTable::Entry& e : table.entries) {
+      const PrimitiveNumbering::Placed placed = numbering.at(e.primitive);
+      uint32_t slot = 0, entry = 0;
+      if (placed.instance >= 0) {
+        const auto k = size_t(placed.instance);
+        slot = slots.meshes[scene.instances[k].mesh][e.primitive - numbering.instance_first(k)];
+        entry = slots.instances[k] + 1;
+      } else {
+        slot = slots.own[e.primitive < triangles ? e.primitive : triangles + (e.primitive - numbering.sphere_first())];
+      }
+      packed.emitters.push_back(glm::vec4(e.probability, uintBitsToFloat(e.alias), uintBitsToFloat(slot), uintBitsToFloat(entry)));
+    }
   }
   packed.frame = {uint32_t(table.entries.size()), exponent};
   packed.lights.resize(scene.lights.size() * VKRAY_TEXELS_PER_LIGHT);

@@ -54,6 +54,13 @@ class RadianceUnscale {
 
 glm::vec3 unscale_radiance(glm::vec3 scaled, int radiance_exponent);
 
+// Where the packed primitives lie, for the lighting to name an area light's slot.
+struct PrimitiveSlots {
+  std::vector<uint32_t> own;                   // the scene's own primitive (primitive_boxes order) -> its slot
+  std::vector<std::vector<uint32_t>> meshes;   // a mesh's triangle -> its slot
+  std::vector<uint32_t> instances;             // Scene::instances -> its entry in the instance buffer
+};
+
 // The buffers that depend on the primitives alone (same_geometry), which a scene whose camera,
 // lights or materials change keeps on the device.
 struct PackedGeometry {
@@ -63,6 +70,8 @@ struct PackedGeometry {
   std::vector<glm::vec4> texcoords;   // VKRAY_TEXELS_PER_TEXCOORDS texels each; empty when nothing is textured
   std::vector<glm::vec4> tangents;    // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when no material has a normal map
   std::vector<glm::vec4> colours;     // VKRAY_TEXELS_PER_PRIMITIVE texels each; empty when no triangle is coloured
+  std::vector<glm::vec4> instances;   // VKRAY_TEXELS_PER_INSTANCE texels each; empty when the scene has none
+  PrimitiveSlots slots;
   // Every texture's texels, in Scene::textures order: half floats, 4 a texel (an RGBA16F texel buffer).
   std::vector<uint16_t> textures;
 };
@@ -78,13 +87,14 @@ struct PackedLighting {
 // The scene's buffers; the per-frame uniforms come from pack_frame().
 struct PackedScene : PackedGeometry, PackedLighting {};
 
-PackedScene pack_scene(const Scene& scene, const Bvh& bvh);
+PackedScene pack_scene(const Scene& scene, const SceneBvh& bvh);
 // Where each of Scene::textures starts in PackedGeometry::textures, in texels. Throws LimitError when
 // the textures together pass 2^31 texels.
 std::vector<uint32_t> texture_offsets(const Scene& scene);
-PackedGeometry pack_geometry(const Scene& scene, const Bvh& bvh);
-// `order`: the BVH's leaf order (Bvh::order) of the primitive buffer the lighting goes with.
-PackedLighting pack_lighting(const Scene& scene, const std::vector<uint32_t>& order);
+// Throws LimitError where the two levels together are deeper than the GPU's traversal stack holds.
+PackedGeometry pack_geometry(const Scene& scene, const SceneBvh& bvh);
+// `slots`: those of the primitive buffer the lighting goes with.
+PackedLighting pack_lighting(const Scene& scene, const PrimitiveSlots& slots);
 
 // The binary BVH as the shader reads it: 4-wide nodes, each a binary node with its children's
 // children, child boxes quantized to 8 bits per side (layout in shaders/shared/scene_layout.h). Empty when

@@ -16,7 +16,8 @@ static_assert(sizeof(Sphere) == 28, "a Sphere field is not in scene_digest");
 static_assert(sizeof(Triangle) == 228, "a Triangle field is not in scene_digest");
 static_assert(sizeof(TextureRef) == 44, "a TextureRef field is not in scene_digest");
 static_assert(sizeof(Material) == 400, "a Material field is not in scene_digest");
-static_assert(sizeof(Scene) == 376, "a Scene field is not in scene_digest");
+static_assert(sizeof(Scene) == 424, "a Scene field is not in scene_digest");
+static_assert(sizeof(Instance) == 72, "an Instance field is not in scene_digest");
 
 // Hasher with glm's vectors, component by component.
 class SceneHasher : public Hasher {
@@ -74,15 +75,28 @@ std::string scene_digest(const Scene& scene) {
   for (const PointLight& l : scene.lights) h->add(l.position), h->add(l.intensity);
   h->add(uint64_t(scene.spheres.size()));
   for (const Sphere& s : scene.spheres) h->add(s.center), h->add(s.radius), h->add(s.material), h->add(s.object), h->add(s.inward);
-  h->add(uint64_t(scene.triangles.size()));
-  for (const Triangle& t : scene.triangles) {
-    for (const glm::vec3& v : t.v) h->add(v);
-    h->add(t.material), h->add(t.object), h->add(t.smooth);
-    for (const glm::vec3& n : t.normals) h->add(n);
-    for (const glm::vec2& uv : t.uv) h->add(uv);
-    for (const glm::vec2& uv : t.uv1) h->add(uv);
-    for (const glm::vec4& tangent : t.tangents) h->add(tangent);
-    for (const glm::vec4& colour : t.colours) h->add(colour);
+  const auto add_triangles = [&](const std::vector<Triangle>& triangles) {
+    h->add(uint64_t(triangles.size()));
+    for (const Triangle& t : triangles) {
+      for (const glm::vec3& v : t.v) h->add(v);
+      h->add(t.material), h->add(t.object), h->add(t.smooth);
+      for (const glm::vec3& n : t.normals) h->add(n);
+      for (const glm::vec2& uv : t.uv) h->add(uv);
+      for (const glm::vec2& uv : t.uv1) h->add(uv);
+      for (const glm::vec4& tangent : t.tangents) h->add(tangent);
+      for (const glm::vec4& colour : t.colours) h->add(colour);
+    }
+  };
+  add_triangles(scene.triangles);
+  // Instances only where there are some: a scene without keeps the digest it always had.
+  if (!scene.instances.empty()) {
+    h->add(uint64_t(scene.meshes.size()));
+    for (const SharedMesh& m : scene.meshes) add_triangles(m.triangles);
+    h->add(uint64_t(scene.instances.size()));
+    for (const Instance& i : scene.instances) {
+      h->add(i.mesh), h->add(i.object);
+      for (int c = 0; c < 4; ++c) h->add(glm::vec4(i.to_world[c]));
+    }
   }
   return h->hex();
 }

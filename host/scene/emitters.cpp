@@ -6,31 +6,46 @@
 
 namespace vkray {
 
-double primitive_area(const Scene& scene, uint32_t p) {
-  if (p < scene.triangles.size()) {
-    const Triangle& t = scene.triangles[p];
-    const glm::dvec3 v0(t.v[0]);
-    return 0.5 * glm::length(glm::cross(glm::dvec3(t.v[1]) - v0, glm::dvec3(t.v[2]) - v0));
+double primitive_area(const Scene& scene, const PrimitiveNumbering& numbering, uint64_t p) {
+  const PrimitiveNumbering::Placed placed = numbering.at(p);
+  if (placed.sphere) {
+    const double r = placed.sphere->radius;
+    return 4.0 * std::numbers::pi * r * r;
   }
-  const double r = scene.spheres[p - scene.triangles.size()].radius;
-  return 4.0 * std::numbers::pi * r * r;
+  const Triangle& t = *placed.triangle;
+  glm::dvec3 v[3] = {glm::dvec3(t.v[0]), glm::dvec3(t.v[1]), glm::dvec3(t.v[2])};
+  if (placed.instance >= 0) {  // the area it has where its instance places it
+    const glm::dmat4 to_world(scene.instances[size_t(placed.instance)].to_world);
+    for (glm::dvec3& corner : v) corner = glm::dvec3(to_world * glm::dvec4(corner, 1.0));
+  }
+  return 0.5 * glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
 }
 
 EmitterTable build_emitter_table(const Scene& scene) {
   EmitterTable table;
   std::vector<double> weights;
-  const auto consider = [&](uint32_t p, uint32_t material) {
+  const PrimitiveNumbering numbering(scene);
+  const auto consider = [&](uint64_t p, uint32_t material) {
     const glm::vec3 e = scene.materials[material].emission;
     if (!scene.materials[material].emissive()) return;
-    const double weight = primitive_area(scene, p) * double(gpu::emission_luminance(e));
+    const double weight = primitive_area(scene, numbering, p) * double(gpu::emission_luminance(e));
     if (!(weight > 0)) return;
-    table.entries.push_back({1.0f, uint32_t(table.entries.size()), p});
+    table.entries.push_back({1.0f, uint32_t(table.entries.size()), uint32_t(p)});
     weights.push_back(weight);
     table.total_weight += weight;
   };
-  const uint32_t triangles = static_cast<uint32_t>(scene.triangles.size());
-  for (uint32_t p = 0; p < triangles; ++p) consider(p, scene.triangles[p].material);
-  for (uint32_t s = 0; s < scene.spheres.size(); ++s) consider(triangles + s, scene.spheres[s].material);
+  const uint64_t triangles = scene.triangles.size();
+  for (uint64_t p = 0; p < triangles; ++p) consider(p, scene.triangles[size_t(p)].material);
+  // An instance's emitters: its mesh's emissive triangles, found once per mesh.
+  std::vector<std::vector<uint32_t>> emissive(scene.meshes.size());
+  for (size_t m = 0; m < scene.meshes.size(); ++m)
+    for (uint32_t t = 0; t < scene.meshes[m].triangles.size(); ++t)
+      if (scene.materials[scene.meshes[m].triangles[t].material].emissive()) emissive[m].push_back(t);
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const SharedMesh& mesh = scene.meshes[scene.instances[i].mesh];
+    for (const uint32_t t : emissive[scene.instances[i].mesh]) consider(numbering.instance_first(i) + t, mesh.triangles[t].material);
+  }
+  for (uint64_t s = 0; s < scene.spheres.size(); ++s) consider(numbering.sphere_first() + s, scene.spheres[size_t(s)].material);
   table.density.assign(scene.materials.size(), 0.0);
   if (table.total_weight > 0)
     for (size_t m = 0; m < scene.materials.size(); ++m)

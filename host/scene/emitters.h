@@ -15,7 +15,7 @@ struct EmitterTable {
   struct Entry {
     float probability = 1.0f;  // of keeping this entry rather than its alias
     uint32_t alias = 0;
-    uint32_t primitive = 0;    // in the scene's numbering: triangles, then spheres
+    uint32_t primitive = 0;    // in the scene's numbering (PrimitiveNumbering)
   };
   std::vector<Entry> entries;  // empty when nothing emits
   double total_weight = 0;     // the sum of area * luminance(emission) over the entries
@@ -29,7 +29,7 @@ struct EmitterTable {
 // never be picked.
 EmitterTable build_emitter_table(const Scene& scene);
 
-// The area of primitive p (scene numbering), in double.
-double primitive_area(const Scene& scene, uint32_t p);
+// The area of primitive p (the scene's numbering) where the scene places it, in double.
+double primitive_area(const Scene& scene, const PrimitiveNumbering& numbering, uint64_t p);
 
 }  // namespace vkray

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -27,7 +28,7 @@ std::string where_is(const Scene& scene, uint32_t object, const Material& materi
 }
 
 void check_extent(const Scene& scene) {
-  if (scene.triangles.empty() && scene.spheres.empty()) return;  // nothing to square a distance to
+  if (scene.triangles.empty() && scene.spheres.empty() && scene.instances.empty()) return;  // nothing to square a distance to
   const float extent = scene.extent();
   if (extent >= kMinExtent) return;
   throw SceneError(scene.file.string() + ": the scene reaches only " + brief(extent) +
@@ -69,15 +70,36 @@ void check_radiance_range(const Scene& scene) {
 
 void check_area_lights(const Scene& scene) {
   const EmitterTable table = build_emitter_table(scene);
+  const PrimitiveNumbering numbering(scene);
   for (const EmitterTable::Entry& e : table.entries) {
-    const bool sphere = e.primitive >= scene.triangles.size();
-    const uint32_t material = sphere ? scene.spheres[e.primitive - scene.triangles.size()].material : scene.triangles[e.primitive].material;
+    const uint32_t material = numbering.material(e.primitive);
     if (table.density[material] <= double(FLT_MAX)) continue;
-    const uint32_t object = sphere ? scene.spheres[e.primitive - scene.triangles.size()].object : scene.triangles[e.primitive].object;
+    const uint32_t object = numbering.object(e.primitive);
     throw SceneError(scene.file.string() + ": " + where_is(scene, object, scene.materials[material]) +
-                     ": an area light of area " + brief(primitive_area(scene, e.primitive)) +
+                     ": an area light of area " + brief(primitive_area(scene, numbering, e.primitive)) +
                      ": light sampling picks its points with a density of at least 1 / area, past the largest 32-bit "
                      "float (3.4e38) the GPU computes with; make it larger, or its material not emit");
+  }
+}
+
+// Rays reach an instance's mesh moved by the inverse of its transform: from anywhere within the
+// scene's reach, they must arrive within the coordinates vkray computes with (a mesh scaled by 1e-9
+// and seen from 1e3 away would be met by rays from 1e12 in its own space, past where the GPU's
+// products stay finite).
+void check_instances(const Scene& scene) {
+  if (scene.instances.empty()) return;
+  const double reach = scene.extent();
+  for (const Instance& instance : scene.instances) {
+    const glm::dmat4 inverse = glm::inverse(glm::dmat4(instance.to_world));
+    double farthest = 0;
+    for (int r = 0; r < 3; ++r)
+      farthest = std::max(farthest, (std::abs(inverse[0][r]) + std::abs(inverse[1][r]) + std::abs(inverse[2][r])) * reach +
+                                        std::abs(inverse[3][r]));
+    if (farthest <= double(kMaxCoordinate)) continue;
+    const SharedMesh& mesh = scene.meshes[instance.mesh];
+    throw SceneError(scene.file.string() + ": " + where_is(scene, instance.object, scene.materials[mesh.triangles[0].material]) +
+                     ": an instance's transform shrinks its mesh so far that rays from the scene (reaching " + brief(reach) +
+                     ") would meet it from " + brief(farthest) + " in the mesh's own space, past the coordinates vkray renders (+-1e9)");
   }
 }
 
@@ -87,6 +109,7 @@ void check_float_range(const Scene& scene) {
   check_extent(scene);
   check_radiance_range(scene);
   check_area_lights(scene);
+  check_instances(scene);
 }
 
 }  // namespace vkray

@@ -1,8 +1,11 @@
 #include "scene/scene.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
+
+#include <glm/gtc/matrix_inverse.hpp>
 
 namespace vkray {
 
@@ -31,7 +34,67 @@ float Scene::extent() const {
   for (const auto& s : spheres) grow(glm::abs(s.center) + s.radius);
   for (const auto& t : triangles)
     for (const auto& p : t.v) grow(p);
+  // An instance's world box: its mesh's box, every corner moved.
+  std::vector<std::pair<glm::vec3, glm::vec3>> boxes(meshes.size(), {glm::vec3(FLT_MAX), glm::vec3(-FLT_MAX)});
+  for (size_t m = 0; m < meshes.size(); ++m)
+    for (const auto& t : meshes[m].triangles)
+      for (const auto& p : t.v) boxes[m] = {glm::min(boxes[m].first, p), glm::max(boxes[m].second, p)};
+  for (const Instance& instance : instances) {
+    const auto& [lo, hi] = boxes[instance.mesh];
+    if (lo.x > hi.x) continue;
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::vec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
+      grow(glm::vec3(instance.to_world * glm::vec4(p, 1.0f)));
+    }
+  }
   return e;
+}
+
+PrimitiveNumbering::PrimitiveNumbering(const Scene& scene) : scene_(&scene) {
+  uint64_t next = scene.triangles.size();
+  instance_first_.reserve(scene.instances.size());
+  for (const Instance& instance : scene.instances) {
+    instance_first_.push_back(next);
+    next += scene.meshes[instance.mesh].triangles.size();
+  }
+  sphere_first_ = next;
+}
+
+PrimitiveNumbering::Placed PrimitiveNumbering::at(uint64_t p) const {
+  if (p < scene_->triangles.size()) return {&scene_->triangles[p], nullptr, -1};
+  if (p >= sphere_first_) return {nullptr, &scene_->spheres[p - sphere_first_], -1};
+  // The last instance that starts at or before p (instances of empty meshes start where the next does).
+  const auto after = std::upper_bound(instance_first_.begin(), instance_first_.end(), p);
+  const auto instance = size_t(after - instance_first_.begin()) - 1;
+  return {&scene_->meshes[scene_->instances[instance].mesh].triangles[p - instance_first_[instance]], nullptr, int64_t(instance)};
+}
+
+uint32_t PrimitiveNumbering::material(uint64_t p) const {
+  const Placed placed = at(p);
+  return placed.sphere ? placed.sphere->material : placed.triangle->material;
+}
+
+uint32_t PrimitiveNumbering::object(uint64_t p) const {
+  const Placed placed = at(p);
+  if (placed.instance >= 0) return scene_->instances[size_t(placed.instance)].object;
+  return placed.sphere ? placed.sphere->object : placed.triangle->object;
+}
+
+Triangle placed_triangle(const Triangle& t, const glm::dmat4& to_world) {
+  const glm::dmat3 linear(to_world);
+  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
+  const bool mirrors = glm::determinant(linear) < 0;
+  Triangle out = t;
+  for (size_t k = 0; k < 3; ++k) {
+    out.v[k] = glm::vec3(to_world * glm::dvec4(t.v[k], 1.0));
+    if (t.smooth) out.normals[k] = glm::vec3(glm::normalize(normal_matrix * glm::dvec3(t.normals[k])));
+    if (t.has_tangents()) {
+      const glm::dvec3 d = linear * glm::dvec3(t.tangents[k]);
+      out.tangents[k] = glm::vec4(glm::vec3(glm::normalize(d)), mirrors ? -t.tangents[k].w : t.tangents[k].w);
+    }
+  }
+  if (mirrors) out.swap_corners();
+  return out;
 }
 
 namespace {
@@ -80,7 +143,14 @@ bool same_geometry(const Scene& a, const Scene& b) {
   return a.materials.size() == b.materials.size() && textured(a) == textured(b) && normal_mapped(a) == normal_mapped(b) && same_primitive_flags() &&
          std::equal(a.textures.begin(), a.textures.end(), b.textures.begin(), b.textures.end(), same_texture) &&
          std::equal(a.triangles.begin(), a.triangles.end(), b.triangles.begin(), b.triangles.end(), same) &&
-         std::equal(a.spheres.begin(), a.spheres.end(), b.spheres.begin(), b.spheres.end(), same);
+         std::equal(a.spheres.begin(), a.spheres.end(), b.spheres.begin(), b.spheres.end(), same) &&
+         std::equal(a.meshes.begin(), a.meshes.end(), b.meshes.begin(), b.meshes.end(),
+                    [&](const SharedMesh& x, const SharedMesh& y) {
+                      return std::equal(x.triangles.begin(), x.triangles.end(), y.triangles.begin(), y.triangles.end(), same);
+                    }) &&
+         std::equal(a.instances.begin(), a.instances.end(), b.instances.begin(), b.instances.end(), [](const Instance& x, const Instance& y) {
+           return x.mesh == y.mesh && x.object == y.object && std::memcmp(&x.to_world, &y.to_world, sizeof(glm::mat4)) == 0;
+         });
 }
 
 }  // namespace vkray

@@ -1,5 +1,6 @@
 // The in-memory scene: what a scene file (docs/scene-format.md) describes, with every object
-// transform already applied, so renderers only see world-space primitives.
+// transform already applied to its own primitives; a mesh placed more than once is stored once, in
+// its own space, and placed by instances, whose transforms the renderers apply to rays.
 #pragma once
 
 #include <algorithm>
@@ -40,6 +41,12 @@ constexpr float kMaxCoordinate = 1e9f;
 // A scene holds at most this many primitives (triangles and spheres together): a BVH leaf names its
 // first primitive in 27 bits (bvh/bvh.h checks that the two agree).
 constexpr size_t kMaxScenePrimitives = (size_t(1) << 27) - 1;
+// A scene places at most this many primitives, instances' counted each time they are placed: a
+// primitive's place in the scene (PrimitiveNumbering) travels to the GPU as the bits of a float,
+// and every number below 0x7f800000 is the bits of a finite float.
+constexpr uint64_t kMaxPlacedPrimitives = 2'000'000'000;
+// A scene holds at most this many instances (a BVH leaf names them as it names primitives).
+constexpr size_t kMaxInstances = kMaxScenePrimitives;
 
 struct ImageSettings {
   uint32_t width = 512;
@@ -220,6 +227,22 @@ struct Triangle {
   bool translucent_colours() const { return colours[0].a != 1.0f || colours[1].a != 1.0f || colours[2].a != 1.0f; }
 };
 
+// A mesh that instances place (Scene::instances): its triangles in its own space, stored once
+// however often it is placed. A triangle's `object` is unused: its instance's counts.
+struct SharedMesh {
+  std::vector<Triangle> triangles;
+};
+
+// One placement of a mesh: its triangles as `to_world` (affine, invertible) moves them. The
+// renderers move rays the other way, into the mesh's space (its normals turn by the inverse
+// transpose); a transform that mirrors keeps front faces front, as it does for a scene's own
+// triangles.
+struct Instance {
+  uint32_t mesh = 0;  // in Scene::meshes
+  glm::mat4 to_world{1.0f};
+  uint32_t object = 0;  // its place in the file's "objects": the `object` pass reports it
+};
+
 struct Scene {
   std::filesystem::path file;  // where it was loaded from; paths inside are relative to its folder
   std::string name;            // the file's stem: "cornell" for scenes/cornell.json
@@ -233,6 +256,8 @@ struct Scene {
   std::vector<PointLight> lights;
   std::vector<Sphere> spheres;
   std::vector<Triangle> triangles;
+  std::vector<SharedMesh> meshes;    // what `instances` place
+  std::vector<Instance> instances;
   std::vector<std::shared_ptr<const Texture>> textures;  // what the materials' TextureRefs index
   std::vector<std::string> warnings;  // odd but valid input, e.g. unknown keys
   // Files the scene reads besides itself (meshes): `vkray watch` watches them.
@@ -248,8 +273,16 @@ struct Scene {
   // every ray then draws a key from its sample's stream (shared/sampling.h, alpha_random), on both
   // renderers. The GPU's pipeline reads the same off the packed primitives' flags (VKRAY_PRIM_ALPHA).
   bool see_through() const {
+    const auto triangle = [&](const Triangle& t) { return see_through(t); };
     return std::any_of(spheres.begin(), spheres.end(), [&](const Sphere& s) { return materials[s.material].see_through(); }) ||
-           std::any_of(triangles.begin(), triangles.end(), [&](const Triangle& t) { return see_through(t); });
+           std::any_of(triangles.begin(), triangles.end(), triangle) ||
+           std::any_of(meshes.begin(), meshes.end(), [&](const SharedMesh& m) { return std::any_of(m.triangles.begin(), m.triangles.end(), triangle); });
+  }
+  // Whether some triangle, the meshes' included, satisfies `predicate`.
+  template <typename Predicate>
+  bool any_triangle(const Predicate& predicate) const {
+    return std::any_of(triangles.begin(), triangles.end(), predicate) ||
+           std::any_of(meshes.begin(), meshes.end(), [&](const SharedMesh& m) { return std::any_of(m.triangles.begin(), m.triangles.end(), predicate); });
   }
   // Whether a triangle lets some ray through: its material does, or the material blends or masks and
   // the triangle's vertex colours are not all opaque.
@@ -258,6 +291,37 @@ struct Scene {
     return m.see_through() || (m.alpha_mode != AlphaMode::opaque && t.translucent_colours());
   }
 };
+
+// The scene's numbering of the primitives it places: its own triangles, then each instance's mesh
+// triangles (instance by instance, each in its mesh's order), then its spheres. Ties between hits
+// and alpha keys go by it (VKRAY_TIE, shared/sampling.h) on both renderers, so a scene renders as
+// it would with every instance's triangles copied into place in that order.
+class PrimitiveNumbering {
+ public:
+  explicit PrimitiveNumbering(const Scene& scene);
+
+  struct Placed {
+    const Triangle* triangle = nullptr;  // in its mesh's space when `instance` >= 0
+    const Sphere* sphere = nullptr;
+    int64_t instance = -1;               // in Scene::instances
+  };
+  uint64_t count() const { return sphere_first_ + scene_->spheres.size(); }
+  uint64_t instance_first(size_t instance) const { return instance_first_[instance]; }
+  uint64_t sphere_first() const { return sphere_first_; }
+  Placed at(uint64_t p) const;
+  uint32_t material(uint64_t p) const;
+  uint32_t object(uint64_t p) const;
+
+ private:
+  const Scene* scene_;
+  std::vector<uint64_t> instance_first_;
+  uint64_t sphere_first_ = 0;
+};
+
+// Triangle `t` of a mesh as instance `to_world` places it: its vertices moved, its normals turned by
+// the inverse transpose and its tangents as directions (each unit again), corners swapped where the
+// transform mirrors. What a renderer that copied the instance into place would hold.
+Triangle placed_triangle(const Triangle& t, const glm::dmat4& to_world);
 
 // Whether two scenes have the same primitives, bit for bit, with the same materials, objects and
 // textures (a scene on the device can then keep its BVH, primitive and texture buffers:

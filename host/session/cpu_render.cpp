@@ -13,7 +13,7 @@ unsigned cpu_threads(const RenderOptions& options) {
   return thread_count(options.threads);
 }
 
-RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, const Bvh* bvh,
+RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, const SceneBvh* bvh,
                            std::vector<uint64_t>* signatures) {
   cpu::ReferenceOptions reference_options;
   reference_options.threads = cpu_threads(options);
@@ -23,9 +23,9 @@ RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, con
   if (options.progress)
     reference_options.progress = [&options](uint32_t done, uint32_t total) { options.progress("rows", done, total); };
   const ImageSettings settings = image_settings(scene, options);
-  Bvh built;  // one BVH for a band's probe and the render
+  SceneBvh built;  // one BVH for a band's probe and the render
   if (options.region && std::holds_alternative<Band>(*options.region) && !bvh) {
-    built = build_bvh(primitive_boxes(scene), reference_options.threads);
+    built = build_scene_bvh(scene, reference_options.threads);
     reference_options.bvh = bvh = &built;
   }
   if (options.region) reference_options.region = resolve_region(scene, settings, *options.region, bvh);

@@ -51,7 +51,7 @@ RegionRequest parse_region(std::string_view text) {
   return region;
 }
 
-std::vector<PixelRegion> work_bands(const Scene& scene, const ImageSettings& image, uint32_t count, const Bvh* bvh) {
+std::vector<PixelRegion> work_bands(const Scene& scene, const ImageSettings& image, uint32_t count, const SceneBvh* bvh) {
   if (count == 0 || count > image.height)
     throw UsageError(std::to_string(count) + " bands of a " + std::to_string(image.height) +
                      "-row image: a band has at least one row, so 1 to " + std::to_string(image.height));
@@ -100,7 +100,7 @@ std::vector<PixelRegion> work_bands(const Scene& scene, const ImageSettings& ima
   return bands;
 }
 
-PixelRegion resolve_region(const Scene& scene, const ImageSettings& image, const RegionRequest& request, const Bvh* bvh) {
+PixelRegion resolve_region(const Scene& scene, const ImageSettings& image, const RegionRequest& request, const SceneBvh* bvh) {
   if (const Band* band = std::get_if<Band>(&request)) return work_bands(scene, image, band->count, bvh)[band->index];
   const PixelRegion region = std::get<PixelRegion>(request);
   if (!region.within(image.width, image.height))

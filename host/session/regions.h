@@ -13,7 +13,7 @@
 #include "scene/scene.h"
 
 namespace vkray {
-struct Bvh;
+struct SceneBvh;
 
 // The I-th of N bands, counted from 0 (0 <= index < count).
 struct Band {
@@ -35,11 +35,11 @@ constexpr uint32_t kMaxBands = kMaxImageSide;
 // The bands depend only on the scene and the image settings, so every process that asks computes
 // the same ones. `bvh`: one built for the scene; null builds one. Throws UsageError when count is 0
 // or exceeds the image's rows, Cancelled on an interrupt request.
-std::vector<PixelRegion> work_bands(const Scene& scene, const ImageSettings& image, uint32_t count, const Bvh* bvh = nullptr);
+std::vector<PixelRegion> work_bands(const Scene& scene, const ImageSettings& image, uint32_t count, const SceneBvh* bvh = nullptr);
 
 // The pixels `request` names in an image of `image`'s size: a rectangle is checked to lie within
 // it (UsageError otherwise), a band is work_bands(...)[index].
 PixelRegion resolve_region(const Scene& scene, const ImageSettings& image, const RegionRequest& request,
-                           const Bvh* bvh = nullptr);
+                           const SceneBvh* bvh = nullptr);
 
 }  // namespace vkray

@@ -114,7 +114,7 @@ bool DeviceScene::shares_geometry() const { return buffers_->shares_geometry(); 
 
 BackgroundBvh::BackgroundBvh(std::shared_ptr<const Scene> scene) : stop_(std::make_shared<std::atomic<bool>>(false)) {
   build_ = std::async(std::launch::async,
-                      [scene = std::move(scene), stop = stop_] { return build_bvh(primitive_boxes(*scene), 0, stop.get()); });
+                      [scene = std::move(scene), stop = stop_] { return build_scene_bvh(*scene, 0, stop.get()); });
 }
 
 BackgroundBvh::~BackgroundBvh() {
@@ -122,19 +122,21 @@ BackgroundBvh::~BackgroundBvh() {
   if (build_.valid()) build_.wait();  // milliseconds: the build checks the flag at every node
 }
 
-Bvh BackgroundBvh::get() { return build_.get(); }
+SceneBvh BackgroundBvh::get() { return build_.get(); }
 
-DeviceScene Session::upload(std::shared_ptr<const Scene> scene, std::shared_ptr<const Bvh> bvh) {
+DeviceScene Session::upload(std::shared_ptr<const Scene> scene, std::shared_ptr<const SceneBvh> bvh) {
   device();
   // A tree built for another scene would send the packing past the primitives' ends.
-  if (bvh && bvh->order.size() != scene->triangles.size() + scene->spheres.size())
-    throw UsageError("a BVH over " + std::to_string(bvh->order.size()) + " primitives for a scene of " +
-                     std::to_string(scene->triangles.size() + scene->spheres.size()));
+  if (bvh && (bvh->primitives.order.size() != scene->triangles.size() + scene->spheres.size() ||
+              bvh->meshes.size() != scene->meshes.size() || bvh->instances.order.size() != scene->instances.size()))
+    throw UsageError("a BVH over " + std::to_string(bvh->primitives.order.size()) + " primitives and " +
+                     std::to_string(bvh->instances.order.size()) + " instances for a scene of " +
+                     std::to_string(scene->triangles.size() + scene->spheres.size()) + " and " + std::to_string(scene->instances.size()));
   // An upload may go through the queue, behind a tile that timed out and still runs: refuse at
   // once rather than wait behind it.
   if (renderer_->busy_after_interrupts(kInterruptedTileWait))
     throw TimeoutError("the device is still running a render tile that timed out; the scene was not uploaded");
-  if (!bvh) bvh = std::make_shared<const Bvh>(build_bvh(primitive_boxes(*scene)));
+  if (!bvh) bvh = std::make_shared<const SceneBvh>(build_scene_bvh(*scene));
   DeviceScene uploaded(on_device([&] { return std::make_shared<const gpu::SceneBuffers>(ctx_, std::move(scene), bvh.get()); }),
                        bvh);
   check_validation("scene upload");
@@ -186,6 +188,7 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   variant.point_lights = !s.lights.empty();
   variant.background = variant.path && s.background != glm::vec3(0.0f);  // only paths sample it
   variant.vertex_colours = scene.vertex_colours();
+  variant.instances = scene.instances();
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))
     variant.inline_scene = scene.inline_scene();
   return variant;

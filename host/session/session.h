@@ -40,13 +40,13 @@ class DeviceScene {
 
  private:
   friend class Session;
-  DeviceScene(std::shared_ptr<const gpu::SceneBuffers> buffers, std::shared_ptr<const Bvh> bvh)
+  DeviceScene(std::shared_ptr<const gpu::SceneBuffers> buffers, std::shared_ptr<const SceneBvh> bvh)
       : buffers_(std::move(buffers)), bvh_(std::move(bvh)) {}
   std::shared_ptr<const gpu::SceneBuffers> buffers_;
   // The tree on the device, as built: a band of a region is estimated with it instead of a tree built
   // again for each band (about a second for two million triangles), at the cost of keeping its nodes in
   // host memory as long as the handle (less than the scene's own triangles take).
-  std::shared_ptr<const Bvh> bvh_;
+  std::shared_ptr<const SceneBvh> bvh_;
 };
 
 class Session {
@@ -81,7 +81,7 @@ class Session {
   // ---- Scenes -----------------------------------------------------------------------------------
   // Builds the scene's BVH (or takes `bvh`, built for this scene) and uploads it. Throws
   // TimeoutError at once while a tile that timed out still runs on the device.
-  DeviceScene upload(std::shared_ptr<const Scene> scene, std::shared_ptr<const Bvh> bvh = nullptr);
+  DeviceScene upload(std::shared_ptr<const Scene> scene, std::shared_ptr<const SceneBvh> bvh = nullptr);
   // `scene`, an edit of `previous` (uploaded by this session): when their geometry is the same
   // (same_geometry: a camera, lights, materials, the image or the integrator changed), it shares
   // `previous`'s BVH and primitive buffers and uploads only the lighting; otherwise upload(scene).
@@ -145,11 +145,11 @@ class BackgroundBvh {
   BackgroundBvh& operator=(const BackgroundBvh&) = delete;
 
   // Waits for the tree. Throws what the build threw (LimitError, Cancelled).
-  Bvh get();
+  SceneBvh get();
 
  private:
   std::shared_ptr<std::atomic<bool>> stop_;  // shared with the building thread, which may outlive a moved-from future
-  std::future<Bvh> build_;
+  std::future<SceneBvh> build_;
 };
 
 }  // namespace vkray

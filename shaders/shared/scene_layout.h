@@ -69,6 +69,48 @@ VKRAY_INLINE float sphere_radius(vec4 b) { return b.x; }
 // Vertex colours of coloured triangles (VKRAY_PRIM_COLOURED): a buffer in the same slots as the
 // primitives, one texel per vertex (rgba, each in [0, 1]), present only when some triangle is coloured.
 
+// ---- Instances: VKRAY_TEXELS_PER_INSTANCE RGBA32F texels each ---------------------------------------
+// Present when the scene places meshes by instances (vkray::Instance). The BVH is then two levels:
+// the node buffer starts with a top BVH whose leaves name instance nodes (below: an instance, or the
+// scene's own primitives, untransformed), and each names the root of its own BVH further on, over
+// primitives in their own space. The entries here hold what shading needs. A ray enters an entry moved into that space by its to_mesh rows;
+// its direction is not made unit again, so t is the same in both. A primitive's scene index there is
+// its place in its mesh, and the entry's first scene index is added (vkray::PrimitiveNumbering).
+// The traversal reads what it needs of an instance where it reads nodes: the top BVH's leaves name
+// instance nodes, VKRAY_TEXELS_PER_NODE texels each in the node buffer (the three rows of the
+// world-to-mesh transform as float bits, then (root node, first scene index, entry, 0)), entry being
+// the instance's place in the instance buffer, or VKRAY_NO_INSTANCE for the scene's own primitives.
+#define VKRAY_NO_INSTANCE 0xffffffffu
+
+struct InstanceNode {
+  vec4 row0, row1, row2;
+  uint root;
+  uint first_index;
+  uint instance;
+};
+
+VKRAY_INLINE InstanceNode instance_node(uvec4 t0, uvec4 t1, uvec4 t2, uvec4 t3) {
+  InstanceNode n;
+  n.row0 = uintBitsToFloat(t0);
+  n.row1 = uintBitsToFloat(t1);
+  n.row2 = uintBitsToFloat(t2);
+  n.root = t3.x;
+  n.first_index = t3.y;
+  n.instance = t3.z;
+  return n;
+}
+
+#define VKRAY_TEXELS_PER_INSTANCE 7
+#define VKRAY_INSTANCE_TO_MESH 0   // 3 texels: the rows of the world-to-mesh transform (affine, 3x4)
+#define VKRAY_INSTANCE_TO_WORLD 3  // 3 texels: the rows of the mesh-to-world transform
+// (root node, first scene index, object, placed) as uint bits; placed 0: the scene's own primitives,
+// whose texels hold their scene index and object themselves and whose transforms are the identity.
+#define VKRAY_INSTANCE_HEADER 6
+
+VKRAY_INLINE vec4 instance_header_texel(uint root, uint first_index, uint object, uint placed) {
+  return vec4(uintBitsToFloat(root), uintBitsToFloat(first_index), uintBitsToFloat(object), uintBitsToFloat(placed));
+}
+
 // ---- Materials: shared/materials.h ------------------------------------------------------------------
 
 // The material a primitive's flags name.
@@ -116,9 +158,10 @@ VKRAY_INLINE uint texture_texcoord_set(uint mode) { return (mode >> 6u) & 1u; }
 
 // ---- Emissive primitives: the area lights, one RGBA32F texel each ------------------------------------
 // An alias table (Walker 1977) over the primitives whose material emits, each weighted by its power
-// (area times the luminance of its emission): entry i is (probability, alias as uint bits, primitive
-// as uint bits, 0). The primitive is a slot in the primitive buffer on the GPU and the scene's
-// numbering on the CPU. One uniform u picks an entry with alias_pick; both renderers compute it in
+// (area times the luminance of its emission, where the scene places it): entry i is (probability,
+// alias as uint bits, primitive as uint bits, instance + 1 as uint bits). The primitive is a slot in
+// the primitive buffer on the GPU and the scene's numbering on the CPU; the instance is its entry in
+// the instance buffer, 0 for none. One uniform u picks an entry with alias_pick; both renderers compute it in
 // float, so they pick the same light for the same u.
 #define VKRAY_TEXELS_PER_EMITTER 1
 

@@ -27,6 +27,7 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BINDING_TEXTURES 10   // uniform texel buffer, RGBA16F: every texture's texels
 #define VKRAY_BINDING_TANGENTS 11   // uniform texel buffer, RGBA32F: vertex tangents of normal-mapped triangles
 #define VKRAY_BINDING_COLOURS 12    // uniform texel buffer, RGBA32F: vertex colours of coloured triangles
+#define VKRAY_BINDING_INSTANCES 13  // uniform texel buffer, RGBA32F: the instances (scene_layout.h)
 
 // ---- Specialization constants ------------------------------------------------------------------
 // One table: X(id, GLSL name, gpu::ShaderVariant member, default). resources.glsl declares each
@@ -67,6 +68,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_BACKGROUND 12
 // false when no triangle has vertex colours: no colours buffer read, and no code for them.
 #define VKRAY_SPEC_VERTEX_COLOURS 13
+// false when the scene places no mesh by instances: one level of BVH, and no code for a second.
+#define VKRAY_SPEC_INSTANCES 14
 // And one per material type, id VKRAY_SPEC_MATERIALS + its number (shared/materials.h): whether the
 // scene has a material of that type (gpu::ShaderVariant::materials, a bit each); the BSDF code of
 // the others is left out. Declared as SCENE_HAS_<name> (SCENE_HAS_roughconductor).
@@ -85,7 +88,8 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_SHADING_NORMALS, SCENE_HAS_SHADING_NORMALS, shading_normals, true) \
   X(VKRAY_SPEC_POINT_LIGHTS, SCENE_HAS_POINT_LIGHTS, point_lights, true) \
   X(VKRAY_SPEC_BACKGROUND, SCENE_HAS_BACKGROUND, background, true) \
-  X(VKRAY_SPEC_VERTEX_COLOURS, SCENE_HAS_VERTEX_COLOURS, vertex_colours, false)
+  X(VKRAY_SPEC_VERTEX_COLOURS, SCENE_HAS_VERTEX_COLOURS, vertex_colours, false) \
+  X(VKRAY_SPEC_INSTANCES, SCENE_HAS_INSTANCES, instances, false)
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
