@@ -6,6 +6,7 @@
 #include <set>
 #include <vector>
 
+#include <glm/gtc/matrix_access.hpp>
 #include <gtest/gtest.h>
 
 #include "base/errors.h"
@@ -238,7 +239,8 @@ TEST(GltfTest, GpuInstancingPlacesTheMeshOncePerInstance) {
   EXPECT_NE(many.find("test.gltf: nodes[0]: the file places more than 5 triangles"), std::string::npos) << many;
   small.max_placed_triangles = 2;
   const std::string instances = error_of([&] { parse_gltf(b.gltf(), "test.gltf", small); });
-  EXPECT_NE(instances.find("test.gltf: nodes[0].extensions.EXT_mesh_gpu_instancing: 3 instances; vkray places at most 2 triangles"),
+  EXPECT_NE(instances.find("test.gltf: nodes[0].extensions.EXT_mesh_gpu_instancing: 3 instances; vkray places at most 16777216 "
+                            "meshes and 2 triangles"),
             std::string::npos)
       << instances;
   b.doc["nodes"][node]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] = b.accessor({1, 1, 1}, "VEC3");
@@ -251,7 +253,8 @@ TEST(GltfTest, NodesSharingAMeshPlaceItByInstances) {
   GltfBuilder b;
   b.quad();
   b.quad();  // a second mesh, placed once
-  for (const auto& [translation, scale] : {std::pair{3.0, 1.0}, std::pair{-3.0, -1.0}, std::pair{0.0, 0.0}}) {
+  // (The last: a scale no float holds, 1e-50, which leaves the mesh to be read in place.)
+  for (const auto& [translation, scale] : {std::pair{3.0, 1.0}, std::pair{-3.0, -1.0}, std::pair{0.0, 0.0}, std::pair{0.0, 1e-50}}) {
     b.doc["nodes"].push_back({{"mesh", 0}, {"translation", {translation, 0, 0}}, {"scale", {scale, 1, 1}}});
     b.doc["scenes"][0]["nodes"].push_back(int(b.doc["nodes"].size()) - 1);
   }
@@ -263,7 +266,14 @@ TEST(GltfTest, NodesSharingAMeshPlaceItByInstances) {
   EXPECT_LT(glm::determinant(glm::mat3(s.instances[2].to_world)), 0.0f);  // mirrored, as the file has it
   // In place: the second mesh, and the first where a node scales it to nothing (its triangles then
   // degenerate, which the scene leaves out).
-  EXPECT_EQ(s.triangles.size(), 4u);
+  EXPECT_EQ(s.triangles.size(), 6u);
+  // A node's matrix whose last row is not (0, 0, 0, 1) places its copies by the affine part, and so
+  // its instances.
+  b.doc["nodes"][3] = {{"mesh", 0}, {"matrix", {1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 3, 0, 0, 2}}};
+  const GltfScene projective = parse(b.gltf());
+  ASSERT_EQ(projective.instances.size(), 3u);
+  EXPECT_EQ(glm::row(projective.instances[2].to_world, 3), glm::vec4(0, 0, 0, 1));
+  EXPECT_EQ(glm::vec3(projective.instances[2].to_world[3]), glm::vec3(3, 0, 0));
 }
 
 TEST(GltfTest, AFlatteningScaleKeepsWhatStaysInThePlane) {

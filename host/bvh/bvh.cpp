@@ -611,9 +611,10 @@ std::vector<Aabb> instance_boxes(const Scene& scene, const std::vector<Bvh>& mes
       const glm::dvec3 p((corner & 1) ? local.max.x : local.min.x, (corner & 2) ? local.max.y : local.min.y,
                          (corner & 4) ? local.max.z : local.min.z);
       const glm::dvec3 q(m * glm::dvec4(p, 1.0));
+      // (Held within the coordinates vkray renders, where the loader holds every placed corner.)
       for (int a = 0; a < 3; ++a) {
-        world.min[a] = std::min(world.min[a], std::nextafter(float(q[a]), -FLT_MAX));
-        world.max[a] = std::max(world.max[a], std::nextafter(float(q[a]), FLT_MAX));
+        world.min[a] = std::min(world.min[a], std::max(std::nextafter(float(q[a]), -FLT_MAX), -kMaxCoordinate));
+        world.max[a] = std::max(world.max[a], std::min(std::nextafter(float(q[a]), FLT_MAX), kMaxCoordinate));
       }
     }
   }

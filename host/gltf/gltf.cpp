@@ -484,7 +484,7 @@ void GltfReader::walk_nodes() {
       if (n.extensions.count("EXT_mesh_gpu_instancing"))
         for (const dmat4& placed : gpu_instances(node, world)) placements_.push_back({node, placed});
       else
-        placements_.push_back({node, world});
+        placements_.push_back({node, world});  // (at most one a node: the file's size bounds them)
     }
     for (auto child = n.children.rbegin(); child != n.children.rend(); ++child) stack.emplace_back(size_t(*child), world);
   }
@@ -519,9 +519,9 @@ std::vector<dmat4> GltfReader::gpu_instances(size_t node, const dmat4& world) {
       if (!(std::abs(v) <= FLT_MAX)) fail(where + ".attributes." + key, "instance " + std::to_string(i) + " is not finite");
   };
   // Every instance a placement: held to the most primitives a scene places before any is made.
-  if (count > limits_.max_placed_triangles)
+  if (count > limits_.max_placed_triangles || count > kMaxInstances - std::min(kMaxInstances, placements_.size()))
     throw LimitError(file_.string() + ": " + where + ": " + std::to_string(count) + " instances; vkray places at most " +
-                     std::to_string(limits_.max_placed_triangles) + " triangles");
+                     std::to_string(kMaxInstances) + " meshes and " + std::to_string(limits_.max_placed_triangles) + " triangles");
   std::vector<dmat4> placed;
   placed.reserve(count);
   for (size_t i = 0; i < count; ++i) {
@@ -552,9 +552,22 @@ void GltfReader::place_meshes() {
   // A mesh (with its morph weights) placed more than once is read once, in its own space, and placed
   // by instances; one placed once, and a placement whose transform cannot be inverted (a zero scale
   // hides it), is read in place as always.
-  const auto invertible = [](const dmat4& world) {
-    const double det = glm::determinant(glm::dmat3(world));
-    return det != 0 && std::isfinite(det) && std::isfinite(1.0 / det);
+  // The affine part of a placement, as the copies are placed (a node's matrix may have a last row of
+  // its own); and whether it is invertible as the scene's loader asks of an instance: as floats,
+  // inverted, it fits floats.
+  const auto affine = [](dmat4 world) {
+    world[0][3] = world[1][3] = world[2][3] = 0.0;
+    world[3][3] = 1.0;
+    return glm::mat4(world);
+  };
+  const auto invertible = [&](const dmat4& world) {
+    const glm::dmat4 as_floats(affine(world));
+    if (glm::determinant(glm::dmat3(as_floats)) == 0.0) return false;
+    const glm::dmat4 inverse = glm::inverse(as_floats);
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 3; ++r)
+        if (!(std::abs(inverse[c][r]) <= double(FLT_MAX))) return false;
+    return true;
   };
   const auto key = [&](size_t node) {
     const tinygltf::Node& n = model_.nodes[node];
@@ -593,7 +606,7 @@ void GltfReader::place_meshes() {
     if (placed > limits_.max_placed_triangles)
       throw LimitError(file_.string() + ": " + element("nodes", p.node) + ": the file places more than " +
                        std::to_string(limits_.max_placed_triangles) + " triangles; vkray renders at most that many");
-    scene_.instances.push_back({uint32_t(mesh->second), glm::mat4(p.world), 0u});
+    scene_.instances.push_back({uint32_t(mesh->second), affine(p.world), 0u});
   }
 }
 

@@ -144,8 +144,10 @@ class SceneParser {
   // A mesh object's triangles, placed by `transform`.
   std::vector<Triangle> mesh_triangles(const Value& v, const glm::mat4& transform);
   // Stores `triangles` once as a mesh (Scene::meshes) and places it by each of `placements`
-  // (Scene::instances, of the current object); `where`: the "instances" array.
-  void add_instances(const Value& where, std::vector<Triangle>& triangles, const std::vector<glm::mat4>& placements);
+  // (Scene::instances, of the current object). `where`: the "instances" array, whose elements are the
+  // placements when `each_named` (an error then names the one at fault), else what they come from.
+  void add_instances(const Value& where, std::vector<Triangle>& triangles, const std::vector<glm::mat4>& placements,
+                     bool each_named = true);
   // Adds a texture to Scene::textures, counting its texels in scene_texels_.
   void add_texture(std::shared_ptr<const Texture> texture) {
     scene_texels_ += uint64_t(texture->width) * texture->height;

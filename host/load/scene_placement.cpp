@@ -115,7 +115,13 @@ void SceneParser::add_gltf_instances(const Value& file_value, const Value& where
 }
 
 void SceneParser::add_gltf_meshes(const Value& where, const LoadedGltf& loaded, const std::vector<glm::mat4>& placements) {
-  // Each mesh the file places by instances, placed by each of them, each of those moved by each placement.
+  // Each mesh the file places by instances, placed by each of them, each of those moved by each
+  // placement: held to the scene's limit before any is made.
+  if (!loaded.gltf.instances.empty() &&
+      placements.size() > (kMaxInstances - std::min(kMaxInstances, scene_.instances.size())) / loaded.gltf.instances.size())
+    throw LimitError(file_.string() + ": " + where.path + ": " + std::to_string(placements.size()) + " placements of a file of " +
+                     std::to_string(loaded.gltf.instances.size()) + " instances would make more than " + std::to_string(kMaxInstances) +
+                     " instances; vkray renders at most that many");
   for (size_t m = 0; m < loaded.gltf.meshes.size(); ++m) {
     std::vector<glm::mat4> transforms;
     for (const glm::mat4& placement : placements)
@@ -124,11 +130,14 @@ void SceneParser::add_gltf_meshes(const Value& where, const LoadedGltf& loaded, 
     if (transforms.empty()) continue;
     std::vector<Triangle> triangles = loaded.gltf.meshes[m].triangles;
     for (Triangle& t : triangles) t.material += loaded.material_offset;
-    add_instances(where, triangles, transforms);
+    add_instances(where, triangles, transforms, false);
   }
 }
 
-void SceneParser::add_instances(const Value& where, std::vector<Triangle>& triangles, const std::vector<glm::mat4>& placements) {
+void SceneParser::add_instances(const Value& where, std::vector<Triangle>& triangles, const std::vector<glm::mat4>& placements,
+                                bool each_named) {
+  // Where a placement's error points: its element of "instances", or `where` itself.
+  const auto at = [&](size_t i) { return each_named ? where[i] : where; };
   // The mesh in its own space, its zero-area triangles left out; nothing is placed when none is left.
   SharedMesh mesh;
   glm::vec3 lo(FLT_MAX), hi(-FLT_MAX);
@@ -173,13 +182,13 @@ void SceneParser::add_instances(const Value& where, std::vector<Triangle>& trian
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 3; ++r) invertible = invertible && std::abs(inverse[c][r]) <= double(FLT_MAX);
     if (!invertible)
-      fail(where.j.is_array() ? where[i] : where, "the transform cannot be inverted in 32-bit floats (a scale of zero, or too near it)");
+      fail(at(i), "the transform cannot be inverted in 32-bit floats (a scale of zero, or too near it)");
     // Every corner of the mesh's box, placed, within the coordinates vkray renders: so is every vertex.
     for (int corner = 0; corner < 8; ++corner) {
       const glm::vec3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
       const glm::vec3 q = transform_point(placements[i], p);
       if (!glm::all(glm::lessThanEqual(glm::abs(q), glm::vec3(kMaxCoordinate))))
-        check_coordinates(where.j.is_array() ? where[i] : where, q, "the placed mesh's bounding box");
+        check_coordinates(at(i), q, "the placed mesh's bounding box");
     }
     scene_.instances.push_back({mesh_index, placements[i], object_});
   }

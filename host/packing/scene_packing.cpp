@@ -329,14 +329,8 @@ PackedGeometry pack_geometry(const Scene& scene, const SceneBvh& bvh) {
     const bool own = !bvh.primitives.nodes.empty();
     if (own) boxes.push_back(root_box(bvh.primitives));
     const Bvh top = build_bvh(boxes, 0, nullptr, 1);
-    uint32_t deepest = own ? bvh.primitives.depth : 0;
-    for (const Bvh& mesh : bvh.meshes) deepest = std::max(deepest, mesh.depth);
-    // The GPU's stack holds one BVH kMaxDepth deep; the top's levels and an entry's come one after
-    // the other, with one more for the rest of a top leaf.
-    if (top.depth + deepest > kMaxDepth - 4)
-      throw LimitError(scene.file.string() + ": the instances' BVH (" + std::to_string(top.depth) + " levels) over meshes of up to " +
-                       std::to_string(deepest) + " levels is deeper than the GPU's traversal holds (" + std::to_string(kMaxDepth - 4) +
-                       " together)");
+    // (Each level has a traversal stack of its own on the GPU, each as deep as one BVH can be.)
+    VKRAY_CHECK(top.nodes.size() + top.order.size() < kMaxPrimitives, "the instances' nodes pass the leaf encoding");
     // The node buffer: the top BVH, its leaves' instance nodes, then each entry's BVH.
     const std::vector<glm::uvec4> top_nodes = pack_nodes(top);
     const auto instance_nodes = uint32_t(top_nodes.size() / VKRAY_TEXELS_PER_NODE);

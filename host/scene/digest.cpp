@@ -95,7 +95,7 @@ std::string scene_digest(const Scene& scene) {
     h->add(uint64_t(scene.instances.size()));
     for (const Instance& i : scene.instances) {
       h->add(i.mesh), h->add(i.object);
-      for (int c = 0; c < 4; ++c) h->add(glm::vec4(i.to_world[c]));
+      for (int column = 0; column < 4; ++column) h->add(glm::vec4(i.to_world[column]));
     }
   }
   return h->hex();

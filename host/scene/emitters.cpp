@@ -2,6 +2,7 @@
 
 #include <numbers>
 
+#include "base/errors.h"
 #include "shared/scene_layout.h"
 
 namespace vkray {
@@ -35,12 +36,19 @@ EmitterTable build_emitter_table(const Scene& scene) {
     table.total_weight += weight;
   };
   const uint64_t triangles = scene.triangles.size();
-  for (uint64_t p = 0; p < triangles; ++p) consider(p, scene.triangles[size_t(p)].material);
-  // An instance's emitters: its mesh's emissive triangles, found once per mesh.
+  // An instance's emitters: its mesh's emissive triangles, found once per mesh. Each placed one is an
+  // entry: as many as a scene of copies would have, held to the scene's primitive limit before any
+  // is made.
   std::vector<std::vector<uint32_t>> emissive(scene.meshes.size());
   for (size_t m = 0; m < scene.meshes.size(); ++m)
     for (uint32_t t = 0; t < scene.meshes[m].triangles.size(); ++t)
       if (scene.materials[scene.meshes[m].triangles[t].material].emissive()) emissive[m].push_back(t);
+  uint64_t placed = 0;
+  for (const Instance& instance : scene.instances) placed += emissive[instance.mesh].size();
+  if (placed > kMaxScenePrimitives)
+    throw LimitError(scene.file.string() + ": its instances place " + std::to_string(placed) +
+                     " emissive triangles; vkray samples at most " + std::to_string(kMaxScenePrimitives) + " area lights");
+  for (uint64_t p = 0; p < triangles; ++p) consider(p, scene.triangles[size_t(p)].material);
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const SharedMesh& mesh = scene.meshes[scene.instances[i].mesh];
     for (const uint32_t t : emissive[scene.instances[i].mesh]) consider(numbering.instance_first(i) + t, mesh.triangles[t].material);

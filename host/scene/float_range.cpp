@@ -91,6 +91,16 @@ void check_instances(const Scene& scene) {
   const double reach = scene.extent();
   for (const Instance& instance : scene.instances) {
     const glm::dmat4 inverse = glm::inverse(glm::dmat4(instance.to_world));
+    // And the other way: a mesh grown by more than 1e9 turns its normals by a transform whose
+    // squares fall below the smallest normal float.
+    double growth = 0;
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) growth = std::max(growth, double(std::abs(instance.to_world[c][r])));
+    if (growth > double(kMaxCoordinate)) {
+      const SharedMesh& mesh = scene.meshes[instance.mesh];
+      throw SceneError(scene.file.string() + ": " + where_is(scene, instance.object, scene.materials[mesh.triangles[0].material]) +
+                       ": an instance's transform scales its mesh by " + brief(growth) + ", past the 1e9 vkray renders");
+    }
     double farthest = 0;
     for (int r = 0; r < 3; ++r)
       farthest = std::max(farthest, (std::abs(inverse[0][r]) + std::abs(inverse[1][r]) + std::abs(inverse[2][r])) * reach +

@@ -45,8 +45,10 @@ constexpr size_t kMaxScenePrimitives = (size_t(1) << 27) - 1;
 // primitive's place in the scene (PrimitiveNumbering) travels to the GPU as the bits of a float,
 // and every number below 0x7f800000 is the bits of a finite float.
 constexpr uint64_t kMaxPlacedPrimitives = 2'000'000'000;
-// A scene holds at most this many instances (a BVH leaf names them as it names primitives).
-constexpr size_t kMaxInstances = kMaxScenePrimitives;
+// A scene holds at most this many instances: far past a real scene's (the memory of one is about 200
+// bytes), and a small glTF file cannot claim more (an accessor without a buffer view holds any count
+// of zeros).
+constexpr size_t kMaxInstances = size_t(1) << 24;
 
 struct ImageSettings {
   uint32_t width = 512;
