@@ -21,12 +21,17 @@ InstanceHeader instance_header(uint entry) {
   return InstanceHeader(floatBitsToUint(h.x), floatBitsToUint(h.y), floatBitsToUint(h.z), floatBitsToUint(h.w) != 0u);
 }
 
-// The ray in the entry's mesh space: its direction is not made unit again, so t is the same.
-Ray ray_to_mesh(uint entry, Ray ray) {
-  int base = int(entry) * VKRAY_TEXELS_PER_INSTANCE + VKRAY_INSTANCE_TO_MESH;
-  vec4 r0 = texelFetch(instances, base), r1 = texelFetch(instances, base + 1), r2 = texelFetch(instances, base + 2);
+// A ray moved by the affine transform with rows r0, r1, r2 (a world-to-mesh transform): its direction
+// is not made unit again, so t is the same in both spaces.
+Ray moved_ray(vec4 r0, vec4 r1, vec4 r2, Ray ray) {
   return Ray(vec3(dot(r0.xyz, ray.origin) + r0.w, dot(r1.xyz, ray.origin) + r1.w, dot(r2.xyz, ray.origin) + r2.w),
              vec3(dot(r0.xyz, ray.dir), dot(r1.xyz, ray.dir), dot(r2.xyz, ray.dir)));
+}
+
+// The ray in the entry's mesh space.
+Ray ray_to_mesh(uint entry, Ray ray) {
+  int base = int(entry) * VKRAY_TEXELS_PER_INSTANCE + VKRAY_INSTANCE_TO_MESH;
+  return moved_ray(texelFetch(instances, base), texelFetch(instances, base + 1), texelFetch(instances, base + 2), ray);
 }
 
 // A mesh-space normal in world space, unit: by the inverse transpose, whose columns are the

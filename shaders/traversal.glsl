@@ -214,9 +214,7 @@ Hit traverse(Ray ray, float t_min, float t_max, bool any_hit, bool cull_back, fl
     NodeTexels texels = fetch_node(is_leaf(node) ? leaf_first(node) : node);
     if (is_leaf(node)) {
       InstanceNode entry = instance_node(texels.t[0], texels.t[1], texels.t[2], texels.t[3]);
-      Ray local = Ray(vec3(dot(entry.row0.xyz, ray.origin) + entry.row0.w, dot(entry.row1.xyz, ray.origin) + entry.row1.w,
-                           dot(entry.row2.xyz, ray.origin) + entry.row2.w),
-                      vec3(dot(entry.row0.xyz, ray.dir), dot(entry.row1.xyz, ray.dir), dot(entry.row2.xyz, ray.dir)));
+      Ray local = moved_ray(entry.row0, entry.row1, entry.row2, ray);
       if (walk(local, ray_shear(local.dir), safe_inverse(local.dir), entry.root, entry.instance, entry.first_index, t_min, t_max, any_hit,
                cull_back, passed_t, passed_index, hit, hit_index))
         return hit;

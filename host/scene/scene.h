@@ -275,10 +275,8 @@ struct Scene {
   // every ray then draws a key from its sample's stream (shared/sampling.h, alpha_random), on both
   // renderers. The GPU's pipeline reads the same off the packed primitives' flags (VKRAY_PRIM_ALPHA).
   bool see_through() const {
-    const auto triangle = [&](const Triangle& t) { return see_through(t); };
     return std::any_of(spheres.begin(), spheres.end(), [&](const Sphere& s) { return materials[s.material].see_through(); }) ||
-           std::any_of(triangles.begin(), triangles.end(), triangle) ||
-           std::any_of(meshes.begin(), meshes.end(), [&](const SharedMesh& m) { return std::any_of(m.triangles.begin(), m.triangles.end(), triangle); });
+           any_triangle([&](const Triangle& t) { return see_through(t); });
   }
   // Whether some triangle, the meshes' included, satisfies `predicate`.
   template <typename Predicate>
