@@ -1,7 +1,7 @@
 // The path integrator: the rendering equation by unidirectional path tracing, as Mitsuba 3's `path`.
-// At every vertex that is not a delta (diffuse or glossy), next-event estimation: each point light,
-// one area-light sample and one sample of the background (when it is not black), the last two
-// weighed against BSDF sampling by the power heuristic; then the BSDF picks the next direction. A
+// At every vertex that is not a delta (diffuse or glossy), next-event estimation: each point, spot and
+// directional light, one area-light sample and one sample of the background (when it is not black),
+// the last two weighed against BSDF sampling by the power heuristic; then the BSDF picks the next direction. A
 // hit on an emitter (or a miss, on the background) adds its light weighed the same way, or whole
 // after a mirror or glass.
 // Depth counts as Mitsuba's max_depth does; Russian roulette from rr_depth on.
@@ -76,7 +76,7 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
     // ---- Next-event estimation: f cos times the light over its density, weighed against BSDF sampling --
     LitPoint lit = lit_point(x, n, n_geometric, s);
     vec3 from_points = vec3(0.0);
-    add_point_lights(lit, s, wo, front, from_points, stream, rays);
+    add_delta_lights(lit, s, wo, front, from_points, stream, rays);
     p.radiance += p.throughput * from_points;
     if (SCENE_HAS_EMITTERS) {
       AreaLightSample light = sample_area_light_from(lit, stream, rays);

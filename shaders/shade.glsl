@@ -5,7 +5,9 @@
 // for smooth meshes, the geometric normal otherwise, turned by a normal map), w the unit vector to the
 // light, r its distance, and V = 0 when the light is at most epsilon above the plane of n at x
 // (n . (light - x) <= epsilon), below the geometric plane at x (shading normals let no light through
-// a surface), or a shadow ray finds anything closer than the light. Any other surface that is not a delta: the ambient term times
+// a surface), or a shadow ray finds anything closer than the light. A spot light's I is times its
+// falloff; a directional light gives its irradiance E in place of I / r^2, its V by a shadow ray
+// that goes on past the scene. Any other surface that is not a delta: the ambient term times
 // its colour, and its BSDF f(wo, w) (n . w) in place of albedo (n . w) / pi. The path integrator
 // (path.glsl) uses the same light terms.
 #ifndef VKRAY_SHADE_GLSL
@@ -121,33 +123,64 @@ AreaLightSample sample_area_light_from(LitPoint p, inout uint stream, inout uint
   return s;
 }
 
-// Adds V f(wo, w) |n . w| I / r^2 for every point light to `radiance`: the surface s at p, seen along
-// wo; adds the shadow rays it casts to `rays` (each draws its alpha key from the stream).
-void add_point_lights(LitPoint p, Surface s, vec3 wo, bool front, inout vec3 radiance, inout uint stream, inout uint rays) {
+// How much of a spot's intensity leaves along a direction at cosine c to its axis (VKRAY_LIGHT_CONE).
+float spot_falloff(uint kind, float c, vec4 cone) {
+  if (kind == VKRAY_LIGHT_GLTF_SPOT) {
+    float ramp = clamp(c * cone.x + cone.y, 0.0, 1.0);
+    return ramp * ramp;
+  }
+  // Mitsuba's: 1 within the beam, 0 from the cutoff on, linear in the angle between.
+  if (!(c > cone.x)) return 0.0;
+  return c >= cone.y ? 1.0 : (cone.z - acos(c)) * cone.w;
+}
+
+// Adds V f(wo, w) |n . w| times each light's arrival to `radiance`: I / r^2 from a point light, I
+// times its falloff / r^2 from a spot, E from a directional light; the surface s at p, seen along wo.
+// Adds the shadow rays it casts to `rays` (each draws its alpha key from the stream).
+void add_delta_lights(LitPoint p, Surface s, vec3 wo, bool front, inout vec3 radiance, inout uint stream, inout uint rays) {
   // A do-while without `continue`, as the sample loop in trace.comp: a loop that tests first costs
   // a masked pass more, and so does one with a `continue` (the compiler moves the test to the top
   // of the next pass, for every lane).
   uint i = 0u;
   if (SCENE_HAS_POINT_LIGHTS && frame.light_count > 0u) do {
     int base = int(i) * VKRAY_TEXELS_PER_LIGHT;
-    vec3 light_pos = texelFetch(lights, base + VKRAY_LIGHT_POSITION).xyz;
-    vec3 to_light = light_pos - p.x;
-    float r2 = dot(to_light, to_light);
-    // Lit only by a light more than epsilon above the plane of n at x (the contract's height rule:
-    // a light on the surface, or at x itself, lights nothing there, whatever the rounding of x), or
-    // below it for a BSDF that transmits.
-    float height = dot(p.n, to_light);
-    bool lit = (height > frame.epsilon || (p.both_sides && height < -frame.epsilon)) && faces(p, to_light);
-    if (SHADOW_RAYS && lit) {
-      vec3 shadow_origin = origin_toward(p, to_light);
-      vec3 shadow_dir = light_pos - shadow_origin;
-      float shadow_dist = length(shadow_dir);
-      rays += 1u;
-      // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
-      lit = !trace_any(Ray(shadow_origin, shadow_dir / shadow_dist), frame.epsilon, shadow_dist - frame.epsilon, stream);
+    vec4 position = texelFetch(lights, base + VKRAY_LIGHT_POSITION);
+    uint kind = floatBitsToUint(position.w);
+    vec3 arriving = texelFetch(lights, base + VKRAY_LIGHT_INTENSITY).rgb;
+    vec3 w, shadow_target;
+    bool lit;
+    float shadow_far = FAR;
+    if (kind == VKRAY_LIGHT_DIRECTIONAL) {
+      // From the same direction everywhere, past everything in the scene.
+      w = -texelFetch(lights, base + VKRAY_LIGHT_DIRECTION).xyz;
+      lit = faces(p, w);
+    } else {
+      vec3 to_light = position.xyz - p.x;
+      float r2 = dot(to_light, to_light);
+      w = to_light * inversesqrt(r2);
+      // Lit only by a light more than epsilon above the plane of n at x (the contract's height rule:
+      // a light on the surface, or at x itself, lights nothing there, whatever the rounding of x), or
+      // below it for a BSDF that transmits.
+      float height = dot(p.n, to_light);
+      lit = (height > frame.epsilon || (p.both_sides && height < -frame.epsilon)) && faces(p, to_light);
+      arriving /= r2;
+      if (kind != VKRAY_LIGHT_POINT)
+        arriving *= spot_falloff(kind, dot(texelFetch(lights, base + VKRAY_LIGHT_DIRECTION).xyz, -w), texelFetch(lights, base + VKRAY_LIGHT_CONE));
     }
-    if (lit)
-      radiance += eval_bsdf(s, wo, to_light * inversesqrt(r2), p.n, front) * (texelFetch(lights, base + VKRAY_LIGHT_INTENSITY).rgb / r2);
+    if (SHADOW_RAYS && lit) {
+      vec3 shadow_origin = origin_toward(p, w);
+      vec3 shadow_dir = w;
+      if (kind != VKRAY_LIGHT_DIRECTIONAL) {
+        shadow_dir = position.xyz - shadow_origin;
+        float shadow_dist = length(shadow_dir);
+        shadow_dir /= shadow_dist;
+        // Stop epsilon short of the light so a light lying on a surface is not hidden by that surface.
+        shadow_far = shadow_dist - frame.epsilon;
+      }
+      rays += 1u;
+      lit = !trace_any(Ray(shadow_origin, shadow_dir), frame.epsilon, shadow_far, stream);
+    }
+    if (lit) radiance += eval_bsdf(s, wo, w, p.n, front) * arriving;
   } while (++i < frame.light_count);
 }
 
@@ -163,7 +196,7 @@ vec3 shade(Ray ray, vec3 x, Surface surface, inout uint stream, inout uint rays)
   // Shadow rays start a little off the surface, on the side the ray came from (or the light's).
   LitPoint p = lit_point(x, n, n_geometric, surface);
   vec3 radiance = surface.albedo * frame.ambient.rgb;
-  add_point_lights(p, surface, wo, front, radiance, stream, rays);
+  add_delta_lights(p, surface, wo, front, radiance, stream, rays);
   if (SCENE_HAS_EMITTERS) {  // one light sample: f cos Le / pdf
     AreaLightSample light = sample_area_light_from(p, stream, rays);
     if (light.pdf > 0.0) radiance += eval_bsdf(surface, wo, light.dir, n, front) * (light.radiance / light.pdf);

@@ -6,6 +6,7 @@
 #include <set>
 #include <vector>
 
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_access.hpp>
 #include <gtest/gtest.h>
 
@@ -317,32 +318,69 @@ TEST(GltfTest, PicturesAreDecodedOnceAndWithinTheTexelBudget) {
   EXPECT_NE(message.find("test.gltf: images[0]: a 2 x 2 picture would bring the scene's textures past"), std::string::npos) << message;
 }
 
-TEST(GltfTest, TheFirstCameraDepthFirstAndPointLights) {
+TEST(GltfTest, TheFirstCameraDepthFirstAndTheLights) {
   GltfBuilder b;
   b.quad();
   b.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}, {"aspectRatio", 2.0}}}},
                       {{"type", "perspective"}, {"perspective", {{"yfov", 1.0}, {"znear", 0.1}}}}};
   b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
-  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"color", {1, 0.5, 0}}, {"intensity", 4}},
-                                                           {{"type", "spot"}, {"spot", json::object()}}};
+  b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
+      {{"type", "point"}, {"color", {1, 0.5, 0}}, {"intensity", 4}},
+      {{"type", "spot"}, {"spot", json::object()}, {"intensity", 2}},
+      {{"type", "spot"}, {"spot", {{"innerConeAngle", 0.25}, {"outerConeAngle", 0.5}}}},
+      {{"type", "directional"}, {"color", {0.5, 1, 1}}, {"intensity", 3}}};
   // Root 1 holds camera 1 deep inside; root 2 holds camera 0: depth-first, camera 1 comes first.
   b.doc["nodes"].push_back({{"children", {2}}});
   b.doc["nodes"].push_back({{"camera", 1}, {"translation", {0, 0, 3}}});
   b.doc["nodes"].push_back({{"camera", 0}});
   b.doc["nodes"].push_back({{"translation", {0, 4, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
   b.doc["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
-  b.doc["scenes"][0]["nodes"] = {0, 1, 3, 4, 5};
+  // Turned a quarter about x: -z, the way a light shines, becomes -y; the translation moves it.
+  const double h = std::sqrt(0.5);
+  b.doc["nodes"].push_back({{"rotation", {-h, 0, 0, h}}, {"translation", {1, 2, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
+  b.doc["nodes"].push_back({{"rotation", {-h, 0, 0, h}}, {"extensions", {{"KHR_lights_punctual", {{"light", 3}}}}}});
+  b.doc["scenes"][0]["nodes"] = {0, 1, 3, 4, 5, 6, 7};
   const GltfScene s = parse(b.gltf());
   ASSERT_TRUE(s.camera);
   EXPECT_EQ(s.camera->position, glm::vec3(0, 0, 3));
   EXPECT_EQ(s.camera->forward, glm::vec3(0, 0, -1));
   EXPECT_NEAR(s.camera->focal_length, 0.5f / std::tan(0.5f), 1e-6f);
   EXPECT_EQ(s.aspect_ratio, 0.0f);  // camera 1 gives none
-  ASSERT_EQ(s.lights.size(), 1u);
+  ASSERT_EQ(s.lights.size(), 4u);
+  EXPECT_EQ(s.lights[0].type, Light::Type::point);
   EXPECT_EQ(s.lights[0].position, glm::vec3(0, 4, 0));
   EXPECT_EQ(s.lights[0].intensity, glm::vec3(4, 2, 0));
-  ASSERT_EQ(s.warnings.size(), 1u);
-  EXPECT_NE(s.warnings[0].find("spot lights are not rendered"), std::string::npos) << s.warnings[0];
+  // A spot with the specification's defaults: no inner cone, the outer at pi/4, along -z.
+  EXPECT_EQ(s.lights[1].type, Light::Type::spot);
+  EXPECT_EQ(s.lights[1].falloff, Light::Falloff::gltf);
+  EXPECT_EQ(s.lights[1].intensity, glm::vec3(2));
+  EXPECT_EQ(s.lights[1].direction, glm::vec3(0, 0, -1));
+  EXPECT_FLOAT_EQ(s.lights[1].cutoff_angle, glm::quarter_pi<float>());
+  EXPECT_EQ(s.lights[1].beam_width, 0.0f);
+  EXPECT_EQ(s.lights[2].position, glm::vec3(1, 2, 3));
+  EXPECT_NEAR(glm::distance(s.lights[2].direction, glm::vec3(0, -1, 0)), 0.0f, 1e-6f);
+  EXPECT_FLOAT_EQ(s.lights[2].cutoff_angle, 0.5f);
+  EXPECT_FLOAT_EQ(s.lights[2].beam_width, 0.25f);
+  // A directional light's lux become its irradiance.
+  EXPECT_EQ(s.lights[3].type, Light::Type::directional);
+  EXPECT_EQ(s.lights[3].intensity, glm::vec3(1.5, 3, 3));
+  EXPECT_NEAR(glm::distance(s.lights[3].direction, glm::vec3(0, -1, 0)), 0.0f, 1e-6f);
+  EXPECT_TRUE(s.warnings.empty());
+}
+
+TEST(GltfTest, ASpotsConesAreCheckedAgainstTheSpecification) {
+  for (const auto& [spot, what] : std::vector<std::pair<json, std::string>>{
+           {{{"innerConeAngle", 0.5}, {"outerConeAngle", 0.5}}, "lights[0].spot.innerConeAngle: expected radians from 0 to below outerConeAngle"},
+           {{{"outerConeAngle", 2.0}}, "lights[0].spot.outerConeAngle: expected radians in (0, pi/2]"},
+           {{{"innerConeAngle", -0.1}}, "lights[0].spot.innerConeAngle"}}) {
+    GltfBuilder b;
+    b.quad();
+    b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    b.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "spot"}, {"spot", spot}}};
+    b.doc["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    b.doc["scenes"][0]["nodes"].push_back(b.doc["nodes"].size() - 1);
+    expect_error(b, what);
+  }
 }
 
 TEST(GltfTest, MaterialsKeepTheirColourAndEmissionAndNameWhatIsNotRendered) {
@@ -1056,6 +1094,10 @@ TEST(ShippedGltfTest, KhronosModelsLoadAsDescribed) {
     for (const Triangle& t : box.triangles)
       for (const glm::vec3& v : t.v) EXPECT_NEAR(std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}), 0.5f, 1e-6f) << form;
   }
+  // The lamp brings its five lights (one in its shade, whose paper lets light through), so vkray adds none.
+  const Scene lamp = load_scene(dir / "LightsPunctualLamp/glTF/LightsPunctualLamp.gltf");
+  EXPECT_EQ(lamp.lights.size(), 5u);
+  EXPECT_EQ(lamp.lights[0].intensity, glm::vec3(15.0f, float(0.6318749785423279 * 15), float(0.23909975588321689 * 15)));
   const GltfScene truck = load_gltf(dir / "CesiumMilkTruck/glTF/CesiumMilkTruck.gltf");
   EXPECT_EQ(truck.materials.size(), 4u);
   ASSERT_EQ(truck.textures.size(), 1u);  // the progressive JPEG

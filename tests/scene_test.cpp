@@ -406,8 +406,17 @@ TEST(SceneTest, MaterialAndColourErrors) {
 }
 
 TEST(SceneTest, LightErrors) {
-  expect_error(with_camera(R"("lights": [{"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1]}])"),
+  expect_error(with_camera(R"("lights": [{"type": "area", "position": [0, 0, 0], "intensity": [1, 1, 1]}])"),
                "/lights/0/type", "unknown light type");
+  expect_error(with_camera(R"("lights": [{"type": "spot", "position": [0, 0, 0], "intensity": [1, 1, 1]}])"),
+               "/lights/0", "missing required key \"look_at\" (or \"direction\")");
+  expect_error(with_camera(R"("lights": [{"type": "spot", "position": [0, 0, 0], "direction": [0, 0, 1], "intensity": [1, 1, 1],
+                                          "cutoff_angle": 0}])"),
+               "/lights/0/cutoff_angle", "expected degrees in (0, 180]");
+  expect_error(with_camera(R"("lights": [{"type": "spot", "position": [0, 0, 0], "direction": [0, 0, 1], "intensity": [1, 1, 1],
+                                          "beam_width": -1}])"),
+               "/lights/0/beam_width", "expected degrees from 0 to the cutoff_angle (20)");
+  expect_error(with_camera(R"("lights": [{"type": "directional", "direction": [0, 0, 1]}])"), "/lights/0", "\"irradiance\"");
   expect_error(with_camera(R"("lights": [{"position": [0, 0, 0], "intensity": [1, 1, 1]}])"), "/lights/0", "\"type\"");
   expect_error(with_camera(R"("lights": [{"type": "point", "position": [0, 0, 0]}])"), "/lights/0", "\"intensity\"");
   expect_error(with_camera(R"("lights": [{"type": "point", "position": [0, 0, 0], "intensity": [1, 1, 1], "power": [1, 1, 1]}])"),

@@ -219,7 +219,8 @@ INSTANTIATE_TEST_SUITE_P(Khronos, ShippedModelTest,
                                            "SimpleMorph/glTF-Embedded/SimpleMorph.gltf",
                                            "SimpleInstancing/glTF-Binary/SimpleInstancing.glb", "UnlitTest/glTF-Binary/UnlitTest.glb",
                                            "MultiUVTest/glTF-Binary/MultiUVTest.glb",
-                                           "TextureEncodingTest/glTF-Binary/TextureEncodingTest.glb"),
+                                           "TextureEncodingTest/glTF-Binary/TextureEncodingTest.glb",
+                                           "LightsPunctualLamp/glTF/LightsPunctualLamp.gltf"),
                          [](const auto& p) {
                            std::string name = std::filesystem::path(p.param).parent_path().string();
                            for (char& c : name)

@@ -21,7 +21,7 @@ dvec3 shade(const Tracer& tracer, const Lights& lights, const SurfacePoint& s, c
   dvec3 radiance = bsdf.color * dvec3(scene.ambient);
   const LitPoint p{x, n, n_geometric, x + tracer.epsilon() * n_geometric, x - tracer.epsilon() * n_geometric,
                    bsdf.has(VKRAY_BSDF_TRANSMISSION)};
-  lights.add_point_lights(p, bsdf, wo, front, radiance, first ? &state.signature : nullptr, state.stream, state.rays);
+  lights.add_delta_lights(p, bsdf, wo, front, radiance, first ? &state.signature : nullptr, state.stream, state.rays);
   if (lights.has_area_lights()) {
     const AreaLightSample light = lights.sample_area_light_from(p, state.stream, state.rays);
     if (light.pdf > 0) radiance += eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance / light.pdf;

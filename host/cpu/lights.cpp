@@ -1,6 +1,8 @@
 #include "cpu/lights.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "cpu/texture.h"
 #include "cpu/warp.h"
@@ -14,12 +16,44 @@ Lights::Lights(const Tracer& tracer, bool shadows)
   if (!table_.entries.empty()) inv_weight_ = 1 / table_.total_weight;
 }
 
-void Lights::add_point_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& wo, bool front, dvec3& radiance, uint64_t* signature,
+namespace {
+
+// How much of a spot's intensity leaves at `angle` (radians) from its axis, from the angles as the
+// scene gives them.
+double spot_falloff(const Light& light, double angle) {
+  const double cutoff = light.cutoff_angle, beam = light.beam_width;
+  if (light.falloff == Light::Falloff::gltf) {
+    // KHR_lights_punctual: a ramp in the cosine from the outer cone to the inner, squared.
+    const double ramp = (std::cos(angle) - std::cos(cutoff)) / std::max(0.001, std::cos(beam) - std::cos(cutoff));
+    return std::pow(std::clamp(ramp, 0.0, 1.0), 2);
+  }
+  // Mitsuba's spot: whole within the beam width, none past the cutoff, linear in the angle between.
+  if (angle >= cutoff) return 0;
+  return angle <= beam ? 1 : (cutoff - angle) / (cutoff - beam);
+}
+
+}  // namespace
+
+void Lights::add_delta_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& wo, bool front, dvec3& radiance, uint64_t* signature,
                               uint32_t& stream, uint64_t& rays) const {
   const Scene& scene = tracer_.scene();
   for (size_t l = 0; l < scene.lights.size(); ++l) {
-    const dvec3 light(scene.lights[l].position);
-    const dvec3 to_light = light - p.x;
+    const Light& light = scene.lights[l];
+    const dvec3 intensity(light.intensity);
+    if (light.type == Light::Type::directional) {
+      // The same direction at every point: the shadow ray goes on past the scene.
+      const dvec3 w = -dvec3(light.direction);
+      if (!p.faces(w)) continue;
+      if (shadows_) {
+        ++rays;
+        if (tracer_.occluded({p.origin_toward(w), w}, epsilon_, std::numeric_limits<double>::infinity(), stream)) continue;
+      }
+      if (signature) mix(*signature, 0x8000000000000000ull | l);
+      radiance += eval_bsdf(bsdf, wo, w, p.n, front) * intensity;
+      continue;
+    }
+    const dvec3 position(light.position);
+    const dvec3 to_light = position - p.x;
     const double r2 = glm::dot(to_light, to_light);
     // The light must stand more than epsilon above the plane of the normal (or below it, for a BSDF
     // that transmits): one on the surface (or at x) lights nothing there.
@@ -28,12 +62,18 @@ void Lights::add_point_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& 
     if (shadows_) {
       ++rays;
       const dvec3& origin = p.origin_toward(to_light);
-      const dvec3 shadow = light - origin;
+      const dvec3 shadow = position - origin;
       const double distance = glm::length(shadow);
       if (tracer_.occluded({origin, shadow / distance}, epsilon_, distance - epsilon_, stream)) continue;
     }
     if (signature) mix(*signature, 0x8000000000000000ull | l);
-    radiance += eval_bsdf(bsdf, wo, to_light / std::sqrt(r2), p.n, front) * dvec3(scene.lights[l].intensity) / r2;
+    const dvec3 w = to_light / std::sqrt(r2);
+    double falloff = 1;
+    if (light.type == Light::Type::spot) {
+      const double c = std::clamp(glm::dot(glm::normalize(dvec3(light.direction)), -w), -1.0, 1.0);
+      falloff = spot_falloff(light, std::acos(c));
+    }
+    radiance += eval_bsdf(bsdf, wo, w, p.n, front) * intensity * falloff / r2;
   }
 }
 

@@ -1,5 +1,5 @@
-// The CPU reference's light sampling: every point light (the scene contract's term, with its height
-// rule and shadow ray), and one point on an area light picked from the emitter table
+// The CPU reference's light sampling: every point, spot and directional light (the scene contract's
+// term, with its height rule and shadow ray), and one point on an area light picked from the emitter table
 // (scene/emitters.h) with the same numbers the shader draws (shaders/emitters.glsl).
 #pragma once
 
@@ -61,9 +61,11 @@ class Lights {
   // shadows false: every light counts as visible (benchmarks).
   Lights(const Tracer& tracer, bool shadows);
 
-  // Adds V f(wo, w) |n . w| I / r^2 of every point light to `radiance` (for a diffuse surface, albedo V I (n . w) / (pi r^2), the scene contract's term); counts shadow
-  // rays in `rays` (each draws its alpha key from `stream`); mixes each light that lights x into `signature` when given.
-  void add_point_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& wo, bool front, dvec3& radiance, uint64_t* signature,
+  // Adds V f(wo, w) |n . w| times what each light sends to x to `radiance`: I / r^2 from a point light
+  // (for a diffuse surface, albedo V I (n . w) / (pi r^2), the scene contract's term), a spot's I times
+  // its falloff / r^2, a directional light's irradiance E. Counts shadow rays in `rays` (each draws its
+  // alpha key from `stream`); mixes each light that lights x into `signature` when given.
+  void add_delta_lights(const LitPoint& p, const Bsdf& bsdf, const dvec3& wo, bool front, dvec3& radiance, uint64_t* signature,
                         uint32_t& stream, uint64_t& rays) const;
 
   bool has_area_lights() const { return !table_.entries.empty(); }

@@ -1,5 +1,5 @@
-// Path tracing, as the shader's path.glsl: next-event estimation at every vertex that is not a delta (every point
-// light, one area-light sample, one background sample) weighed by the power heuristic against BSDF
+// Path tracing, as the shader's path.glsl: next-event estimation at every vertex that is not a delta (every point,
+// spot and directional light, one area-light sample, one background sample) weighed by the power heuristic against BSDF
 // sampling; Mitsuba's max_depth; Russian roulette from rr_depth.
 #include <algorithm>
 #include <limits>
@@ -59,7 +59,7 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
       // Next-event estimation: each term f cos times the light over its density, weighed against BSDF sampling.
       const LitPoint p{x, n, n_geometric, origin, x - epsilon * n_geometric, bsdf.has(VKRAY_BSDF_TRANSMISSION)};
       dvec3 from_points(0.0);
-      lights.add_point_lights(p, bsdf, wo, front, from_points, depth == 1 ? &state.signature : nullptr, state.stream, state.rays);
+      lights.add_delta_lights(p, bsdf, wo, front, from_points, depth == 1 ? &state.signature : nullptr, state.stream, state.rays);
       radiance += throughput * from_points;
       if (lights.has_area_lights()) {
         const AreaLightSample light = lights.sample_area_light_from(p, state.stream, state.rays);

@@ -133,7 +133,7 @@ EmbreeTracer::Result EmbreeTracer::trace(uint32_t width, uint32_t height, bool s
       rtcIntersect8(valid, scene, &context, &primary);
       for (int lane = 0; lane < 8; ++lane) hits += valid[lane] && primary.hit.geomID[lane] != RTC_INVALID_GEOMETRY_ID;
       if (!shadows) continue;
-      for (const PointLight& light : scene_.lights) {
+      for (const Light& light : scene_.lights) {
         for (int lane = 0; lane < 8; ++lane) {
           shadow_valid[lane] = 0;
           if (!valid[lane] || primary.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID) continue;
@@ -141,10 +141,12 @@ EmbreeTracer::Result EmbreeTracer::trace(uint32_t width, uint32_t height, bool s
           const glm::vec3 x = cam.origin + primary.ray.tfar[lane] * d;
           glm::vec3 n = glm::normalize(glm::vec3(primary.hit.Ng_x[lane], primary.hit.Ng_y[lane], primary.hit.Ng_z[lane]));
           if (glm::dot(n, d) > 0) n = -n;
-          if (!(glm::dot(n, light.position - x) > 0)) continue;
+          // A directional light's shadow ray goes on past the scene; any other's stops at the light.
+          const bool directional = light.type == Light::Type::directional;
+          if (!(glm::dot(n, directional ? -light.direction : light.position - x) > 0)) continue;
           const glm::vec3 origin = x + epsilon * n;
-          const glm::vec3 to_light = light.position - origin;
-          const float distance = glm::length(to_light);
+          const glm::vec3 to_light = directional ? -light.direction : light.position - origin;
+          const float distance = directional ? 1.0f : glm::length(to_light);
           shadow.org_x[lane] = origin.x;
           shadow.org_y[lane] = origin.y;
           shadow.org_z[lane] = origin.z;
@@ -152,7 +154,7 @@ EmbreeTracer::Result EmbreeTracer::trace(uint32_t width, uint32_t height, bool s
           shadow.dir_y[lane] = to_light.y / distance;
           shadow.dir_z[lane] = to_light.z / distance;
           shadow.tnear[lane] = epsilon;
-          shadow.tfar[lane] = distance - epsilon;
+          shadow.tfar[lane] = directional ? std::numeric_limits<float>::infinity() : distance - epsilon;
           shadow.time[lane] = 0;
           shadow.mask[lane] = ~0u;
           shadow.id[lane] = 0;

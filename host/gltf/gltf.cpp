@@ -1121,9 +1121,13 @@ void GltfReader::add_light(size_t node, const dmat4& world) {
     fail(where, "lights[" + std::to_string(index) + "] does not exist (the file has " + std::to_string(model_.lights.size()) + ")");
   const tinygltf::Light& l = model_.lights[size_t(index)];
   const std::string name = "KHR_lights_punctual." + element("lights", size_t(index));
-  if (l.type != "point") {
-    warn_once("light " + l.type, name, printable(l.type) + " lights are not rendered (vkray renders point lights)");
-    return;
+  Light light;
+  if (l.type == "spot") {
+    light.type = Light::Type::spot;
+  } else if (l.type == "directional") {
+    light.type = Light::Type::directional;
+  } else if (l.type != "point") {
+    fail(name + ".type", "unknown light type \"" + printable(l.type) + "\" (expected \"point\", \"spot\" or \"directional\")");
   }
   glm::vec3 colour(1.0f);
   if (!l.color.empty()) {
@@ -1134,13 +1138,33 @@ void GltfReader::add_light(size_t node, const dmat4& world) {
     }
   }
   if (!(l.intensity >= 0.0 && l.intensity <= 1e12)) fail(name + ".intensity", "expected a number from 0 to 1e12");
-  if (l.range > 0) warn_once("light range", name, "a light's range is not rendered: its light reaches everywhere");
-  PointLight light;
-  const dvec3 position(world * glm::dvec4(0, 0, 0, 1));
-  if (!(glm::length(position) < double(kMaxCoordinate))) fail(element("nodes", node), "the light lies past +-1e9");
-  light.position = glm::vec3(position);
-  // glTF's intensity is in candela (lm/sr); vkray's point lights give W/sr, and the value is taken as it is.
+  if (l.range > 0 && light.type != Light::Type::directional)
+    warn_once("light range", name, "a light's range is not rendered: its light reaches everywhere");
+  // glTF's intensity is in candela (lm/sr) for point and spot lights and in lux (lm/m^2) for
+  // directional ones; vkray's are W/sr and W/m^2, and the value is taken as it is.
   light.intensity = colour * float(l.intensity);
+  if (light.type != Light::Type::directional) {
+    const dvec3 position(world * glm::dvec4(0, 0, 0, 1));
+    if (!(glm::length(position) < double(kMaxCoordinate))) fail(element("nodes", node), "the light lies past +-1e9");
+    light.position = glm::vec3(position);
+  }
+  if (light.type != Light::Type::point) {
+    // It shines along the node's -z.
+    const dvec3 direction = glm::dmat3(world) * dvec3(0, 0, -1);
+    if (!(glm::length(direction) > 0.0) || !std::isfinite(glm::length(direction)))
+      fail(element("nodes", node), "the node's transform leaves the light no direction");
+    light.direction = glm::vec3(glm::normalize(direction));
+  }
+  if (light.type == Light::Type::spot) {
+    // The specification: 0 <= innerConeAngle < outerConeAngle <= pi / 2.
+    const double inner = l.spot.innerConeAngle, outer = l.spot.outerConeAngle;
+    if (!(outer > 0.0 && outer <= glm::half_pi<double>() + 1e-6))
+      fail(name + ".spot.outerConeAngle", "expected radians in (0, pi/2]");
+    if (!(inner >= 0.0 && inner < outer)) fail(name + ".spot.innerConeAngle", "expected radians from 0 to below outerConeAngle");
+    light.falloff = Light::Falloff::gltf;
+    light.cutoff_angle = float(std::min(outer, glm::half_pi<double>()));
+    light.beam_width = float(inner);
+  }
   scene_.lights.push_back(light);
 }
 

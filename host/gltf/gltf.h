@@ -27,7 +27,7 @@ struct GltfScene {
   std::vector<Instance> instances;
   std::vector<Material> materials;  // their TextureRefs index `textures`
   std::vector<std::shared_ptr<const Texture>> textures;
-  std::vector<PointLight> lights;   // KHR_lights_punctual point lights, in world space
+  std::vector<Light> lights;        // KHR_lights_punctual's point, spot and directional lights, in world space
   // The first camera, depth-first from the default scene's root nodes, and its aspect ratio (width
   // over height; 0 when the file gives none).
   std::optional<Camera> camera;

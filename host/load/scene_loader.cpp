@@ -215,7 +215,10 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
   const auto [lo, hi] = placed_bounds(scene);
   if (scene.lights.empty() && lo.x <= hi.x) {
     const float distance = std::max(glm::length((lo + hi) / 2.0f - scene.camera.position), 1e-6f);
-    scene.lights.push_back(PointLight{scene.camera.position, glm::vec3(glm::pi<float>() * distance * distance)});
+    Light light;
+    light.position = scene.camera.position;
+    light.intensity = glm::vec3(glm::pi<float>() * distance * distance);
+    scene.lights.push_back(light);
     scene.warnings.push_back(file.string() + ": the file brings no light (emissive surfaces do not count): vkray adds a point light at the camera");
   }
   finish_scene(scene);

@@ -362,16 +362,58 @@ uint32_t SceneParser::material_ref(const Value& v) const {
 
 void SceneParser::parse_light(const Value& v) {
   expect_object(v);
-  check_keys(v, {"type", "position", "intensity", "power"});
   const Value type = require(v, "type");
-  if (string(type) != "point") fail(type, "unknown light type " + brief(type.j) + " (expected \"point\")");
-  PointLight light;
-  light.position = three_numbers(require(v, "position"));
-  check_coordinates(v["position"], light.position, "the light");
-  if (one_of(v, "intensity", "power")) {
-    light.intensity = color(v["intensity"]);
+  const std::string kind = string(type);
+  Light light;
+  // A direction given by a target or by itself, as the camera's; judged in double (any finite float
+  // vector has a finite length there unless it is zero).
+  const auto aim = [&](const char* what) {
+    const bool by_target = what == std::string("spot") ? one_of(v, "look_at", "direction") : false;
+    const Value given = by_target ? v["look_at"] : require(v, "direction");
+    if (by_target) check_coordinates(given, three_numbers(given), "look_at");
+    const glm::dvec3 d = by_target ? glm::dvec3(three_numbers(given)) - glm::dvec3(light.position) : glm::dvec3(three_numbers(given));
+    if (!(glm::length(d) > 0.0)) fail(given, by_target ? "look_at equals the light's position: no direction" : "direction has zero length");
+    light.direction = glm::vec3(glm::normalize(d));
+  };
+  if (kind == "point") {
+    check_keys(v, {"type", "position", "intensity", "power"});
+    light.position = three_numbers(require(v, "position"));
+    check_coordinates(v["position"], light.position, "the light");
+    if (one_of(v, "intensity", "power")) {
+      light.intensity = color(v["intensity"]);
+    } else {
+      light.intensity = color(v["power"]) / (4.0f * glm::pi<float>());  // isotropic: I = P / 4pi
+    }
+  } else if (kind == "spot") {
+    // Mitsuba's `spot`: its intensity at the centre, a cutoff angle (20 degrees unless given) and a
+    // beam width (three quarters of the cutoff unless given), in degrees.
+    check_keys(v, {"type", "position", "look_at", "direction", "intensity", "cutoff_angle", "beam_width"});
+    light.type = Light::Type::spot;
+    light.position = three_numbers(require(v, "position"));
+    check_coordinates(v["position"], light.position, "the light");
+    aim("spot");
+    light.intensity = color(require(v, "intensity"));
+    float cutoff = 20.0f;
+    if (v.has("cutoff_angle")) {
+      cutoff = number(v["cutoff_angle"]);
+      if (!(cutoff > 0.0f && cutoff <= 180.0f)) fail(v["cutoff_angle"], "expected degrees in (0, 180], got " + brief(v["cutoff_angle"].j));
+    }
+    float beam = 0.75f * cutoff;
+    if (v.has("beam_width")) {
+      beam = number(v["beam_width"]);
+      if (!(beam >= 0.0f && beam <= cutoff))
+        fail(v["beam_width"], "expected degrees from 0 to the cutoff_angle (" + (v.has("cutoff_angle") ? brief(v["cutoff_angle"].j) : std::string("20")) + "), got " + brief(v["beam_width"].j));
+    }
+    light.cutoff_angle = glm::radians(cutoff);
+    light.beam_width = glm::radians(beam);
+  } else if (kind == "directional") {
+    // Mitsuba's `directional`: the irradiance on a surface facing it, arriving along `direction`.
+    check_keys(v, {"type", "direction", "irradiance"});
+    light.type = Light::Type::directional;
+    aim("directional");
+    light.intensity = color(require(v, "irradiance"));
   } else {
-    light.intensity = color(v["power"]) / (4.0f * glm::pi<float>());  // isotropic: I = P / 4pi
+    fail(type, "unknown light type " + brief(type.j) + " (expected \"point\", \"spot\" or \"directional\")");
   }
   scene_.lights.push_back(light);
 }

@@ -97,9 +97,16 @@ std::pair<std::optional<Camera>, float> SceneParser::add_gltf(const Value* where
 }
 
 void SceneParser::add_gltf_lights(const Value& where, const GltfScene& gltf, const glm::mat4& transform) {
-  for (PointLight light : gltf.lights) {
-    light.position = transform_point(transform, light.position);
-    check_coordinates(where, light.position, "a light of the glTF file");
+  for (Light light : gltf.lights) {
+    if (light.type != Light::Type::directional) {
+      light.position = transform_point(transform, light.position);
+      check_coordinates(where, light.position, "a light of the glTF file");
+    }
+    if (light.type != Light::Type::point) {
+      // A direction turns by the transform's linear part (an invertible one: the object's transform is).
+      const glm::dvec3 d = glm::dmat3(transform) * glm::dvec3(light.direction);
+      light.direction = glm::vec3(glm::normalize(d));
+    }
     scene_.lights.push_back(light);
   }
 }

@@ -393,7 +393,7 @@ int radiance_exponent(const Scene& scene) {
   float brightest = std::max({scene.background.r, scene.background.g, scene.background.b, scene.ambient.r, scene.ambient.g,
                               scene.ambient.b});
   for (const Material& m : scene.materials) brightest = std::max({brightest, m.emission.r, m.emission.g, m.emission.b});
-  for (const PointLight& l : scene.lights) brightest = std::max({brightest, l.intensity.r, l.intensity.g, l.intensity.b});
+  for (const Light& l : scene.lights) brightest = std::max({brightest, l.intensity.r, l.intensity.g, l.intensity.b});
   if (!(brightest > 0.0f)) return 0;
   int exponent = 0;
   std::frexp(brightest, &exponent);  // brightest = m 2^exponent, m in [0.5, 1)
@@ -461,8 +461,31 @@ PackedLighting pack_lighting(const Scene& scene, const PrimitiveSlots& slots) {
   packed.frame = {uint32_t(table.entries.size()), exponent};
   packed.lights.resize(scene.lights.size() * VKRAY_TEXELS_PER_LIGHT);
   for (size_t i = 0; i < scene.lights.size(); ++i) {
-    packed.lights[i * VKRAY_TEXELS_PER_LIGHT + VKRAY_LIGHT_POSITION] = glm::vec4(scene.lights[i].position, 0.0f);
-    packed.lights[i * VKRAY_TEXELS_PER_LIGHT + VKRAY_LIGHT_INTENSITY] = glm::vec4(scale_radiance(scene.lights[i].intensity, exponent), 0.0f);
+    const Light& l = scene.lights[i];
+    glm::vec4* texels = &packed.lights[i * VKRAY_TEXELS_PER_LIGHT];
+    uint32_t kind = VKRAY_LIGHT_POINT;
+    glm::vec4 cone(0.0f);
+    if (l.type == Light::Type::directional) {
+      kind = VKRAY_LIGHT_DIRECTIONAL;
+    } else if (l.type == Light::Type::spot) {
+      // The cosines and the ramp's slope in double, then one rounding each.
+      const double cos_cutoff = std::cos(double(l.cutoff_angle)), cos_beam = std::cos(double(l.beam_width));
+      if (l.falloff == Light::Falloff::mitsuba) {
+        kind = VKRAY_LIGHT_SPOT;
+        // A beam as wide as the cutoff has no ramp: the slope is never used (the cosine is past one end).
+        const double transition = double(l.cutoff_angle) - double(l.beam_width);
+        cone = glm::vec4(float(cos_cutoff), float(cos_beam), l.cutoff_angle, transition > 0 ? float(1 / transition) : 0.0f);
+      } else {
+        // KHR_lights_punctual's own form, its 0.001 included.
+        kind = VKRAY_LIGHT_GLTF_SPOT;
+        const double scale = 1 / std::max(0.001, cos_beam - cos_cutoff);
+        cone = glm::vec4(float(scale), float(-cos_cutoff * scale), 0.0f, 0.0f);
+      }
+    }
+    texels[VKRAY_LIGHT_POSITION] = glm::vec4(l.position, uintBitsToFloat(kind));
+    texels[VKRAY_LIGHT_INTENSITY] = glm::vec4(scale_radiance(l.intensity, exponent), 0.0f);
+    texels[VKRAY_LIGHT_DIRECTION] = glm::vec4(l.direction, 0.0f);
+    texels[VKRAY_LIGHT_CONE] = cone;
   }
   return packed;
 }

@@ -11,7 +11,7 @@ namespace {
 // here updated: the build stops until it is.
 static_assert(sizeof(Camera) == 48, "a Camera field is not in scene_digest");
 static_assert(sizeof(Integrator) == 12, "an Integrator field is not in scene_digest");
-static_assert(sizeof(PointLight) == 24, "a PointLight field is not in scene_digest");
+static_assert(sizeof(Light) == 52, "a Light field is not in scene_digest");
 static_assert(sizeof(Sphere) == 28, "a Sphere field is not in scene_digest");
 static_assert(sizeof(Triangle) == 228, "a Triangle field is not in scene_digest");
 static_assert(sizeof(TextureRef) == 44, "a TextureRef field is not in scene_digest");
@@ -72,7 +72,10 @@ std::string scene_digest(const Scene& scene) {
     h->bytes(t->texels.data(), t->texels.size() * sizeof(uint16_t));
   }
   h->add(uint64_t(scene.lights.size()));
-  for (const PointLight& l : scene.lights) h->add(l.position), h->add(l.intensity);
+  for (const Light& l : scene.lights) {
+    h->add(l.type), h->add(l.position), h->add(l.intensity), h->add(l.direction);
+    h->add(l.falloff), h->add(l.cutoff_angle), h->add(l.beam_width);
+  }
   h->add(uint64_t(scene.spheres.size()));
   for (const Sphere& s : scene.spheres) h->add(s.center), h->add(s.radius), h->add(s.material), h->add(s.object), h->add(s.inward);
   const auto add_triangles = [&](const std::vector<Triangle>& triangles) {

@@ -52,7 +52,9 @@ void check_radiance_range(const Scene& scene) {
   for (const Material& m : scene.materials)
     all.push_back({"material \"" + printable(m.name) + "\"'s emission", brightest(m.emission)});
   for (size_t i = 0; i < scene.lights.size(); ++i)
-    all.push_back({(json ? "/lights/" : "light ") + std::to_string(i) + (json ? "/intensity" : "'s intensity"),
+    all.push_back({(json ? "/lights/" : "light ") + std::to_string(i) +
+                       (scene.lights[i].type == Light::Type::directional ? (json ? "/irradiance" : "'s irradiance")
+                                                                          : (json ? "/intensity" : "'s intensity")),
                    brightest(scene.lights[i].intensity)});
   const Radiance* bright = nullptr;
   const Radiance* dim = nullptr;

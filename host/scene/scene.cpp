@@ -30,7 +30,8 @@ float Scene::extent() const {
   auto grow = [&e](glm::vec3 p) { e = std::max({e, std::abs(p.x), std::abs(p.y), std::abs(p.z)}); };
   // Rays leave anywhere on the lens: its rounding is what epsilon must stand above.
   grow(glm::abs(camera.position) + camera.aperture_radius);
-  for (const auto& l : lights) grow(l.position);
+  for (const auto& l : lights)
+    if (l.type != Light::Type::directional) grow(l.position);
   for (const auto& s : spheres) grow(glm::abs(s.center) + s.radius);
   for (const auto& t : triangles)
     for (const auto& p : t.v) grow(p);

@@ -177,9 +177,24 @@ struct Integrator {
   uint32_t rr_depth = 5;     // path: Russian roulette from this depth on
 };
 
-struct PointLight {
-  glm::vec3 position{0.0f};
-  glm::vec3 intensity{0.0f};  // radiant intensity I (W/sr); a file's "power" P is stored as P / 4pi
+// A light that is not a surface, each as Mitsuba's emitter of the name: it sends light from one point
+// (point, spot) or from one direction (directional), so only the lights themselves find it, never a
+// ray by chance.
+struct Light {
+  enum class Type : uint32_t { point, spot, directional };
+  // How a spot dims toward its edge: Mitsuba's `spot` (1 within beam_width, then linearly in the
+  // angle to 0 at cutoff_angle), or KHR_lights_punctual's (the square of a ramp in the cosine from
+  // the outer cone, cutoff_angle, to the inner, beam_width).
+  enum class Falloff : uint32_t { mitsuba, gltf };
+  Type type = Type::point;
+  glm::vec3 position{0.0f};   // point, spot
+  // point: radiant intensity I (W/sr; a file's "power" P is stored as P / 4pi); spot: I at its
+  // centre; directional: irradiance E (W/m^2) on a surface that faces it
+  glm::vec3 intensity{0.0f};
+  glm::vec3 direction{0.0f, 0.0f, 1.0f};  // spot, directional: unit, the way its light travels
+  Falloff falloff = Falloff::mitsuba;
+  float cutoff_angle = 0.0f;  // spot: radians from the axis, in (0, pi]: no light past it
+  float beam_width = 0.0f;    // spot: radians, in [0, cutoff_angle]: full light within it
 };
 
 struct Sphere {
@@ -255,7 +270,7 @@ struct Scene {
   glm::vec3 background{0.0f};
   glm::vec3 ambient{0.0f};
   std::vector<Material> materials;
-  std::vector<PointLight> lights;
+  std::vector<Light> lights;
   std::vector<Sphere> spheres;
   std::vector<Triangle> triangles;
   std::vector<SharedMesh> meshes;    // what `instances` place

@@ -175,10 +175,20 @@ VKRAY_INLINE bool alias_keeps_entry(float u, uint count, uint entry, float proba
 // The luminance (Rec. 709) that weighs an emission: the power of an area light is its area times it.
 VKRAY_INLINE float emission_luminance(vec3 e) { return 0.2126f * e.x + 0.7152f * e.y + 0.0722f * e.z; }
 
-// ---- Point lights: VKRAY_TEXELS_PER_LIGHT RGBA32F texels each ---------------------------------------
-#define VKRAY_TEXELS_PER_LIGHT 2
-#define VKRAY_LIGHT_POSITION 0   // (position, 0)
-#define VKRAY_LIGHT_INTENSITY 1  // (intensity, 0), W/sr
+// ---- Lights that are not surfaces (vkray::Light): VKRAY_TEXELS_PER_LIGHT RGBA32F texels each --------
+#define VKRAY_TEXELS_PER_LIGHT 4
+#define VKRAY_LIGHT_POSITION 0   // (position, kind as uint bits); a directional light's position is unused
+#define VKRAY_LIGHT_INTENSITY 1  // (intensity, 0): W/sr, a spot's at its centre; a directional light's irradiance, W/m^2
+#define VKRAY_LIGHT_DIRECTION 2  // (unit direction its light travels along: a spot's axis, 0); a point's is unused
+#define VKRAY_LIGHT_CONE 3       // a spot's falloff: (cos cutoff, cos beam, cutoff, 1 / (cutoff - beam)) for
+                                 // VKRAY_LIGHT_SPOT, (scale, offset, 0, 0) for VKRAY_LIGHT_GLTF_SPOT
+// The kinds. VKRAY_LIGHT_SPOT falls off as Mitsuba's `spot`: 1 inside the beam width, linearly in
+// the angle to 0 at the cutoff; VKRAY_LIGHT_GLTF_SPOT as KHR_lights_punctual's: the square of
+// clamp(cos * scale + offset, 0, 1), from 1 inside the inner cone to 0 at the outer.
+#define VKRAY_LIGHT_POINT 0u
+#define VKRAY_LIGHT_SPOT 1u
+#define VKRAY_LIGHT_GLTF_SPOT 2u
+#define VKRAY_LIGHT_DIRECTIONAL 3u
 
 // ---- BVH links ---------------------------------------------------------------------------------------
 // A child link is an inner node's index, or a leaf: VKRAY_LEAF_BIT | first << VKRAY_LEAF_COUNT_BITS |

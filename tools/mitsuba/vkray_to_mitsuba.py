@@ -48,7 +48,8 @@ Mapping (vkray's docs/scene-format.md and docs/rendering.md):
               the row-major matrix); flat shading = no vertex normals; "smooth": the file's
               normals, else area-weighted normals of the vertices welded by position (vkray's
               rule); flip_normals reverses the winding. Spheres: 'sphere' (its flip_normals).
-  lights      point: intensity, or power / 4 pi.
+  lights      point: intensity, or power / 4 pi; spot: intensity, cutoff_angle, beam_width, its to_world
+              a look_at frame along its direction; directional: direction, irradiance.
   background  path: a 'constant' emitter. direct: composited where the camera ray misses (from
               the film's alpha), since vkray's direct model is not lit by the background.
   integrator  path -> 'path' (max_depth, rr_depth); direct or absent -> 'path' max_depth 2.
@@ -468,10 +469,27 @@ def scene_dict(path, overrides=None):
 
     # lights
     for i, light in enumerate(scene.get("lights", [])):
-        if light.get("type") != "point":
-            raise ValueError(f"{path}: /lights/{i}/type: unknown light type {light.get('type')!r}")
+        kind = light.get("type")
+        rgb = lambda key: {"type": "rgb", "value": [float(x) for x in light[key]]}
+        if kind == "directional":
+            direction = vec3(light["direction"], f"lights/{i}/direction")
+            d[f"light{i}"] = {"type": "directional", "direction": (direction / np.linalg.norm(direction)).tolist(),
+                              "irradiance": rgb("irradiance")}
+            continue
+        if kind not in ("point", "spot"):
+            raise ValueError(f"{path}: /lights/{i}/type: unknown light type {kind!r}")
         p = vec3(light["position"], f"lights/{i}/position")
         grow(p[None])
+        if kind == "spot":
+            # Mitsuba's spot shines along its local +z: a look_at frame from the position toward the aim.
+            aim = vec3(light["look_at"], f"lights/{i}/look_at") - p if "look_at" in light else vec3(light["direction"], f"lights/{i}/direction")
+            aim = aim / np.linalg.norm(aim)
+            up = np.array([0.0, 1.0, 0.0]) if abs(aim[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+            cutoff = float(light.get("cutoff_angle", 20.0))
+            d[f"light{i}"] = {"type": "spot", "intensity": rgb("intensity"), "cutoff_angle": cutoff,
+                              "beam_width": float(light.get("beam_width", 0.75 * cutoff)),
+                              "to_world": mi.ScalarTransform4f.look_at(origin=p.tolist(), target=(p + aim).tolist(), up=up.tolist())}
+            continue
         if "intensity" in light:
             intensity = np.array(light["intensity"], dtype=np.float64)
         else:
