@@ -7,6 +7,7 @@
 
 #include "aovs.glsl"
 #include "bsdf.glsl"
+#include "environment.glsl"
 #include "shade.glsl"
 #include "traversal.glsl"
 
@@ -14,7 +15,7 @@
 vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
   if (!SCENE_HAS_EMITTERS && !SCENE_HAS_NON_DIFFUSE) {  // the lecture's model: one hit, shaded
     Hit hit = trace_closest(ray, frame.epsilon, FAR, true, stream);
-    if (hit.prim == NO_HIT) return frame.background.rgb;
+    if (hit.prim == NO_HIT) return background_radiance(ray.dir);
     vec3 x = ray_at(ray, hit.t);
     Surface s = hit_surface(hit, ray);
     if (FIRST_HIT_PASSES) add_first_hit(hit, x, s);
@@ -25,7 +26,7 @@ vec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) {
   do {
     Hit hit = trace_closest(ray, frame.epsilon, FAR, bounce == 0u, stream);
     if (hit.prim == NO_HIT) {
-      radiance += throughput * frame.background.rgb;
+      radiance += throughput * background_radiance(ray.dir);
       break;
     }
     vec3 x = ray_at(ray, hit.t);

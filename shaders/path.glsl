@@ -1,9 +1,10 @@
 // The path integrator: the rendering equation by unidirectional path tracing, as Mitsuba 3's `path`.
 // At every vertex that is not a delta (diffuse or glossy), next-event estimation: each point, spot and
-// directional light, one area-light sample and one sample of the background (when it is not black),
-// the last two weighed against BSDF sampling by the power heuristic; then the BSDF picks the next direction. A
-// hit on an emitter (or a miss, on the background) adds its light weighed the same way, or whole
-// after a mirror or glass.
+// directional light, one area-light sample and one sample of the environment map (drawn by its
+// radiance) or of the background (uniform, when it is not black), the last two weighed against BSDF
+// sampling by the power heuristic; then the BSDF picks the next direction. A hit on an emitter (or a
+// miss, on the environment or the background) adds its light weighed the same way, or whole after a
+// mirror or glass.
 // Depth counts as Mitsuba's max_depth does; Russian roulette from rr_depth on.
 #ifndef VKRAY_PATH_GLSL
 #define VKRAY_PATH_GLSL
@@ -49,8 +50,13 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   bool background_sampled = SCENE_HAS_BACKGROUND && (frame.background.r > 0.0 || frame.background.g > 0.0 || frame.background.b > 0.0);
   Hit hit = trace_closest(p.ray, frame.epsilon, FAR, p.depth == 0u, stream);
   if (hit.prim == NO_HIT) {
-    float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, BACKGROUND_PDF);
-    p.radiance += p.throughput * frame.background.rgb * weight;
+    if (SCENE_HAS_ENVIRONMENT) {
+      EnvironmentLookup e = environment_lookup(p.ray.dir);
+      p.radiance += p.throughput * e.radiance * (p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, e.pdf));
+    } else {
+      float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, BACKGROUND_PDF);
+      p.radiance += p.throughput * frame.background.rgb * weight;
+    }
     return true;
   }
   vec3 x = ray_at(p.ray, hit.t);
@@ -84,7 +90,12 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
         p.radiance += p.throughput * eval_bsdf(s, wo, light.dir, n, front) * light.radiance *
                       (power_heuristic(light.pdf, pdf_bsdf(s, wo, light.dir, n, front)) / light.pdf);
     }
-    if (background_sampled) {
+    if (SCENE_HAS_ENVIRONMENT) {
+      AreaLightSample light = sample_environment_from(lit, stream, rays);
+      if (light.pdf > 0.0)
+        p.radiance += p.throughput * eval_bsdf(s, wo, light.dir, n, front) * light.radiance *
+                      (power_heuristic(light.pdf, pdf_bsdf(s, wo, light.dir, n, front)) / light.pdf);
+    } else if (background_sampled) {
       vec3 w = uniform_sphere(vec2(next_random(stream), next_random(stream)));
       if (faces(lit, w)) {
         rays += 1u;

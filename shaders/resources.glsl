@@ -19,6 +19,8 @@ layout(set = 0, binding = VKRAY_BINDING_TEXTURES) uniform samplerBuffer textures
 layout(set = 0, binding = VKRAY_BINDING_TANGENTS) uniform samplerBuffer tangents;
 layout(set = 0, binding = VKRAY_BINDING_COLOURS) uniform samplerBuffer colours;
 layout(set = 0, binding = VKRAY_BINDING_INSTANCES) uniform samplerBuffer instances;
+layout(set = 0, binding = VKRAY_BINDING_ENVIRONMENT) uniform samplerBuffer environment;
+layout(set = 0, binding = VKRAY_BINDING_ENVIRONMENT_CDF) uniform samplerBuffer environment_cdf;
 
 // The frame's constants as every function reads them: a private copy of the uniform block, made
 // by load_frame() before anything else in main. llvmpipe reads a uniform block lane by lane at

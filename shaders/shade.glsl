@@ -15,6 +15,7 @@
 
 #include "bsdf.glsl"
 #include "emitters.glsl"
+#include "environment.glsl"
 #include "primitives.glsl"
 #include "resources.glsl"
 #include "traversal.glsl"
@@ -123,6 +124,21 @@ AreaLightSample sample_area_light_from(LitPoint p, inout uint stream, inout uint
   return s;
 }
 
+// One direction drawn from the environment map as a point p sees it, in the same form. Draws two
+// numbers from the stream.
+AreaLightSample sample_environment_from(LitPoint p, inout uint stream, inout uint rays) {
+  EnvironmentSample e = sample_environment(stream);
+  AreaLightSample s = AreaLightSample(vec3(0.0), e.dir, dot(p.n, e.dir), 0.0);
+  if (!(e.pdf > 0.0 && faces(p, e.dir))) return s;
+  if (SHADOW_RAYS) {
+    rays += 1u;
+    if (trace_any(Ray(origin_toward(p, e.dir), e.dir), frame.epsilon, FAR, stream)) return s;
+  }
+  s.radiance = e.radiance;
+  s.pdf = e.pdf;
+  return s;
+}
+
 // How much of a spot's intensity leaves along a direction at cosine c to its axis (VKRAY_LIGHT_CONE).
 float spot_falloff(uint kind, float c, vec4 cone) {
   if (kind == VKRAY_LIGHT_GLTF_SPOT) {
@@ -199,6 +215,10 @@ vec3 shade(Ray ray, vec3 x, Surface surface, inout uint stream, inout uint rays)
   add_delta_lights(p, surface, wo, front, radiance, stream, rays);
   if (SCENE_HAS_EMITTERS) {  // one light sample: f cos Le / pdf
     AreaLightSample light = sample_area_light_from(p, stream, rays);
+    if (light.pdf > 0.0) radiance += eval_bsdf(surface, wo, light.dir, n, front) * (light.radiance / light.pdf);
+  }
+  if (SCENE_HAS_ENVIRONMENT) {  // and one of the environment, the same way
+    AreaLightSample light = sample_environment_from(p, stream, rays);
     if (light.pdf > 0.0) radiance += eval_bsdf(surface, wo, light.dir, n, front) * (light.radiance / light.pdf);
   }
   return radiance;

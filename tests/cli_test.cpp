@@ -66,6 +66,21 @@ TEST(CliTest, BadSceneExitsOneNamingFileAndKeyAndWritesNothing) {
   EXPECT_FALSE(has_image_files(dir.path()));
 }
 
+TEST(CliTest, AnEnvironmentFlagLightsTheSceneOrNamesItsFile) {
+  TempDir dir;
+  const std::string sky = std::string(VKRAY_CHECK_DIR) + "/environment/sky.hdr";
+  const Result lit = vkray("render --validate " + kScenes + "/gltf/BoxTextured/glTF-Binary/BoxTextured.glb --environment " + sky +
+                               " -o box.pfm --width 24 --height 24 --spp 4",
+                           dir.path());
+  ASSERT_EQ(lit.exit_code, 0) << lit.err;
+  EXPECT_EQ(lit.err.find("adds a point light at the camera"), std::string::npos) << lit.err;
+  EXPECT_GT(read_pfm(dir / "box.pfm").at(0, 0).b, 0.0f);  // the sky, where the box is not
+  const Result missing = vkray("render --validate --environment nowhere.hdr -o out.png", dir.path());
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("nowhere.hdr: not found"), std::string::npos) << missing.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.png"));
+}
+
 TEST(CliTest, MissingSceneExitsOne) {
   TempDir dir;
   const Result run = vkray("render nowhere.json", dir.path());

@@ -35,6 +35,9 @@ CLI::Validator within(const ArgumentLimit& limit) {
 
 void add_scene_flags(CLI::App& command, SceneFlags& flags) {
   command.add_option("scene", flags.scene, "Scene file (default: the Cornell box, scenes/cornell.json)");
+  command.add_option("--environment", flags.environment,
+                     "Light the scene by this environment map (.hdr or .exr, equirectangular), in place of its own "
+                     "environment and background");
   command.add_option("--width", flags.width, "Image width in pixels (overrides the scene)")->check(within(kWidthArgument));
   command.add_option("--height", flags.height, "Image height in pixels (overrides the scene)")->check(within(kHeightArgument));
   command.add_option("--spp", flags.spp, "Samples per pixel (overrides the scene)")->check(within(kSppArgument));

@@ -13,9 +13,10 @@
 
 namespace vkray::cli {
 
-// SCENE [--width W] [--height H] [--spp N] [--seed S] [--region X0,Y0,X1,Y1|I/N]
+// SCENE [--environment FILE] [--width W] [--height H] [--spp N] [--seed S] [--region X0,Y0,X1,Y1|I/N]
 struct SceneFlags {
   std::filesystem::path scene;  // empty: the default scene
+  std::filesystem::path environment;  // an environment map in place of the scene's; empty: none
   std::optional<uint32_t> width, height, spp, seed;
   std::optional<RegionRequest> region;  // offered by add_region_flag
 };

@@ -75,7 +75,7 @@ int run_parity(const ParityArgs& args) {
   auto log = [&](const std::string& line) {
     if (!args.json) std::cerr << "vkray: " << line << "\n";
   };
-  const LoadedScene loaded = load_scene_file(scene_file(args.scene));
+  const LoadedScene loaded = load_scene_file(scene_file(args.scene), args.scene.environment);
   if (!args.diff.empty()) check_output_image(args.diff);
   RenderOptions options = render_options(&args.scene, &args.gpu, &args.cpu);
   log(describe(*loaded.scene, image_settings(*loaded.scene, options)));

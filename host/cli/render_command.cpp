@@ -38,7 +38,7 @@ int run_render(const RenderArgs& args) {
   auto log = [&](const std::string& line) {
     if (!args.quiet) std::cerr << "vkray: " << line << "\n";
   };
-  const LoadedScene loaded = load_scene_file(scene_file(args.scene));
+  const LoadedScene loaded = load_scene_file(scene_file(args.scene), args.scene.environment);
   const std::filesystem::path output =
       args.output.empty() ? std::filesystem::path(loaded.scene->name + ".png") : args.output;
   ExrContent content;

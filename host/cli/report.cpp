@@ -14,10 +14,10 @@
 
 namespace vkray::cli {
 
-LoadedScene load_scene_file(const std::filesystem::path& file) {
+LoadedScene load_scene_file(const std::filesystem::path& file, const std::filesystem::path& environment) {
   const auto start = Clock::now();
   LoadedScene loaded;
-  loaded.scene = std::make_shared<const Scene>(load_scene(file));
+  loaded.scene = std::make_shared<const Scene>(load_scene(file, nullptr, environment));
   for (const auto& warning : loaded.scene->warnings) std::cerr << "vkray: warning: " << warning << "\n";
   loaded.load_ms = ms_since(start);
   return loaded;

@@ -17,8 +17,9 @@ struct LoadedScene {
   std::shared_ptr<const Scene> scene;
   double load_ms = 0;
 };
-// Loads a scene file and prints its warnings.
-LoadedScene load_scene_file(const std::filesystem::path& file);
+// Loads a scene file (lit by the environment map `environment` when it is not empty: load_scene)
+// and prints its warnings.
+LoadedScene load_scene_file(const std::filesystem::path& file, const std::filesystem::path& environment = {});
 
 // "scenes/cornell.json: 30 triangles, 0 spheres, 1 lights; 512x512, 1 spp"
 std::string describe(const Scene& scene, const ImageSettings& image);

@@ -73,6 +73,7 @@ class Watch {
 
   const WatchArgs& args_;
   const std::filesystem::path scene_file_;
+  const std::filesystem::path environment_file_;  // --environment; empty: the scene's own
   const std::filesystem::path output_;
   SessionOptions session_options_;
   RenderOptions options_;
@@ -87,6 +88,7 @@ class Watch {
 Watch::Watch(const WatchArgs& args)
     : args_(args),
       scene_file_(absolute_normal(scene_file(args.scene))),
+      environment_file_(args.scene.environment.empty() ? std::filesystem::path() : absolute_normal(args.scene.environment)),
       output_(args.output.empty() ? std::filesystem::path(scene_file_.stem().string() + ".png") : args.output),
       session_options_(session_options(args.device)),
       options_(render_options(&args.scene, &args.gpu, nullptr)) {
@@ -101,7 +103,7 @@ Watch::Watch(const WatchArgs& args)
 std::string Watch::reload_scene() {
   const auto start = Clock::now();
   try {
-    auto loaded = std::make_shared<const Scene>(load_scene(scene_file_));
+    auto loaded = std::make_shared<const Scene>(load_scene(scene_file_, nullptr, environment_file_));
     for (const auto& warning : loaded->warnings) std::cerr << "vkray: warning: " << warning << "\n";
     DeviceScene uploaded = session_->upload(loaded, nullptr);
     scene_ = std::move(loaded);

@@ -26,6 +26,10 @@ dvec3 shade(const Tracer& tracer, const Lights& lights, const SurfacePoint& s, c
     const AreaLightSample light = lights.sample_area_light_from(p, state.stream, state.rays);
     if (light.pdf > 0) radiance += eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance / light.pdf;
   }
+  if (lights.environment()) {  // the environment: one more light, sampled the same way
+    const AreaLightSample light = lights.sample_environment_from(p, state.stream, state.rays);
+    if (light.pdf > 0) radiance += eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance / light.pdf;
+  }
   return radiance;
 }
 
@@ -41,7 +45,7 @@ dvec3 direct_radiance(const Tracer& tracer, const Lights& lights, const Ray& cam
     const Hit hit = bounce == 0 ? tracer.camera_hit(ray, epsilon, far, state.stream) : tracer.closest(ray, epsilon, far, state.stream);
     if (bounce == 0) mix(state.signature, uint64_t(int64_t(hit.primitive)));
     if (hit.primitive < 0) {
-      radiance += throughput * dvec3(scene.background);
+      radiance += throughput * lights.background(ray.dir);
       break;
     }
     const SurfacePoint s = tracer.surface(ray, hit);

@@ -14,6 +14,27 @@ namespace vkray::cpu {
 Lights::Lights(const Tracer& tracer, bool shadows)
     : tracer_(tracer), shadows_(shadows), epsilon_(tracer.epsilon()), table_(build_emitter_table(tracer.scene())) {
   if (!table_.entries.empty()) inv_weight_ = 1 / table_.total_weight;
+  if (tracer.scene().environment) environment_.emplace(*tracer.scene().environment);
+}
+
+dvec3 Lights::background(const dvec3& dir) const {
+  return environment() ? environment_->lookup(dir).radiance : dvec3(tracer_.scene().background);
+}
+
+AreaLightSample Lights::sample_environment_from(const LitPoint& p, uint32_t& stream, uint64_t& rays) const {
+  const double u_row = gpu::next_random(stream), u_column = gpu::next_random(stream);
+  const EnvironmentLight::Sample e = environment_->sample(u_row, u_column);
+  AreaLightSample s;
+  s.dir = e.dir;
+  s.cos_x = glm::dot(p.n, e.dir);
+  if (!(e.pdf > 0 && p.faces(e.dir))) return s;
+  if (shadows_) {
+    ++rays;
+    if (tracer_.occluded({p.origin_toward(e.dir), e.dir}, epsilon_, std::numeric_limits<double>::infinity(), stream)) return s;
+  }
+  s.radiance = e.radiance;
+  s.pdf = e.pdf;
+  return s;
 }
 
 namespace {

@@ -4,8 +4,10 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 #include "cpu/bsdf.h"
+#include "cpu/environment.h"
 #include "cpu/tracer.h"
 #include "scene/emitters.h"
 
@@ -76,12 +78,20 @@ class Lights {
   // A point on the area lights (three numbers) as p sees it.
   AreaLightSample sample_area_light_from(const LitPoint& p, uint32_t& stream, uint64_t& rays) const;
 
+  // The environment map, when the scene has one that sends light; null otherwise.
+  const EnvironmentLight* environment() const { return environment_ && environment_->lights() ? &*environment_ : nullptr; }
+  // What a ray that leaves the scene along `dir` brings: the environment's radiance, or the background.
+  dvec3 background(const dvec3& dir) const;
+  // A direction drawn from the environment (two numbers) as p sees it, in the area light's form.
+  AreaLightSample sample_environment_from(const LitPoint& p, uint32_t& stream, uint64_t& rays) const;
+
  private:
   const Tracer& tracer_;
   bool shadows_;
   double epsilon_;
   EmitterTable table_;
   double inv_weight_ = 0;
+  std::optional<EnvironmentLight> environment_;
 };
 
 }  // namespace vkray::cpu

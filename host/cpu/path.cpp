@@ -35,7 +35,12 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     const Hit hit = depth == 0 ? tracer.camera_hit(ray, epsilon, kFar, state.stream) : tracer.closest(ray, epsilon, kFar, state.stream);
     if (depth == 0) mix(state.signature, uint64_t(int64_t(hit.primitive)));
     if (hit.primitive < 0) {
-      radiance += throughput * background * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, kBackgroundPdf));
+      if (const EnvironmentLight* environment = lights.environment()) {
+        const EnvironmentLight::Lookup e = environment->lookup(ray.dir);
+        radiance += throughput * e.radiance * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, e.pdf));
+      } else {
+        radiance += throughput * background * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, kBackgroundPdf));
+      }
       break;
     }
     const SurfacePoint s = tracer.surface(ray, hit);
@@ -67,7 +72,12 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
           radiance += throughput * eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance *
                       (power_heuristic(light.pdf, pdf_bsdf(bsdf, wo, light.dir, n, front)) / light.pdf);
       }
-      if (background_sampled) {
+      if (lights.environment()) {
+        const AreaLightSample light = lights.sample_environment_from(p, state.stream, state.rays);
+        if (light.pdf > 0)
+          radiance += throughput * eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance *
+                      (power_heuristic(light.pdf, pdf_bsdf(bsdf, wo, light.dir, n, front)) / light.pdf);
+      } else if (background_sampled) {
         const double u1 = gpu::next_random(state.stream), u2 = gpu::next_random(state.stream);
         const dvec3 w = uniform_sphere(u1, u2);
         if (p.faces(w)) {

@@ -35,6 +35,8 @@ constexpr BindingSlot kTraceBindings[] = {
     {VKRAY_BINDING_TANGENTS, kTexel, "tangents"},
     {VKRAY_BINDING_COLOURS, kTexel, "colours"},
     {VKRAY_BINDING_INSTANCES, kTexel, "instances"},
+    {VKRAY_BINDING_ENVIRONMENT, kTexel, "environment"},
+    {VKRAY_BINDING_ENVIRONMENT_CDF, kTexel, "environment_cdf"},
 };
 
 // Two rows of one id would give the shader's constant whichever value Vulkan takes first.

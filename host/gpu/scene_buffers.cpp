@@ -16,8 +16,8 @@
 namespace vkray::gpu {
 namespace {
 
-// A texel buffer and its view (RGBA32F for vec4 texels, RGBA32UI for uvec4); never empty (Vulkan
-// has no zero-sized buffers), the shader is told the real count.
+// A texel buffer and its view (RGBA32F for vec4 texels, RGBA32UI for uvec4, R32F for float); never
+// empty (Vulkan has no zero-sized buffers), the shader is told the real count.
 struct TexelBuffer {
   Buffer buffer;
   vk::raii::BufferView view{nullptr};
@@ -25,13 +25,15 @@ struct TexelBuffer {
 
 template <typename Texel>
 TexelBuffer make_texel_buffer(const Context& ctx, const std::vector<Texel>& texels, const char* what) {
-  static_assert(sizeof(Texel) == 16);
-  constexpr vk::Format format = std::is_same_v<Texel, glm::uvec4> ? vk::Format::eR32G32B32A32Uint : vk::Format::eR32G32B32A32Sfloat;
+  static_assert(std::is_same_v<Texel, glm::uvec4> || std::is_same_v<Texel, glm::vec4> || std::is_same_v<Texel, float>);
+  constexpr vk::Format format = std::is_same_v<Texel, glm::uvec4>  ? vk::Format::eR32G32B32A32Uint
+                                : std::is_same_v<Texel, float> ? vk::Format::eR32Sfloat
+                                                               : vk::Format::eR32G32B32A32Sfloat;
   if (texels.size() > ctx.limits().maxTexelBufferElements)
     throw DeviceError(std::string("scene too large for ") + ctx.device_name() + ": " + std::to_string(texels.size()) +
                       " " + what + " texels, maxTexelBufferElements is " +
                       std::to_string(ctx.limits().maxTexelBufferElements));
-  static const Texel placeholder(0);
+  static const Texel placeholder(0);  // (R32F is a format every device reads from uniform texel buffers, as RGBA32F)
   const Texel* data = texels.empty() ? &placeholder : texels.data();
   TexelBuffer t;
   const vk::DeviceSize bytes = checked_mul(std::max<size_t>(texels.size(), 1), sizeof(Texel), what);
@@ -64,8 +66,10 @@ void check_memory(const Context& ctx, const PackedScene& packed) {
   for (const auto* buffer : {&packed.primitives, &packed.normals, &packed.texcoords, &packed.tangents, &packed.colours, &packed.instances,
                              &packed.materials, &packed.lights, &packed.emitters})
     texels = checked_add(texels, buffer->size(), "scene buffers");
-  const uint64_t bytes = checked_add(checked_mul(texels, sizeof(glm::vec4), "scene buffers"),
-                                     checked_mul(packed.textures.size(), sizeof(uint16_t), "textures"), "scene buffers");
+  texels = checked_add(texels, packed.environment.texels.size(), "scene buffers");
+  const uint64_t bytes = checked_add(checked_add(checked_mul(texels, sizeof(glm::vec4), "scene buffers"),
+                                                 checked_mul(packed.textures.size(), sizeof(uint16_t), "textures"), "scene buffers"),
+                                     checked_mul(packed.environment.cdf.size(), sizeof(float), "environment"), "scene buffers");
   const auto memory = ctx.physical_device().getMemoryProperties();
   uint64_t largest_heap = 0;
   for (uint32_t h = 0; h < memory.memoryHeapCount; ++h)
@@ -91,12 +95,14 @@ struct SceneBuffers::Geometry {
 };
 
 struct SceneBuffers::Lighting {
-  TexelBuffer materials, lights, emitters;
+  TexelBuffer materials, lights, emitters, environment, environment_cdf;
 
   Lighting(const Context& ctx, const PackedLighting& packed)
       : materials(make_texel_buffer(ctx, packed.materials, "material")),
         lights(make_texel_buffer(ctx, packed.lights, "light")),
-        emitters(make_texel_buffer(ctx, packed.emitters, "area light")) {}
+        emitters(make_texel_buffer(ctx, packed.emitters, "area light")),
+        environment(make_texel_buffer(ctx, packed.environment.texels, "environment map")),
+        environment_cdf(make_texel_buffer(ctx, packed.environment.cdf, "environment distribution")) {}
 };
 
 SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<const Scene> scene, const SceneBvh* prebuilt)
@@ -163,7 +169,9 @@ void SceneBuffers::bind(DescriptorWriter& writer) const {
       .texel_buffer(VKRAY_BINDING_TEXTURES, *geometry_->textures.view)
       .texel_buffer(VKRAY_BINDING_TANGENTS, *geometry_->tangents.view)
       .texel_buffer(VKRAY_BINDING_COLOURS, *geometry_->colours.view)
-      .texel_buffer(VKRAY_BINDING_INSTANCES, *geometry_->instances.view);
+      .texel_buffer(VKRAY_BINDING_INSTANCES, *geometry_->instances.view)
+      .texel_buffer(VKRAY_BINDING_ENVIRONMENT, *lighting_->environment.view)
+      .texel_buffer(VKRAY_BINDING_ENVIRONMENT_CDF, *lighting_->environment_cdf.view);
 }
 
 }  // namespace vkray::gpu

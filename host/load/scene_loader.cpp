@@ -14,6 +14,7 @@
 #include "base/input_file.h"
 #include "base/interrupt.h"
 #include "base/json_document.h"
+#include "load/environment_file.h"
 #include "load/scene_parser.h"
 #include "mesh/tangents.h"
 #include "scene/transform.h"
@@ -138,13 +139,15 @@ void finish_scene(Scene& scene) {
 
 using scene_file::SceneParser;
 
-Scene parse_scene(std::string_view json_text, const std::filesystem::path& file, MeshCache* meshes) {
+Scene parse_scene(std::string_view json_text, const std::filesystem::path& file, MeshCache* meshes,
+                  const std::filesystem::path& environment) {
   const nlohmann::json root = parse_json_document(json_text, file);
   Scene scene;
   scene.file = file;
   scene.name = file.stem().string();
   MeshCache this_scene;
   SceneParser(file, scene, meshes ? *meshes : this_scene).parse(root);
+  if (!environment.empty()) set_environment(scene, environment);
   finish_scene(scene);
   return scene;
 }
@@ -195,7 +198,7 @@ Camera framing_camera(const Scene& scene) {
 
 }  // namespace
 
-Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
+Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes, const std::filesystem::path& environment) {
   Scene scene;
   scene.file = file;
   scene.name = file.stem().string();
@@ -209,11 +212,12 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
   if (!camera) scene.warnings.push_back(file.string() + ": no perspective camera: vkray frames the scene from the front");
   if (aspect > 0.0f)
     scene.image.width = uint32_t(std::clamp(std::lround(double(scene.image.height) * aspect), 1l, long(kMaxImageSide)));
+  if (!environment.empty()) set_environment(scene, environment);
   // A file that brings no light is lit from the camera, so that it is seen at all (docs/scene-format.md):
   // a point light whose irradiance at the scene's centre, straight on, is 1. Emissive surfaces do not
   // count: a model's glowing parts (a helmet's visor lights) rarely light the rest of it.
   const auto [lo, hi] = placed_bounds(scene);
-  if (scene.lights.empty() && lo.x <= hi.x) {
+  if (scene.lights.empty() && !scene.environment && lo.x <= hi.x) {
     const float distance = std::max(glm::length((lo + hi) / 2.0f - scene.camera.position), 1e-6f);
     Light light;
     light.position = scene.camera.position;
@@ -225,12 +229,12 @@ Scene load_gltf_scene(const std::filesystem::path& file, MeshCache* meshes) {
   return scene;
 }
 
-Scene load_scene(const std::filesystem::path& file, MeshCache* meshes) {
+Scene load_scene(const std::filesystem::path& file, MeshCache* meshes, const std::filesystem::path& environment) {
   if (file.empty()) throw SceneError("the scene file name is empty");
-  if (is_gltf_path(file)) return load_gltf_scene(file, meshes);
+  if (is_gltf_path(file)) return load_gltf_scene(file, meshes, environment);
   const InputFile input = read_input_file(file, kMaxSceneFileBytes);
   if (!input.error.empty()) throw SceneError(file.string() + ": " + input.error);
-  return parse_scene(input.text, file, meshes);
+  return parse_scene(input.text, file, meshes, environment);
 }
 
 

@@ -8,6 +8,7 @@
 
 #include "base/checked.h"
 #include "base/interrupt.h"
+#include "load/environment_file.h"
 #include "scene/transform.h"
 
 namespace vkray::scene_file {
@@ -25,14 +26,18 @@ constexpr float kMinAlpha = VKRAY_MIN_GGX_ALPHA;
 void SceneParser::parse(const json& root_json) {
   const Value root{root_json, ""};
   expect_object(root);
-  check_keys(root, {"description", "image", "camera", "integrator", "seed", "background", "ambient", "materials", "lights",
-                    "objects"});
+  check_keys(root, {"description", "image", "camera", "integrator", "seed", "background", "environment", "ambient", "materials",
+                    "lights", "objects"});
   if (root.has("description")) scene_.description = printable(string(root["description"]), 1000);
   if (root.has("image")) parse_image(root["image"]);
   if (root.has("seed")) scene_.image.seed = static_cast<uint32_t>(integer(root["seed"], 0, UINT32_MAX));
   parse_camera(require(root, "camera"));
   if (root.has("integrator")) parse_integrator(root["integrator"]);
   if (root.has("background")) scene_.background = color(root["background"]);
+  if (root.has("environment")) {
+    if (root.has("background")) fail(root, "give either \"background\" or \"environment\", not both: the map replaces the background");
+    parse_environment(root["environment"]);
+  }
   if (root.has("ambient")) scene_.ambient = color(root["ambient"]);
   if (root.has("materials")) parse_materials(root["materials"]);
   if (root.has("lights")) {
@@ -53,7 +58,8 @@ void SceneParser::parse(const json& root_json) {
     warn(root["ambient"], "the path integrator carries indirect light itself: ambient is the direct model's stand-in for it, "
                           "and is ignored");
   const bool emitters = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const Material& m) { return m.emissive(); });
-  const bool lit = !scene_.lights.empty() || emitters || (path ? scene_.background : scene_.ambient) != glm::vec3(0.0f);
+  const bool lit = !scene_.lights.empty() || emitters || scene_.environment ||
+                   (path ? scene_.background : scene_.ambient) != glm::vec3(0.0f);
   if (!lit && (!scene_.triangles.empty() || !scene_.instances.empty()))
     warn(root, path ? "no lights, no emission and no background: every surface renders black"
                     : "no lights, no emission and no ambient: every surface renders black");
@@ -416,6 +422,41 @@ void SceneParser::parse_light(const Value& v) {
     fail(type, "unknown light type " + brief(type.j) + " (expected \"point\", \"spot\" or \"directional\")");
   }
   scene_.lights.push_back(light);
+}
+
+void SceneParser::parse_environment(const Value& v) {
+  // Mitsuba's envmap: its file, a scale of its radiance, and its to_world, a rotation (a map infinitely far
+  // away has no place to move to, nor a size).
+  expect_object(v);
+  check_keys(v, {"file", "scale", "transform"});
+  Environment environment;
+  environment.file = file_of(require(v, "file"));
+  if (v.has("scale")) {
+    environment.scale = number(v["scale"]);
+    if (!(environment.scale >= 0.0f)) fail(v["scale"], "expected a number >= 0, got " + brief(v["scale"].j));
+  }
+  if (v.has("transform")) {
+    const glm::mat4 m = parse_transform(v["transform"]);
+    const glm::mat3 r(m);
+    // Within float rounding of a rotation: orthonormal columns, determinant 1, no translation.
+    const glm::dmat3 rtr = glm::transpose(glm::dmat3(r)) * glm::dmat3(r);
+    double off = 0.0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) off = std::max(off, std::abs(rtr[i][j] - (i == j ? 1.0 : 0.0)));
+    if (glm::vec3(m[3]) != glm::vec3(0.0f) || !(off < 1e-5) || !(glm::determinant(glm::dmat3(r)) > 0.0))
+      fail(v["transform"], "an environment's transform is a rotation (\"rotate\", or a rotation \"matrix\"): no translation, "
+                           "scale or mirroring");
+    environment.to_world = r;
+  }
+  try {
+    environment.radiance = read_environment_map(environment.file, environment.scale);
+  } catch (const LimitError& e) {
+    throw LimitError(file_.string() + ": " + v["file"].path + ": " + e.what());
+  } catch (const SceneError& e) {
+    throw SceneError(file_.string() + ": " + v["file"].path + ": " + e.what());
+  }
+  reference(environment.file);
+  scene_.environment = std::move(environment);
 }
 
 glm::mat4 SceneParser::parse_transform(const Value& v) {

@@ -122,6 +122,7 @@ class SceneParser {
   // ---- sections ----------------------------------------------------------------------------------
   void parse_image(const Value& v);
   void parse_camera(const Value& v);
+  void parse_environment(const Value& v);
   void parse_integrator(const Value& v);
   void parse_materials(const Value& v);
   glm::vec3 reflectance(const Value& v);  // a colour in [0, 1] (above 1: refused for paths, a warning otherwise)

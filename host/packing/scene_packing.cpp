@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 
+#include <glm/gtc/matrix_access.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -201,6 +202,15 @@ FrameUniforms pack_frame(const Scene& scene, uint32_t primitive_count, const Lig
   f.max_depth = scene.integrator.max_depth;
   f.rr_depth = scene.integrator.rr_depth;
   f.emitter_count = lighting.emitter_count;
+  f.environment_width = lighting.environment_width;
+  f.environment_height = lighting.environment_height;
+  if (scene.environment) {
+    // World to map: the rotation's inverse, its transpose.
+    const glm::mat3 to_map = glm::transpose(scene.environment->to_world);
+    f.environment_row0 = glm::vec4(glm::row(to_map, 0), 0.0f);
+    f.environment_row1 = glm::vec4(glm::row(to_map, 1), 0.0f);
+    f.environment_row2 = glm::vec4(glm::row(to_map, 2), 0.0f);
+  }
   return f;
 }
 
@@ -394,6 +404,7 @@ int radiance_exponent(const Scene& scene) {
                               scene.ambient.b});
   for (const Material& m : scene.materials) brightest = std::max({brightest, m.emission.r, m.emission.g, m.emission.b});
   for (const Light& l : scene.lights) brightest = std::max({brightest, l.intensity.r, l.intensity.g, l.intensity.b});
+  if (scene.environment) brightest = std::max(brightest, brightest_texel(*scene.environment));
   if (!(brightest > 0.0f)) return 0;
   int exponent = 0;
   std::frexp(brightest, &exponent);  // brightest = m 2^exponent, m in [0.5, 1)
@@ -458,7 +469,8 @@ PackedLighting pack_lighting(const Scene& scene, const PrimitiveSlots& slots) {
       packed.emitters.push_back(glm::vec4(e.probability, uintBitsToFloat(e.alias), uintBitsToFloat(slot), uintBitsToFloat(entry)));
     }
   }
-  packed.frame = {uint32_t(table.entries.size()), exponent};
+  if (scene.environment) packed.environment = pack_environment(*scene.environment, exponent);
+  packed.frame = {uint32_t(table.entries.size()), exponent, packed.environment.width, packed.environment.height};
   packed.lights.resize(scene.lights.size() * VKRAY_TEXELS_PER_LIGHT);
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& l = scene.lights[i];

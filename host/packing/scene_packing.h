@@ -12,6 +12,7 @@
 
 #include "bvh/bvh.h"
 #include "scene/scene.h"
+#include "packing/environment_packing.h"
 #include "shared/scene_layout.h"
 #include "shared/types.h"
 
@@ -23,10 +24,11 @@ namespace vkray::gpu {
 struct LightingFrame {
   uint32_t emitter_count = 0;
   int radiance_exponent = 0;
+  uint32_t environment_width = 0, environment_height = 0;  // PackedEnvironment's
 };
 
-// The exponent k that brings the scene's brightest radiance (an emission, the background, the
-// ambient term, a light's intensity) to [2^19, 2^20) when multiplied by 2^k; 0 when all are 0.
+// The exponent k that brings the scene's brightest radiance (an emission, the background or the
+// environment map's brightest texel, the ambient term, a light's intensity) to [2^19, 2^20) when multiplied by 2^k; 0 when all are 0.
 // Headroom above of 2^108 (3e32) for the factors a sample picks up on its way (a point light's
 // 1 / r^2, at least 1e-28 with the scene at least 1e-9 across; the area-light estimator's area /
 // r^2; glass's eta^2); room below of 2^145 (4e43) before the floats a GPU may flush to zero, for the
@@ -81,6 +83,7 @@ struct PackedLighting {
   std::vector<glm::vec4> materials;   // VKRAY_TEXELS_PER_MATERIAL texels each
   std::vector<glm::vec4> lights;      // VKRAY_TEXELS_PER_LIGHT texels each
   std::vector<glm::vec4> emitters;    // VKRAY_TEXELS_PER_EMITTER texels each (scene/emitters.h)
+  PackedEnvironment environment;
   LightingFrame frame;
 };
 

@@ -30,7 +30,8 @@ unsigned thread_count_argument(const py::handle& value) {
 }
 
 std::shared_ptr<const Scene> load(const SceneSource& source, MeshCache* meshes) {
-  return std::make_shared<const Scene>(source.text ? parse_scene(*source.text, source.file, meshes) : load_scene(source.file, meshes));
+  return std::make_shared<const Scene>(source.text ? parse_scene(*source.text, source.file, meshes, source.environment)
+                                                   : load_scene(source.file, meshes, source.environment));
 }
 
 Request make_request(const py::object& width, const py::object& height, const py::object& spp, const py::object& seed,

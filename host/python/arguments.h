@@ -34,6 +34,7 @@ unsigned thread_count_argument(const pybind11::handle& value);
 struct SceneSource {
   std::filesystem::path file;
   std::optional<std::string> text;
+  std::filesystem::path environment;  // an environment map in place of the scene's (load_scene); empty: none
 };
 
 std::shared_ptr<const Scene> load(const SceneSource& source, MeshCache* meshes);

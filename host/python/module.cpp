@@ -330,8 +330,10 @@ PYBIND11_MODULE(_vkray, m) {
   stop_calls_at_exit();
 
   py::class_<vp::SceneSource>(m, "_SceneSource")
-      .def(py::init([](std::filesystem::path file, std::optional<std::string> text) { return vp::SceneSource{std::move(file), std::move(text)}; }),
-           py::arg("file"), py::arg("text") = py::none());
+      .def(py::init([](std::filesystem::path file, std::optional<std::string> text, std::optional<std::filesystem::path> environment) {
+             return vp::SceneSource{std::move(file), std::move(text), environment.value_or(std::filesystem::path())};
+           }),
+           py::arg("file"), py::arg("text") = py::none(), py::arg("environment") = py::none());
 
   py::class_<vp::Request>(m, "_Request")
       .def(py::init(&vp::make_request),

@@ -16,7 +16,8 @@ static_assert(sizeof(Sphere) == 28, "a Sphere field is not in scene_digest");
 static_assert(sizeof(Triangle) == 228, "a Triangle field is not in scene_digest");
 static_assert(sizeof(TextureRef) == 44, "a TextureRef field is not in scene_digest");
 static_assert(sizeof(Material) == 400, "a Material field is not in scene_digest");
-static_assert(sizeof(Scene) == 424, "a Scene field is not in scene_digest");
+static_assert(sizeof(Scene) == 528, "a Scene field is not in scene_digest");
+static_assert(sizeof(Environment) == 96, "an Environment field is not in scene_digest");
 static_assert(sizeof(Instance) == 72, "an Instance field is not in scene_digest");
 
 // Hasher with glm's vectors, component by component.
@@ -44,12 +45,20 @@ void add(SceneHasher& h, const TextureRef& t) {
 std::string scene_digest(const Scene& scene) {
   auto h = std::make_unique<SceneHasher>();  // its buffer is too large for a thread's stack to hold lightly
   // A version of this layout: bump it when the order or the meaning of what is hashed changes.
-  h->add(std::string("vkray scene digest 9"));
+  h->add(std::string("vkray scene digest 10"));
   const Camera& c = scene.camera;
   h->add(c.position), h->add(c.forward), h->add(c.up), h->add(c.focal_length), h->add(c.aperture_radius),
       h->add(c.focus_distance);
   h->add(scene.integrator.type), h->add(scene.integrator.max_depth), h->add(scene.integrator.rr_depth);
   h->add(scene.background), h->add(scene.ambient);
+  // The map by its texels as scaled (the file's name and the scale, as such, do not reach a pixel).
+  h->add(scene.environment.has_value());
+  if (scene.environment) {
+    const Image& map = *scene.environment->radiance;
+    h->add(map.width), h->add(map.height);
+    h->bytes(map.pixels.data(), map.pixels.size() * sizeof(glm::vec3));
+    for (int column = 0; column < 3; ++column) h->add(scene.environment->to_world[column]);
+  }
   h->add(uint64_t(scene.materials.size()));
   for (const Material& m : scene.materials) {
     h->add(m.type), h->add(m.albedo), h->add(m.ior), h->add(m.emission), h->add(m.alpha), h->add(m.eta), h->add(m.k), h->add(m.metallic),

@@ -260,6 +260,17 @@ struct Instance {
   uint32_t object = 0;  // its place in the file's "objects": the `object` pass reports it
 };
 
+// An equirectangular map of radiance that surrounds the scene, infinitely far (Mitsuba's `envmap`):
+// what rays that leave the scene see, and a light to both integrators. It replaces `background`.
+// Orientation and texel layout: shaders/shared/scene_layout.h ("The environment map").
+struct Environment {
+  std::filesystem::path file;  // where the map was read from (a .hdr or .exr file)
+  // Its texels, times the scene's `scale`: 2:1, finite and non-negative; shared by copies of a scene.
+  std::shared_ptr<const Image> radiance;
+  float scale = 1.0f;
+  glm::mat3 to_world{1.0f};  // a rotation: the map's frame in the world (Mitsuba's to_world)
+};
+
 struct Scene {
   std::filesystem::path file;  // where it was loaded from; paths inside are relative to its folder
   std::string name;            // the file's stem: "cornell" for scenes/cornell.json
@@ -268,6 +279,7 @@ struct Scene {
   Camera camera;
   Integrator integrator;
   glm::vec3 background{0.0f};
+  std::optional<Environment> environment;  // in place of background when present
   glm::vec3 ambient{0.0f};
   std::vector<Material> materials;
   std::vector<Light> lights;

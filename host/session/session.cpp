@@ -189,6 +189,7 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   variant.background = variant.path && s.background != glm::vec3(0.0f);  // only paths sample it
   variant.vertex_colours = scene.vertex_colours();
   variant.instances = scene.instances();
+  variant.environment = scene.lighting().environment_width > 0;
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))
     variant.inline_scene = scene.inline_scene();
   return variant;

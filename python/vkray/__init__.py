@@ -126,15 +126,17 @@ def _scene_data(scene: Mapping[str, Any], file: str) -> Any:
     return plain(scene, "", 0)
 
 
-def _source(scene: Scene, base_dir: Optional[Union[str, "os.PathLike[str]"]]) -> Any:
+def _source(scene: Scene, base_dir: Optional[Union[str, "os.PathLike[str]"]],
+            environment: Optional[Union[str, "os.PathLike[str]"]] = None) -> Any:
+    map_file = None if environment is None else _path("environment", environment)
     if isinstance(scene, (str, os.PathLike)):
         if base_dir is not None:
             raise UsageError("base_dir is for scene dicts: a scene file's paths resolve against its own folder")
-        return _vkray._SceneSource(_path("scene", scene))
+        return _vkray._SceneSource(_path("scene", scene), None, map_file)
     if isinstance(scene, Mapping):
         folder = Path(_path("base_dir", base_dir)) if base_dir is not None else Path.cwd()
         file = os.fspath(folder / _DICT_NAME)
-        return _vkray._SceneSource(file, json.dumps(_scene_data(scene, file), allow_nan=False))
+        return _vkray._SceneSource(file, json.dumps(_scene_data(scene, file), allow_nan=False), map_file)
     raise UsageError(f"scene: expected a file name or a dict, got a {type(scene).__name__}")
 
 
@@ -215,19 +217,22 @@ class Renderer:
     def render(self, scene: Scene, *, width: Optional[int] = None, height: Optional[int] = None,
                spp: Optional[int] = None, seed: Optional[int] = None, aovs: Union[str, Iterable[str]] = (),
                region: Optional[Region] = None,
-               base_dir: Optional[Union[str, "os.PathLike[str]"]] = None) -> RenderOutput:
+               base_dir: Optional[Union[str, "os.PathLike[str]"]] = None,
+               environment: Optional[Union[str, "os.PathLike[str]"]] = None) -> RenderOutput:
         """Renders ``scene`` (see ``vkray.render``) on this renderer's device."""
-        return self._renderer.render(_source(scene, base_dir), _request(width, height, spp, seed, aovs, region))
+        return self._renderer.render(_source(scene, base_dir, environment), _request(width, height, spp, seed, aovs, region))
 
     def render_to_file(self, scene: Scene, output: Union[str, "os.PathLike[str]"], *, width: Optional[int] = None,
                        height: Optional[int] = None, spp: Optional[int] = None, seed: Optional[int] = None,
                        aovs: Union[str, Iterable[str]] = (), region: Optional[Region] = None, exr_float: bool = False,
-                       base_dir: Optional[Union[str, "os.PathLike[str]"]] = None) -> None:
+                       base_dir: Optional[Union[str, "os.PathLike[str]"]] = None,
+                       environment: Optional[Union[str, "os.PathLike[str]"]] = None) -> None:
         """Renders ``scene`` and writes ``output`` (.png, .pfm or .exr) as ``vkray render -o`` does: the
         first-hit passes ``aovs`` as EXR layers, 32-bit channels with ``exr_float``, and a ``region``
         as a part for ``vkray.merge`` (.exr, or .pfm with its .pfm.json record). The file is written
         whole or not at all."""
-        self._renderer.render(_source(scene, base_dir), _request(width, height, spp, seed, aovs, region, output, exr_float))
+        self._renderer.render(_source(scene, base_dir, environment),
+                              _request(width, height, spp, seed, aovs, region, output, exr_float))
 
     @property
     def device(self) -> str:
@@ -254,7 +259,8 @@ class Renderer:
 def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] = None, spp: Optional[int] = None,
            seed: Optional[int] = None, renderer: str = "gpu", device: Optional[str] = None,
            aovs: Union[str, Iterable[str]] = (), region: Optional[Region] = None,
-           base_dir: Optional[Union[str, "os.PathLike[str]"]] = None, threads: int = 0) -> RenderOutput:
+           base_dir: Optional[Union[str, "os.PathLike[str]"]] = None, threads: int = 0,
+           environment: Optional[Union[str, "os.PathLike[str]"]] = None) -> RenderOutput:
     """Renders a scene and returns linear radiance as a float32 array of shape (height, width, 3).
 
     Args:
@@ -272,6 +278,8 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
             band I of N bands of about equal work (``vkray.bands``). Each pixel is the same as in the
             full render; the arrays hold the region alone.
         threads: for "cpu": threads to use, 1 to 256; 0, one per hardware thread.
+        environment: an environment map (.hdr or .exr, equirectangular) that lights the scene in
+            place of its own environment and background, as ``vkray render --environment`` does.
 
     Raises:
         SceneError: the scene or a file it names cannot be used (the message names the file and key).
@@ -284,22 +292,22 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
     if renderer == "gpu":
         with Renderer(device) as r:
             return r.render(scene, width=width, height=height, spp=spp, seed=seed, aovs=aovs, region=region,
-                            base_dir=base_dir)
+                            base_dir=base_dir, environment=environment)
     if renderer == "cpu":
         if device is not None:
             raise UsageError("device is for renderer='gpu'; the CPU reference runs on the host")
-        return _vkray.render_cpu(_source(scene, base_dir), _request(width, height, spp, seed, aovs, region), threads)
+        return _vkray.render_cpu(_source(scene, base_dir, environment), _request(width, height, spp, seed, aovs, region), threads)
     raise UsageError(f"renderer is 'gpu' or 'cpu', not {renderer!r}")
 
 
 def parity(scene: Scene, *, width: Optional[int] = None, height: Optional[int] = None, spp: Optional[int] = None,
            seed: Optional[int] = None, device: Optional[str] = None,
            base_dir: Optional[Union[str, "os.PathLike[str]"]] = None, validate: bool = False,
-           threads: int = 0) -> dict[str, Any]:
+           threads: int = 0, environment: Optional[Union[str, "os.PathLike[str]"]] = None) -> dict[str, Any]:
     """Renders ``scene`` on the device and with the CPU reference and compares the images and their
     first-hit passes, as ``vkray parity`` does. Returns the keys ``vkray parity --json`` prints;
     ``result["pass"]`` says whether they agree within the tolerance (``result["tolerance"]``)."""
-    return json.loads(_vkray.parity(_source(scene, base_dir), width, height, spp, seed,
+    return json.loads(_vkray.parity(_source(scene, base_dir, environment), width, height, spp, seed,
                                     None if device is None else str(device), _flag("validate", validate), threads))
 
 

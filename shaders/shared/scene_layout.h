@@ -190,6 +190,21 @@ VKRAY_INLINE float emission_luminance(vec3 e) { return 0.2126f * e.x + 0.7152f *
 #define VKRAY_LIGHT_GLTF_SPOT 2u
 #define VKRAY_LIGHT_DIRECTIONAL 3u
 
+// ---- The environment map (vkray::Environment): an equirectangular map of radiance -----------------------
+// Oriented as Mitsuba's `envmap`: a direction d in the map's own frame (the frame's rows in
+// FrameUniforms) lies at u = atan2(d.x, -d.z) / 2pi (wrapped into [0, 1)), v = acos(d.y) / pi, and
+// texel (x, y), row y counted from the top, covers [x, x + 1) / width by [y, y + 1) / height of
+// (u, v): its radiance is constant there. VKRAY_BINDING_ENVIRONMENT holds one texel per map texel,
+// row by row: (radiance (times the frame's power of two), density), the density being that of
+// picking a point of (u, v) in this texel, per unit area of (u, v), by sample_environment: the
+// texel's luminance times sin(theta) at its row's centre, over their mean. VKRAY_BINDING_ENVIRONMENT_CDF
+// holds the distribution that draws it, the cumulative sums of those weights: height rows of width
+// numbers each, number x of row y the share of the row's weight in its texels 0 to x (the last one
+// 1), then height numbers, number y the share of the whole map's in its rows 0 to y (the last one 1).
+// A row without weight has equal shares, and is never picked.
+#define VKRAY_ENVIRONMENT_ROW_CDF(width, y) ((y) * (width))
+#define VKRAY_ENVIRONMENT_MARGINAL_CDF(width, height) ((width) * (height))
+
 // ---- BVH links ---------------------------------------------------------------------------------------
 // A child link is an inner node's index, or a leaf: VKRAY_LEAF_BIT | first << VKRAY_LEAF_COUNT_BITS |
 // count, first the leaf's first primitive in leaf order, count 1 to 2^VKRAY_LEAF_COUNT_BITS - 1.

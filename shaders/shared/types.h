@@ -28,6 +28,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BINDING_TANGENTS 11   // uniform texel buffer, RGBA32F: vertex tangents of normal-mapped triangles
 #define VKRAY_BINDING_COLOURS 12    // uniform texel buffer, RGBA32F: vertex colours of coloured triangles
 #define VKRAY_BINDING_INSTANCES 13  // uniform texel buffer, RGBA32F: the instances (scene_layout.h)
+#define VKRAY_BINDING_ENVIRONMENT 14      // uniform texel buffer, RGBA32F: the environment map's texels (scene_layout.h)
+#define VKRAY_BINDING_ENVIRONMENT_CDF 15  // uniform texel buffer, R32F: its sampling distribution (scene_layout.h)
 
 // ---- Specialization constants ------------------------------------------------------------------
 // One table: X(id, GLSL name, gpu::ShaderVariant member, default). resources.glsl declares each
@@ -70,6 +72,8 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_VERTEX_COLOURS 13
 // false when the scene places no mesh by instances: one level of BVH, and no code for a second.
 #define VKRAY_SPEC_INSTANCES 14
+// false when the scene has no environment map (Scene::environment): no code to look it up or sample it.
+#define VKRAY_SPEC_ENVIRONMENT 15
 // And one per material type, id VKRAY_SPEC_MATERIALS + its number (shared/materials.h): whether the
 // scene has a material of that type (gpu::ShaderVariant::materials, a bit each); the BSDF code of
 // the others is left out. Declared as SCENE_HAS_<name> (SCENE_HAS_roughconductor).
@@ -89,7 +93,8 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_POINT_LIGHTS, SCENE_HAS_POINT_LIGHTS, point_lights, true) \
   X(VKRAY_SPEC_BACKGROUND, SCENE_HAS_BACKGROUND, background, true) \
   X(VKRAY_SPEC_VERTEX_COLOURS, SCENE_HAS_VERTEX_COLOURS, vertex_colours, false) \
-  X(VKRAY_SPEC_INSTANCES, SCENE_HAS_INSTANCES, instances, false)
+  X(VKRAY_SPEC_INSTANCES, SCENE_HAS_INSTANCES, instances, false) \
+  X(VKRAY_SPEC_ENVIRONMENT, SCENE_HAS_ENVIRONMENT, environment, false)
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float
@@ -143,9 +148,14 @@ struct FrameUniforms {
   int max_depth;          // the path integrator's; -1: no limit
   uint rr_depth;
   uint emitter_count;     // entries of the area lights' alias table
-  uint unused2;
+  uint environment_width;   // the environment map's size in texels (0: none)
+  uint environment_height;
   uint unused0;     // std140 rounds the struct up to a multiple of 16 bytes; the buffer holds all of it
-  uint unused1;
+  // The rows of the rotation from world directions to the environment map's own (Mitsuba's envmap
+  // to_world, inverted); w unused.
+  vec4 environment_row0;
+  vec4 environment_row1;
+  vec4 environment_row2;
 };
 #ifdef __cplusplus
 static_assert(offsetof(FrameUniforms, origin) == 0);
@@ -171,10 +181,13 @@ static_assert(offsetof(FrameUniforms, focus_distance) == 148);
 static_assert(offsetof(FrameUniforms, max_depth) == 152);
 static_assert(offsetof(FrameUniforms, rr_depth) == 156);
 static_assert(offsetof(FrameUniforms, emitter_count) == 160);
-static_assert(offsetof(FrameUniforms, unused2) == 164);
-static_assert(offsetof(FrameUniforms, unused0) == 168);
-static_assert(offsetof(FrameUniforms, unused1) == 172);
-static_assert(sizeof(FrameUniforms) == 176);
+static_assert(offsetof(FrameUniforms, environment_width) == 164);
+static_assert(offsetof(FrameUniforms, environment_height) == 168);
+static_assert(offsetof(FrameUniforms, unused0) == 172);
+static_assert(offsetof(FrameUniforms, environment_row0) == 176);
+static_assert(offsetof(FrameUniforms, environment_row1) == 192);
+static_assert(offsetof(FrameUniforms, environment_row2) == 208);
+static_assert(sizeof(FrameUniforms) == 224);
 #endif
 
 // ---- Push constants: the tile this dispatch covers ---------------------------------------------

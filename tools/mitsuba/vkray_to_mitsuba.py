@@ -50,6 +50,8 @@ Mapping (vkray's docs/scene-format.md and docs/rendering.md):
               rule); flip_normals reverses the winding. Spheres: 'sphere' (its flip_normals).
   lights      point: intensity, or power / 4 pi; spot: intensity, cutoff_angle, beam_width, its to_world
               a look_at frame along its direction; directional: direction, irradiance.
+  environment 'envmap' with the same to_world, given the map resampled 4x finer (environment_emitter
+              says why); path integrator only.
   background  path: a 'constant' emitter. direct: composited where the camera ray misses (from
               the film's alpha), since vkray's direct model is not lit by the background.
   integrator  path -> 'path' (max_depth, rr_depth); direct or absent -> 'path' max_depth 2.
@@ -272,6 +274,26 @@ def alpha_mask(mi, m, b, base, where):
     return {"type": "mask", "opacity": opacity, "bsdf": b}
 
 
+def environment_emitter(mi, env, base):
+    """vkray's "environment" as Mitsuba's envmap, its to_world the same rotation.
+
+    vkray's map is constant over each texel (u in [x, x+1) / W, theta in [y, y+1) / H pi); Mitsuba's
+    envmap interpolates bilinearly between values it places at grid points (u = i / W, v = j / (H - 1)).
+    So Mitsuba is given a map 4 times as fine, each of its grid points holding vkray's texel there:
+    the two then differ only within a quarter texel of each texel's edge.
+    """
+    bitmap = mi.Bitmap(os.path.join(base, env["file"])).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False)
+    src = np.array(bitmap, dtype=np.float32)[:, :, :3] * float(env.get("scale", 1.0))
+    h, w = src.shape[:2]
+    k = 4
+    cols = np.minimum((np.arange(k * w) / (k * w) * w).astype(np.int64), w - 1)
+    rows = np.minimum((np.arange(k * h) / (k * h - 1) * h).astype(np.int64), h - 1)
+    fine = np.ascontiguousarray(src[rows][:, cols])
+    to_world = transform_matrix(env.get("transform", {}))
+    return {"type": "envmap", "bitmap": mi.Bitmap(fine, mi.Bitmap.PixelFormat.RGB),
+            "to_world": mi.ScalarTransform4f(to_world.tolist())}
+
+
 def scene_dict(path, overrides=None):
     """(Mitsuba scene dict, info) for the vkray scene at `path`. Call mi.set_variant first."""
     import mitsuba as mi
@@ -279,7 +301,8 @@ def scene_dict(path, overrides=None):
     o = dict(overrides or {})
     scene = load_scene_json(path)
     base = os.path.dirname(os.path.abspath(path))
-    known = {"description", "image", "camera", "integrator", "seed", "background", "ambient", "materials", "lights", "objects"}
+    known = {"description", "image", "camera", "integrator", "seed", "background", "environment", "ambient", "materials", "lights",
+             "objects"}
     for key in scene:
         if key not in known:
             warn(f"{path}: /{key}: unknown key (ignored)")
@@ -498,6 +521,11 @@ def scene_dict(path, overrides=None):
 
     if background.any() and not direct:
         d["background"] = {"type": "constant", "radiance": {"type": "rgb", "value": background.tolist()}}
+    if "environment" in scene:
+        if direct:
+            raise ValueError(f"{path}: /environment: vkray's direct model is lit by the map as one light; compare the "
+                             "path integrator (give --max-depth)")
+        d["environment"] = environment_emitter(mi, scene["environment"], base)
 
     # Mitsuba's default near clip (0.01) would cut geometry near the camera: vkray's epsilon is 1e-5 x extent.
     e = max(extent[0], 1e-30)
