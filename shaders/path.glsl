@@ -52,7 +52,8 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
   if (hit.prim == NO_HIT) {
     if (SCENE_HAS_ENVIRONMENT) {
       EnvironmentLookup e = environment_lookup(p.ray.dir);
-      p.radiance += p.throughput * e.radiance * (p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, e.pdf));
+      bool whole = p.after_delta || !ENVIRONMENT_SAMPLED;  // nothing else could have found it
+      p.radiance += p.throughput * e.radiance * (whole ? 1.0 : power_heuristic(p.bsdf_pdf, e.pdf));
     } else {
       float weight = p.after_delta ? 1.0 : power_heuristic(p.bsdf_pdf, BACKGROUND_PDF);
       p.radiance += p.throughput * frame.background.rgb * weight;
@@ -91,10 +92,12 @@ bool path_step(inout PathState p, inout uint stream, inout uint rays) {
                       (power_heuristic(light.pdf, pdf_bsdf(s, wo, light.dir, n, front)) / light.pdf);
     }
     if (SCENE_HAS_ENVIRONMENT) {
-      AreaLightSample light = sample_environment_from(lit, stream, rays);
-      if (light.pdf > 0.0)
-        p.radiance += p.throughput * eval_bsdf(s, wo, light.dir, n, front) * light.radiance *
-                      (power_heuristic(light.pdf, pdf_bsdf(s, wo, light.dir, n, front)) / light.pdf);
+      if (ENVIRONMENT_SAMPLED) {
+        AreaLightSample light = sample_environment_from(lit, stream, rays);
+        if (light.pdf > 0.0)
+          p.radiance += p.throughput * eval_bsdf(s, wo, light.dir, n, front) * light.radiance *
+                        (power_heuristic(light.pdf, pdf_bsdf(s, wo, light.dir, n, front)) / light.pdf);
+      }
     } else if (background_sampled) {
       vec3 w = uniform_sphere(vec2(next_random(stream), next_random(stream)));
       if (faces(lit, w)) {

@@ -187,6 +187,30 @@ TEST_P(EnvironmentPhysicsTest, AConstantMapLightsAsTheSameBackgroundDoes) {
   expect_means(by_map, {24, 18, 256}, expected, 0.01);
 }
 
+TEST_P(EnvironmentPhysicsTest, BsdfSamplingAloneFindsTheSameLight) {
+  // The furnace again, the map found by BSDF sampling alone (RenderOptions::sample_environment): the
+  // same albedo B on both renderers; the direct model, which samples no BSDF at a diffuse surface,
+  // refuses it.
+  write_map(dir_, "grey.exr", 64, glm::vec3(0.5f, 1.0f, 2.0f));
+  const Scene scene = parse_scene(R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "vertical_fov": 12},
+      "integrator": )" + integrator() + R"(, "environment": {"file": "grey.exr"},
+      "materials": {"m": {"albedo": [0.8, 0.5, 0.25]}},
+      "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})",
+                                  dir_ / "furnace.json");
+  RenderOptions options;
+  options.sample_environment = false;
+  if (!GetParam()) {
+    const std::string message = error_of([&] { render(scene, {8, 8, 1}, options); });
+    EXPECT_NE(message.find("environment_sampling: \"bsdf\" is for the path integrator"), std::string::npos) << message;
+    return;
+  }
+  for (const bool cpu : {false, true}) {
+    const glm::dvec3 m = image_mean(render(scene, {16, 16, 256}, options, cpu));
+    const glm::dvec3 expected(0.4, 0.5, 0.5);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], expected[c], 0.01 * expected[c]) << (cpu ? "CPU" : "GPU") << ", channel " << c;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Integrators, EnvironmentPhysicsTest, ::testing::Bool(), [](const auto& p) { return p.param ? "Path" : "Direct"; });
 
 // ---- Parity catches a wrong density and a turned map ---------------------------------------------

@@ -38,6 +38,11 @@ void add_scene_flags(CLI::App& command, SceneFlags& flags) {
   command.add_option("--environment", flags.environment,
                      "Light the scene by this environment map (.hdr or .exr, equirectangular), in place of its own "
                      "environment and background");
+  command
+      .add_option("--environment-sampling", flags.environment_sampling,
+                  "How the path integrator finds the environment map: importance (directions drawn from the map, weighed "
+                  "against BSDF sampling; the default) or bsdf (BSDF sampling alone: to measure what importance sampling buys)")
+      ->check(CLI::IsMember({"importance", "bsdf"}));
   command.add_option("--width", flags.width, "Image width in pixels (overrides the scene)")->check(within(kWidthArgument));
   command.add_option("--height", flags.height, "Image height in pixels (overrides the scene)")->check(within(kHeightArgument));
   command.add_option("--spp", flags.spp, "Samples per pixel (overrides the scene)")->check(within(kSppArgument));
@@ -142,6 +147,7 @@ RenderOptions render_options(const SceneFlags* scene, const GpuFlags* gpu, const
     options.samples_per_pixel = scene->spp;
     options.seed = scene->seed;
     options.region = scene->region;
+    options.sample_environment = scene->environment_sampling == "importance";
   }
   if (gpu) {
     options.tile_timeout = std::chrono::milliseconds(gpu->tile_timeout_ms);

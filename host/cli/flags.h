@@ -17,6 +17,7 @@ namespace vkray::cli {
 struct SceneFlags {
   std::filesystem::path scene;  // empty: the default scene
   std::filesystem::path environment;  // an environment map in place of the scene's; empty: none
+  std::string environment_sampling = "importance";  // or "bsdf": RenderOptions::sample_environment false
   std::optional<uint32_t> width, height, spp, seed;
   std::optional<RegionRequest> region;  // offered by add_region_flag
 };

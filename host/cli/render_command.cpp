@@ -70,6 +70,9 @@ int run_render(const RenderArgs& args) {
     {
       const auto on_device = session.upload(loaded.scene, std::make_shared<const SceneBvh>(bvh.get()));
       upload_seconds = on_device.upload_seconds();
+      if (const auto& e = loaded.scene->environment)
+        log("environment " + e->file.string() + ", " + std::to_string(e->radiance->width) + " x " + std::to_string(e->radiance->height) +
+            " texels: distribution built in " + format_ms(on_device.environment_seconds() * 1e3));
       // The scene's pipeline compiled now, so that the compile phase counts it (a small scene's own
       // code is compiled only now that the scene is packed).
       compile_seconds += session.prepare(on_device, options);

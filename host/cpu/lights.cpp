@@ -11,8 +11,8 @@
 
 namespace vkray::cpu {
 
-Lights::Lights(const Tracer& tracer, bool shadows)
-    : tracer_(tracer), shadows_(shadows), epsilon_(tracer.epsilon()), table_(build_emitter_table(tracer.scene())) {
+Lights::Lights(const Tracer& tracer, bool shadows, bool sample_environment)
+    : tracer_(tracer), shadows_(shadows), sample_environment_(sample_environment), epsilon_(tracer.epsilon()), table_(build_emitter_table(tracer.scene())) {
   if (!table_.entries.empty()) inv_weight_ = 1 / table_.total_weight;
   if (tracer.scene().environment) environment_.emplace(*tracer.scene().environment);
 }

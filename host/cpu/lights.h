@@ -60,8 +60,9 @@ struct AreaLightSample {
 
 class Lights {
  public:
-  // shadows false: every light counts as visible (benchmarks).
-  Lights(const Tracer& tracer, bool shadows);
+  // shadows false: every light counts as visible (benchmarks). sample_environment false: the
+  // environment map is found by BSDF sampling alone (RenderOptions::sample_environment).
+  Lights(const Tracer& tracer, bool shadows, bool sample_environment = true);
 
   // Adds V f(wo, w) |n . w| times what each light sends to x to `radiance`: I / r^2 from a point light
   // (for a diffuse surface, albedo V I (n . w) / (pi r^2), the scene contract's term), a spot's I times
@@ -82,12 +83,14 @@ class Lights {
   const EnvironmentLight* environment() const { return environment_ && environment_->lights() ? &*environment_ : nullptr; }
   // What a ray that leaves the scene along `dir` brings: the environment's radiance, or the background.
   dvec3 background(const dvec3& dir) const;
+  bool environment_sampled() const { return sample_environment_; }
   // A direction drawn from the environment (two numbers) as p sees it, in the area light's form.
   AreaLightSample sample_environment_from(const LitPoint& p, uint32_t& stream, uint64_t& rays) const;
 
  private:
   const Tracer& tracer_;
   bool shadows_;
+  bool sample_environment_;
   double epsilon_;
   EmitterTable table_;
   double inv_weight_ = 0;

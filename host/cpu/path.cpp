@@ -37,7 +37,8 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
     if (hit.primitive < 0) {
       if (const EnvironmentLight* environment = lights.environment()) {
         const EnvironmentLight::Lookup e = environment->lookup(ray.dir);
-        radiance += throughput * e.radiance * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, e.pdf));
+        const bool whole = after_delta || !lights.environment_sampled();  // nothing else could have found it
+        radiance += throughput * e.radiance * (whole ? 1.0 : power_heuristic(bsdf_pdf, e.pdf));
       } else {
         radiance += throughput * background * (after_delta ? 1.0 : power_heuristic(bsdf_pdf, kBackgroundPdf));
       }
@@ -73,10 +74,12 @@ dvec3 path_radiance(const Tracer& tracer, const Lights& lights, const Ray& camer
                       (power_heuristic(light.pdf, pdf_bsdf(bsdf, wo, light.dir, n, front)) / light.pdf);
       }
       if (lights.environment()) {
-        const AreaLightSample light = lights.sample_environment_from(p, state.stream, state.rays);
-        if (light.pdf > 0)
-          radiance += throughput * eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance *
-                      (power_heuristic(light.pdf, pdf_bsdf(bsdf, wo, light.dir, n, front)) / light.pdf);
+        if (lights.environment_sampled()) {  // (otherwise found by BSDF sampling alone)
+          const AreaLightSample light = lights.sample_environment_from(p, state.stream, state.rays);
+          if (light.pdf > 0)
+            radiance += throughput * eval_bsdf(bsdf, wo, light.dir, n, front) * light.radiance *
+                        (power_heuristic(light.pdf, pdf_bsdf(bsdf, wo, light.dir, n, front)) / light.pdf);
+        }
       } else if (background_sampled) {
         const double u1 = gpu::next_random(state.stream), u2 = gpu::next_random(state.stream);
         const dvec3 w = uniform_sphere(u1, u2);

@@ -40,7 +40,7 @@ ReferenceResult render_reference(const Scene& scene, const ImageSettings& settin
   }
   const SceneBvh* bvh = options.use_bvh ? (options.bvh ? options.bvh : &built) : nullptr;
   const Tracer tracer(scene, bvh);
-  const Lights lights(tracer, options.shadows);
+  const Lights lights(tracer, options.shadows, options.sample_environment);
   const bool path = scene.integrator.type == Integrator::Type::path;
   const uint32_t seed = gpu::seed_key(settings.seed);
   const double aperture = scene.camera.aperture_radius, focus = scene.camera.focus_distance;

@@ -26,6 +26,7 @@ struct ReferenceOptions {
   bool use_bvh = true;   // false: test every primitive (slow; checks the traversal)
   const SceneBvh* bvh = nullptr;  // a BVH already built for this scene; null: build one
   bool shadows = true;   // false: no shadow rays, every light counts as visible (benchmarks)
+  bool sample_environment = true;  // false: the environment map found by BSDF sampling alone (RenderOptions)
   bool aovs = false;     // also the first-hit passes (image/aovs.h)
   // Only these pixels of the image (empty: all of them); each pixel's samples are the same as in a
   // render of the whole image.

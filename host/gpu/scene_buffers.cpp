@@ -132,6 +132,7 @@ SceneBuffers::SceneBuffers(std::shared_ptr<const Context> ctx, std::shared_ptr<c
                                                         make_texel_buffer(*ctx_, packed.instances, "instance"), std::move(packed.slots)});
   lighting_ = std::make_unique<Lighting>(*ctx_, packed);
   lighting_frame_ = packed.frame;
+  environment_seconds_ = packed.environment_seconds;
   // A BVH built beforehand (perhaps while the shaders compiled) still counts: the upload stage
   // reports the build's own time.
   upload_seconds_ = seconds_since(start) + (prebuilt ? prebuilt->build_seconds : 0.0);
@@ -153,6 +154,7 @@ SceneBuffers::SceneBuffers(const SceneBuffers& same, std::shared_ptr<const Scene
   const PackedLighting packed = pack_lighting(*scene_, geometry_->slots);
   lighting_ = std::make_unique<Lighting>(*ctx_, packed);
   lighting_frame_ = packed.frame;
+  environment_seconds_ = packed.environment_seconds;
   upload_seconds_ = seconds_since(start);
 }
 

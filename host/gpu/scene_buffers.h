@@ -38,6 +38,7 @@ class SceneBuffers {
   uint32_t primitive_count() const { return primitive_count_; }
   double bvh_seconds() const { return bvh_seconds_; }
   double upload_seconds() const { return upload_seconds_; }  // BVH build included, prebuilt or not
+  double environment_seconds() const { return environment_seconds_; }  // of upload: the environment map's packing
   bool shares_geometry() const { return shares_geometry_; }  // made by the second constructor
   const LightingFrame& lighting() const { return lighting_frame_; }
   // Whether some triangle is shaded with its vertex normals (Triangle::smooth).
@@ -62,7 +63,7 @@ class SceneBuffers {
   uint32_t primitive_count_ = 0;
   std::string inline_scene_;
   LightingFrame lighting_frame_;
-  double bvh_seconds_ = 0, upload_seconds_ = 0;
+  double bvh_seconds_ = 0, upload_seconds_ = 0, environment_seconds_ = 0;
   bool shares_geometry_ = false;
   bool vertex_normals_ = false;
   bool vertex_colours_ = false;

@@ -449,7 +449,7 @@ void SceneParser::parse_environment(const Value& v) {
     environment.to_world = r;
   }
   try {
-    environment.radiance = read_environment_map(environment.file, environment.scale);
+    environment.radiance = read_environment_map(environment.file, environment.scale, &environment.brightest);
   } catch (const LimitError& e) {
     throw LimitError(file_.string() + ": " + v["file"].path + ": " + e.what());
   } catch (const SceneError& e) {

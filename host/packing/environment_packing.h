@@ -23,7 +23,4 @@ struct PackedEnvironment {
 // Built on every core; a 4096 x 2048 map in a few tens of milliseconds (tools/bench-environment).
 PackedEnvironment pack_environment(const Environment& environment, int radiance_exponent);
 
-// The map's brightest channel of any texel: what its radiance is scaled by the frame for.
-float brightest_texel(const Environment& environment);
-
 }  // namespace vkray::gpu

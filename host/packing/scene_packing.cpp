@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cfloat>
 #include <cmath>
 #include <numeric>
@@ -404,7 +405,7 @@ int radiance_exponent(const Scene& scene) {
                               scene.ambient.b});
   for (const Material& m : scene.materials) brightest = std::max({brightest, m.emission.r, m.emission.g, m.emission.b});
   for (const Light& l : scene.lights) brightest = std::max({brightest, l.intensity.r, l.intensity.g, l.intensity.b});
-  if (scene.environment) brightest = std::max(brightest, brightest_texel(*scene.environment));
+  if (scene.environment) brightest = std::max(brightest, scene.environment->brightest);
   if (!(brightest > 0.0f)) return 0;
   int exponent = 0;
   std::frexp(brightest, &exponent);  // brightest = m 2^exponent, m in [0.5, 1)
@@ -469,7 +470,11 @@ PackedLighting pack_lighting(const Scene& scene, const PrimitiveSlots& slots) {
       packed.emitters.push_back(glm::vec4(e.probability, uintBitsToFloat(e.alias), uintBitsToFloat(slot), uintBitsToFloat(entry)));
     }
   }
-  if (scene.environment) packed.environment = pack_environment(*scene.environment, exponent);
+  if (scene.environment) {
+    const auto packing = std::chrono::steady_clock::now();
+    packed.environment = pack_environment(*scene.environment, exponent);
+    packed.environment_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - packing).count();
+  }
   packed.frame = {uint32_t(table.entries.size()), exponent, packed.environment.width, packed.environment.height};
   packed.lights.resize(scene.lights.size() * VKRAY_TEXELS_PER_LIGHT);
   for (size_t i = 0; i < scene.lights.size(); ++i) {

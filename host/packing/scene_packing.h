@@ -84,6 +84,7 @@ struct PackedLighting {
   std::vector<glm::vec4> lights;      // VKRAY_TEXELS_PER_LIGHT texels each
   std::vector<glm::vec4> emitters;    // VKRAY_TEXELS_PER_EMITTER texels each (scene/emitters.h)
   PackedEnvironment environment;
+  double environment_seconds = 0;  // building the environment map's distribution (and packing its texels)
   LightingFrame frame;
 };
 

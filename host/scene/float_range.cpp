@@ -48,6 +48,7 @@ void check_radiance_range(const Scene& scene) {
   std::vector<Radiance> all;
   const bool json = !is_gltf_path(scene.file);
   all.push_back({"/background", brightest(scene.background)});
+  if (scene.environment) all.push_back({json ? "/environment" : "the environment map", scene.environment->brightest});
   all.push_back({"/ambient", brightest(scene.ambient)});
   for (const Material& m : scene.materials)
     all.push_back({"material \"" + printable(m.name) + "\"'s emission", brightest(m.emission)});

@@ -267,6 +267,7 @@ struct Environment {
   std::filesystem::path file;  // where the map was read from (a .hdr or .exr file)
   // Its texels, times the scene's `scale`: 2:1, finite and non-negative; shared by copies of a scene.
   std::shared_ptr<const Image> radiance;
+  float brightest = 0.0f;  // the brightest channel of any of its texels, scaled
   float scale = 1.0f;
   glm::mat3 to_world{1.0f};  // a rotation: the map's frame in the world (Mitsuba's to_world)
 };

@@ -19,6 +19,7 @@ RenderResult render_on_cpu(const Scene& scene, const RenderOptions& options, con
   reference_options.threads = cpu_threads(options);
   reference_options.bvh = bvh;
   reference_options.shadows = options.shadows;
+  reference_options.sample_environment = options.sample_environment;
   reference_options.aovs = options.aovs;
   if (options.progress)
     reference_options.progress = [&options](uint32_t done, uint32_t total) { options.progress("rows", done, total); };

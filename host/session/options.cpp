@@ -43,6 +43,9 @@ ImageSettings image_settings(const Scene& scene, const RenderOptions& options) {
     throw kThreadsArgument.error(std::to_string(options.threads));
   if (!kTileTimeoutArgument.contains(options.tile_timeout.count()))
     throw kTileTimeoutArgument.error(std::to_string(options.tile_timeout.count()));
+  if (!options.sample_environment && scene.integrator.type != Integrator::Type::path)
+    throw UsageError("environment_sampling: \"bsdf\" is for the path integrator; the direct model samples no BSDF at a diffuse "
+                     "surface, so only sampling the map lights it");
   return {checked(options.width, scene.image.width, kWidthArgument), checked(options.height, scene.image.height, kHeightArgument),
           checked(options.samples_per_pixel, scene.image.samples_per_pixel, kSppArgument),
           checked(options.seed, scene.image.seed, kSeedArgument)};

@@ -70,6 +70,10 @@ struct RenderOptions {
   std::optional<uint32_t> width, height, samples_per_pixel, seed;
   // false: no shadow rays, every light counts as visible (benchmarks of camera rays alone).
   bool shadows = true;
+  // false: the path integrator finds the environment map by BSDF sampling alone, drawing no
+  // directions from it: what importance sampling buys, measured (tools/bench-environment). Not for
+  // the direct model, which samples no BSDF at a diffuse surface.
+  bool sample_environment = true;
   // Also the first-hit passes (image/aovs.h): RenderResult::aovs.
   bool aovs = false;
   // Only these pixels (session/regions.h), each as in a render of the whole image; the result holds

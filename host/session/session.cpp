@@ -110,6 +110,7 @@ Session::ShaderCompile Session::compile_shaders() {
 const Scene& DeviceScene::scene() const { return buffers_->scene(); }
 double DeviceScene::upload_seconds() const { return buffers_->upload_seconds(); }
 double DeviceScene::bvh_seconds() const { return buffers_->bvh_seconds(); }
+double DeviceScene::environment_seconds() const { return buffers_->environment_seconds(); }
 bool DeviceScene::shares_geometry() const { return buffers_->shares_geometry(); }
 
 BackgroundBvh::BackgroundBvh(std::shared_ptr<const Scene> scene) : stop_(std::make_shared<std::atomic<bool>>(false)) {
@@ -190,6 +191,7 @@ gpu::ShaderVariant shader_variant(const gpu::SceneBuffers& scene, const RenderOp
   variant.vertex_colours = scene.vertex_colours();
   variant.instances = scene.instances();
   variant.environment = scene.lighting().environment_width > 0;
+  variant.environment_sampled = options.sample_environment;
   if (use_inline_scene(scene, image_settings(scene.scene(), options), options.inline_scene))
     variant.inline_scene = scene.inline_scene();
   return variant;

@@ -34,6 +34,7 @@ class DeviceScene {
   const Scene& scene() const;
   double upload_seconds() const;  // BVH build included, also when built beforehand
   double bvh_seconds() const;
+  double environment_seconds() const;  // of upload_seconds: the environment map's distribution, built
   // Made by Session::upload_changes from a scene with the same geometry, whose BVH and primitive
   // buffers it shares.
   bool shares_geometry() const;

@@ -74,10 +74,14 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_SPEC_INSTANCES 14
 // false when the scene has no environment map (Scene::environment): no code to look it up or sample it.
 #define VKRAY_SPEC_ENVIRONMENT 15
+// false for a render in which the path integrator finds the environment map by BSDF sampling alone,
+// drawing no directions from it (RenderOptions::sample_environment: to measure what importance
+// sampling buys).
+#define VKRAY_SPEC_ENVIRONMENT_SAMPLED 16
 // And one per material type, id VKRAY_SPEC_MATERIALS + its number (shared/materials.h): whether the
 // scene has a material of that type (gpu::ShaderVariant::materials, a bit each); the BSDF code of
 // the others is left out. Declared as SCENE_HAS_<name> (SCENE_HAS_roughconductor).
-#define VKRAY_SPEC_MATERIALS 16
+#define VKRAY_SPEC_MATERIALS 24
 #define VKRAY_SPECIALIZATION_CONSTANTS(X)                     \
   X(VKRAY_SPEC_SPHERES, SCENE_HAS_SPHERES, spheres, true)     \
   X(VKRAY_SPEC_SHADOWS, SHADOW_RAYS, shadows, true)           \
@@ -94,7 +98,8 @@ VKRAY_SHARED_BEGIN
   X(VKRAY_SPEC_BACKGROUND, SCENE_HAS_BACKGROUND, background, true) \
   X(VKRAY_SPEC_VERTEX_COLOURS, SCENE_HAS_VERTEX_COLOURS, vertex_colours, false) \
   X(VKRAY_SPEC_INSTANCES, SCENE_HAS_INSTANCES, instances, false) \
-  X(VKRAY_SPEC_ENVIRONMENT, SCENE_HAS_ENVIRONMENT, environment, false)
+  X(VKRAY_SPEC_ENVIRONMENT, SCENE_HAS_ENVIRONMENT, environment, false) \
+  X(VKRAY_SPEC_ENVIRONMENT_SAMPLED, ENVIRONMENT_SAMPLED, environment_sampled, true)
 
 // ---- The visibility contract -----------------------------------------------------------------
 // Two hits whose distances differ by less than this fraction are a tie (that is below float

@@ -160,6 +160,9 @@ def main(argv=None):
     ap.add_argument("--json", action="store_true", help="print one JSON line instead of text")
     ap.add_argument("--blocks", type=int, metavar="B", help="test a - b against noise over B x B blocks (8 is usual)")
     ap.add_argument("--block-png", help="with --blocks: write the blocks' t as a map here")
+    ap.add_argument("--rows", metavar="Y0:Y1", help="compare only rows Y0 to Y1 - 1 (from the top; either may be left "
+                    "out): e.g. the part of an image below an environment map's horizon, whose pixels the two renderers "
+                    "interpolate differently (vkray: constant over a texel; Mitsuba: bilinear), a difference without noise")
     args = ap.parse_args(argv)
     if args.blocks is not None and args.blocks < 3:
         ap.error("--blocks: expected at least 3 (a block's variance needs its pixels)")
@@ -169,6 +172,14 @@ def main(argv=None):
     a, b = read_image(args.a), read_image(args.b)
     if a.shape != b.shape:
         sys.exit(f"compare: the images differ in size: {a.shape[1]}x{a.shape[0]} and {b.shape[1]}x{b.shape[0]}")
+    if args.rows:
+        try:
+            y0, y1 = (int(v) if v else None for v in args.rows.split(":"))
+        except ValueError:
+            ap.error(f"--rows: expected Y0:Y1, got {args.rows!r}")
+        a, b = a[y0:y1], b[y0:y1]
+        if a.shape[0] == 0:
+            ap.error(f"--rows {args.rows}: no rows left")
     mean_a, mean_b = a.mean(axis=(0, 1)), b.mean(axis=(0, 1))
     rel_means = np.where(mean_a != 0, mean_b / np.where(mean_a != 0, mean_a, 1) - 1, 0.0)
     rmse = float(np.sqrt(np.mean((a - b) ** 2)))
