@@ -21,11 +21,13 @@ EnvironmentTexel environment_texel(vec3 dir) {
   vec3 d = vec3(dot(frame.environment_row0.xyz, dir), dot(frame.environment_row1.xyz, dir), dot(frame.environment_row2.xyz, dir));
   float u = atan(d.x, -d.z) * (0.5 / PI);
   u = u < 0.0 ? u + 1.0 : u;
-  float cos_theta = clamp(d.y, -1.0, 1.0);
-  float v = acos(cos_theta) * (1.0 / PI);
+  // The polar angle from both of its sides, as Mitsuba's safe form: acos(y) and sqrt(1 - y^2) lose
+  // their precision near the poles, where y rounds to 1.
+  float sin_theta = length(d.xz);
+  float v = atan(sin_theta, d.y) * (1.0 / PI);
   uint x = min(uint(u * float(frame.environment_width)), frame.environment_width - 1u);
   uint y = min(uint(v * float(frame.environment_height)), frame.environment_height - 1u);
-  return EnvironmentTexel(int(y * frame.environment_width + x), sqrt(max(1.0 - cos_theta * cos_theta, 0.0)));
+  return EnvironmentTexel(int(y * frame.environment_width + x), sin_theta);
 }
 
 // The radiance from direction `dir`, and the density per unit solid angle with which

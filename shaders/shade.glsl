@@ -1,6 +1,6 @@
-// Direct shading from point lights plus an ambient term; for a Lambertian surface exactly the scene
-// contract:
-//   L = albedo * (A + sum_lights V * I * (n . w) / (pi r^2) + one area-light sample)
+// Direct shading from point, spot and directional lights plus an ambient term; for a Lambertian surface
+// exactly the scene contract:
+//   L = albedo * (A + sum_lights V * I * (n . w) / (pi r^2) + one area-light sample + one environment sample)
 // with n the shading normal facing the incoming ray (facing() below: the interpolated vertex normal
 // for smooth meshes, the geometric normal otherwise, turned by a normal map), w the unit vector to the
 // light, r its distance, and V = 0 when the light is at most epsilon above the plane of n at x
@@ -147,7 +147,7 @@ float spot_falloff(uint kind, float c, vec4 cone) {
   }
   // Mitsuba's: 1 within the beam, 0 from the cutoff on, linear in the angle between.
   if (!(c > cone.x)) return 0.0;
-  return c >= cone.y ? 1.0 : (cone.z - acos(c)) * cone.w;
+  return c >= cone.y ? 1.0 : clamp((cone.z - acos(c)) * cone.w, 0.0, 1.0);  // (acos rounds: held to the ramp's range)
 }
 
 // Adds V f(wo, w) |n . w| times each light's arrival to `radiance`: I / r^2 from a point light, I

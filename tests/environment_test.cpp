@@ -2,6 +2,8 @@
 // orientation, the physics of a constant map on both renderers under both integrators, and parity
 // catching a density without its sin(theta) and a map sampled half a turn from where it is read.
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -72,6 +74,25 @@ TEST(EnvironmentFileTest, AMapThatIsNotTwoToOneOrHasABadTexelIsRefusedNamingIt) 
   EXPECT_NE(message.find("a Radiance .hdr or an OpenEXR .exr file"), std::string::npos) << message;
 }
 
+TEST(EnvironmentFileTest, ARadianceFileCutShortOrWithAnEmptyRunIsRefused) {
+  // stb_image would decode the first without its missing pixels, and never finish the second.
+  TempDir dir;
+  const std::filesystem::path sky = std::filesystem::path(VKRAY_CHECK_DIR) / "environment" / "sky.hdr";
+  std::ifstream in(sky, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  std::ofstream(dir / "cut.hdr", std::ios::binary) << bytes.substr(0, bytes.size() - 100);
+  std::string message = error_of([&] { read_environment_map(dir / "cut.hdr", 1.0f); });
+  EXPECT_NE(message.find("cut.hdr: unreadable Radiance pixels (the file ends before its last pixel)"), std::string::npos) << message;
+  std::string rle = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n";
+  rle += std::string("\x02\x02\x00\x08", 4) + std::string(1, '\0');
+  std::ofstream(dir / "empty-run.hdr", std::ios::binary) << rle;
+  message = error_of([&] { read_environment_map(dir / "empty-run.hdr", 1.0f); });
+  EXPECT_NE(message.find("empty-run.hdr: unreadable Radiance pixels (scanline 0 has a run of length 0)"), std::string::npos) << message;
+  std::ofstream(dir / "mid-run.hdr", std::ios::binary) << rle.substr(0, rle.size() - 1) + "\x05\x01";
+  message = error_of([&] { read_environment_map(dir / "mid-run.hdr", 1.0f); });
+  EXPECT_NE(message.find("mid-run.hdr: unreadable Radiance pixels (the file ends within scanline 0)"), std::string::npos) << message;
+}
+
 std::string scene_with_environment(const std::string& environment) {
   return R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "vertical_fov": 40}, "environment": )" + environment + "}";
 }
@@ -93,6 +114,10 @@ TEST(EnvironmentFileTest, TheSceneKeysAreCheckedAsEveryKeyIs) {
   const std::string both = R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "vertical_fov": 40}, "background": [1, 1, 1],
                               "environment": {"file": "sky.exr"}})";
   EXPECT_NE(error(both).find("give either \"background\" or \"environment\""), std::string::npos);
+  // A map given in its place (--environment) replaces the file's own, which is then not read.
+  const Scene replaced = parse_scene(scene_with_environment(R"({"file": "none.hdr"})"), file, nullptr, dir / "sky.exr");
+  ASSERT_TRUE(replaced.environment);
+  EXPECT_EQ(replaced.environment->file, dir / "sky.exr");
   // A quarter turn about y is a rotation: taken, with the file relative to the scene's folder.
   const Scene turned = parse_scene(scene_with_environment(R"({"file": "sky.exr", "transform": {"rotate": [0, 90, 0]}})"), file);
   ASSERT_TRUE(turned.environment);

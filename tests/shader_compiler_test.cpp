@@ -67,7 +67,8 @@ TEST(ShaderCompilerTest, CompilesTheTracerAndListsEveryIncludedFile) {
                          "shade.glsl",      "primitives.glsl",   "intersect.glsl",  "traversal.glsl",
                          "inline_scene.glsl", "warp.glsl",        "emitters.glsl",   "bsdf.glsl",
                          "direct.glsl",     "path.glsl",         "aovs.glsl",       "texture.glsl",
-                         "shared/first_hit_layout.h", "shared/materials.h", "instances.glsl"};
+                         "shared/first_hit_layout.h", "shared/materials.h", "instances.glsl",
+                         "environment.glsl"};
   for (const char* file : files) {
     const auto expected = (dir / file).lexically_normal();
     EXPECT_NE(std::find(shader.sources.begin(), shader.sources.end(), expected), shader.sources.end()) << file;
@@ -100,6 +101,8 @@ TEST(ShaderCompilerTest, ReflectsTheBindingsTheShaderDeclares) {
       {VKRAY_BINDING_TANGENTS, {"tangents", D::eUniformTexelBuffer}},
       {VKRAY_BINDING_COLOURS, {"colours", D::eUniformTexelBuffer}},
       {VKRAY_BINDING_INSTANCES, {"instances", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_ENVIRONMENT, {"environment", D::eUniformTexelBuffer}},
+      {VKRAY_BINDING_ENVIRONMENT_CDF, {"environment_cdf", D::eUniformTexelBuffer}},
   };
   EXPECT_EQ(found, expected);
 }

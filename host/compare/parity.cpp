@@ -30,7 +30,9 @@ ParityTolerance parity_tolerance(const Scene& scene) {
   const bool chooses = std::any_of(scene.materials.begin(), scene.materials.end(),
                                    [](const Material& m) { return m.has(VKRAY_BSDF_DELTA) && m.has(VKRAY_BSDF_TRANSMISSION); });
   const bool emitters = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.emissive(); });
-  tolerance.stochastic = scene.integrator.type == Integrator::Type::path || chooses || emitters || scene.camera.aperture_radius > 0;
+  // An environment map is sampled at random too, through cumulative shares the GPU holds in float.
+  tolerance.stochastic = scene.integrator.type == Integrator::Type::path || chooses || emitters || scene.environment ||
+                         scene.camera.aperture_radius > 0;
   tolerance.textured = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.textured(); });
   return tolerance;
 }

@@ -19,7 +19,8 @@ namespace vkray {
 // edge allowance is a share of edge pixels, not of all pixels: edges are lines, so their share of
 // an image shrinks as its resolution grows, while the share of edge pixels that flip does not.
 //
-// A render that makes random decisions (paths, area lights, glass, a lens: `stochastic`) traces the
+// A render that makes random decisions (paths, area lights, an environment map, glass, a lens:
+// `stochastic`) traces the
 // same samples on both, since the two draw the same random numbers; a sample whose path the two
 // renderers' rounding sends different ways differs by a whole sample's worth of noise, wherever it
 // is. Its tolerance is a share of all pixels instead, and the mean of the image, which such

@@ -1,4 +1,5 @@
-// The direct model: L = albedo (A + sum of point lights + one area-light sample) at the first diffuse
+// The direct model: L = albedo (A + sum of point, spot and directional lights + one area-light sample + one
+// environment-map sample) at the first diffuse
 // surface (a glossy one: its BSDF against the same lights, the ambient term times its colour), emitters
 // seen added, mirrors and glass followed up to VKRAY_SPECULAR_BOUNCES times.
 #include <limits>
@@ -12,7 +13,8 @@ namespace vkray::cpu {
 namespace {
 
 // The radiance a surface that is not a delta reflects toward the ray: the ambient term times its
-// colour, and its BSDF against the point lights and one area-light sample. n, n_geometric face the
+// colour, and its BSDF against the point, spot and directional lights, one area-light sample and one
+// environment-map sample. n, n_geometric face the
 // incoming ray. For a diffuse surface, the scene contract's albedo (A + sum of lights + area light).
 dvec3 shade(const Tracer& tracer, const Lights& lights, const SurfacePoint& s, const Bsdf& bsdf, const dvec3& wo, bool front,
             const dvec3& n, const dvec3& n_geometric, SampleState& state, bool first) {

@@ -60,10 +60,11 @@ EnvironmentLight::Lookup EnvironmentLight::lookup(const dvec3& dir) const {
   const dvec3 d = to_map_ * dir;
   double u = std::atan2(d.x, -d.z) / (2 * kPi);
   if (u < 0) u += 1;
-  const double cos_theta = std::clamp(d.y, -1.0, 1.0);
-  const double v = std::acos(cos_theta) / kPi;
+  // The polar angle from both of its sides: precise near the poles too.
+  const double sin_theta = std::hypot(d.x, d.z);
+  const double v = std::atan2(sin_theta, d.y) / kPi;
   const auto x = std::min(uint32_t(u * width_), width_ - 1), y = std::min(uint32_t(v * height_), height_ - 1);
-  return texel(x, y, std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta)));
+  return texel(x, y, sin_theta);
 }
 
 EnvironmentLight::Sample EnvironmentLight::sample(double u_row, double u_column) const {

@@ -1,5 +1,5 @@
 // Path tracing, as the shader's path.glsl: next-event estimation at every vertex that is not a delta (every point,
-// spot and directional light, one area-light sample, one background sample) weighed by the power heuristic against BSDF
+// spot and directional light, one area-light sample, one environment-map or background sample) weighed by the power heuristic against BSDF
 // sampling; Mitsuba's max_depth; Russian roulette from rr_depth.
 #include <algorithm>
 #include <limits>

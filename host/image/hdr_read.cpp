@@ -4,6 +4,7 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "base/errors.h"
 #include "base/input_file.h"
@@ -24,6 +25,51 @@
 #pragma GCC diagnostic pop
 
 namespace vkray {
+namespace {
+
+// Whether the pixel data after the header holds the `width` x `height` pixels stb_image will read,
+// walked as stb_image walks it: flat RGBE quadruples, or per scanline the run-length form (2, 2, the
+// width in two bytes, then each of the four channels as runs and literal spans). stb_image reads
+// past the end of its buffer as zeros and takes a span of length 0 for no progress, so a file cut
+// short in a run-length scanline would never finish decoding, and one cut short in flat pixels
+// would decode what is not there: both are refused here first. Returns what is wrong, or "".
+std::string scanline_problem(const unsigned char* data, size_t size, uint32_t width, uint32_t height) {
+  size_t at = 0;
+  const auto flat_rows = [&](uint32_t rows) -> std::string {
+    const uint64_t need = uint64_t(rows) * width * 4;
+    return size - at < need ? "the file ends before its last pixel" : "";
+  };
+  if (width < 8 || width >= 32768) return flat_rows(height);
+  for (uint32_t y = 0; y < height; ++y) {
+    if (size - at < 4) return "the file ends before its last scanline";
+    if (data[at] != 2 || data[at + 1] != 2 || (data[at + 2] & 0x80)) return flat_rows(height - y);  // flat from here on
+    at += 4;
+    for (int channel = 0; channel < 4; ++channel) {
+      for (uint32_t x = 0; x < width;) {
+        if (at >= size) return "the file ends within scanline " + std::to_string(y);
+        uint32_t count = data[at++];
+        const bool run = count > 128;
+        if (run) count -= 128;
+        if (count == 0 || count > width - x) return "scanline " + std::to_string(y) + " has a run of length " + std::to_string(count);
+        const size_t bytes = run ? 1 : count;
+        if (size - at < bytes) return "the file ends within scanline " + std::to_string(y);
+        at += bytes;
+        x += count;
+      }
+    }
+  }
+  return "";
+}
+
+// Where the pixels start: after the header's blank line and the resolution line.
+size_t pixels_offset(const std::string& text) {
+  const size_t blank = text.find("\n\n");
+  if (blank == std::string::npos) return std::string::npos;
+  const size_t resolution_end = text.find('\n', blank + 2);
+  return resolution_end == std::string::npos ? std::string::npos : resolution_end + 1;
+}
+
+}  // namespace
 
 Image read_hdr(const std::filesystem::path& file) {
   const InputFile input = read_input_file(file, kMaxPictureFileBytes);
@@ -38,6 +84,11 @@ Image read_hdr(const std::filesystem::path& file) {
   if (width < 1 || height < 1 || uint32_t(width) > kMaxImageSide || uint32_t(height) > kMaxImageSide)
     throw InputError(file.string() + ": " + std::to_string(width) + " x " + std::to_string(height) +
                      " pixels; vkray reads at most " + std::to_string(kMaxImageSide) + " on a side");
+  const size_t offset = pixels_offset(input.text);
+  const std::string problem = offset == std::string::npos
+                                  ? "no resolution line after its header"
+                                  : scanline_problem(bytes + offset, input.text.size() - offset, uint32_t(width), uint32_t(height));
+  if (!problem.empty()) throw InputError(file.string() + ": unreadable Radiance pixels (" + problem + ")");
   Image image;
   try {
     image = Image(uint32_t(width), uint32_t(height));

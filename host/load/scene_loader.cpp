@@ -146,7 +146,9 @@ Scene parse_scene(std::string_view json_text, const std::filesystem::path& file,
   scene.file = file;
   scene.name = file.stem().string();
   MeshCache this_scene;
-  SceneParser(file, scene, meshes ? *meshes : this_scene).parse(root);
+  SceneParser parser(file, scene, meshes ? *meshes : this_scene);
+  parser.replace_environment_with(environment);
+  parser.parse(root);
   if (!environment.empty()) set_environment(scene, environment);
   finish_scene(scene);
   return scene;

@@ -34,7 +34,7 @@ void SceneParser::parse(const json& root_json) {
   parse_camera(require(root, "camera"));
   if (root.has("integrator")) parse_integrator(root["integrator"]);
   if (root.has("background")) scene_.background = color(root["background"]);
-  if (root.has("environment")) {
+  if (root.has("environment") && environment_override_.empty()) {
     if (root.has("background")) fail(root, "give either \"background\" or \"environment\", not both: the map replaces the background");
     parse_environment(root["environment"]);
   }
@@ -58,7 +58,7 @@ void SceneParser::parse(const json& root_json) {
     warn(root["ambient"], "the path integrator carries indirect light itself: ambient is the direct model's stand-in for it, "
                           "and is ignored");
   const bool emitters = std::any_of(scene_.materials.begin(), scene_.materials.end(), [](const Material& m) { return m.emissive(); });
-  const bool lit = !scene_.lights.empty() || emitters || scene_.environment ||
+  const bool lit = !scene_.lights.empty() || emitters || scene_.environment || !environment_override_.empty() ||
                    (path ? scene_.background : scene_.ambient) != glm::vec3(0.0f);
   if (!lit && (!scene_.triangles.empty() || !scene_.instances.empty()))
     warn(root, path ? "no lights, no emission and no background: every surface renders black"

@@ -46,6 +46,9 @@ class SceneParser {
   SceneParser(const std::filesystem::path& file, Scene& scene, MeshCache& meshes) : file_(file), scene_(scene), meshes_(meshes) {}
 
   void parse(const json& root);
+  // An environment map that replaces the file's environment and background (load_scene's
+  // `environment`): the file's own map is then not read.
+  void replace_environment_with(const std::filesystem::path& map) { environment_override_ = map; }
   // Adds a glTF file's triangles, materials, textures and point lights, placed by `transform`, as the
   // object being parsed. `where` is the scene's key that names the file; null when the glTF file is
   // the scene itself (its messages then name it alone). Returns its camera and aspect ratio.
@@ -123,6 +126,7 @@ class SceneParser {
   void parse_image(const Value& v);
   void parse_camera(const Value& v);
   void parse_environment(const Value& v);
+  std::filesystem::path environment_override_;
   void parse_integrator(const Value& v);
   void parse_materials(const Value& v);
   glm::vec3 reflectance(const Value& v);  // a colour in [0, 1] (above 1: refused for paths, a warning otherwise)

@@ -22,6 +22,18 @@ def test_render_returns_what_the_command_line_writes_as_pfm(scenes, vkray_comman
     assert np.array_equal(image, read_pfm(tmp_path / "x.pfm"))
 
 
+def test_an_environment_map_lights_a_scene_as_the_command_line_does(scenes, vkray_command, tmp_path):
+    box = scenes / "gltf" / "BoxTextured" / "glTF-Binary" / "BoxTextured.glb"
+    sky = scenes / "skies" / "daylight.exr"
+    image = vkray.render(box, environment=sky, spp=2, **SMALL)
+    run(vkray_command, "render", str(box), "--environment", str(sky), "--width", "64", "--height", "48", "--spp", "2",
+        "-o", str(tmp_path / "x.pfm"), "-q")
+    assert np.array_equal(image, read_pfm(tmp_path / "x.pfm"))
+    assert image[0, 0].sum() > 0  # the sky, beside the box
+    with pytest.raises(vkray.SceneError, match="nowhere.hdr: not found"):
+        vkray.render(box, environment=tmp_path / "nowhere.hdr", **SMALL)
+
+
 def test_the_cpu_reference_renders_the_same_scene(scenes):
     gpu = vkray.render(scenes / "cornell.json", **SMALL)
     cpu = vkray.render(scenes / "cornell.json", renderer="cpu", threads=2, **SMALL)

@@ -19,7 +19,7 @@ VKRAY_SHARED_BEGIN
 #define VKRAY_BINDING_NORMALS 2     // uniform texel buffer, RGBA32F: vertex normals of smooth triangles
 #define VKRAY_BINDING_NODES 3       // uniform texel buffer, RGBA32UI: 4-wide BVH nodes
 #define VKRAY_BINDING_MATERIALS 4   // uniform texel buffer, RGBA32F: materials
-#define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F: point lights
+#define VKRAY_BINDING_LIGHTS 5      // uniform texel buffer, RGBA32F: point, spot and directional lights
 #define VKRAY_BINDING_OUTPUT 6      // storage buffer: one vec4 per pixel (rgb radiance, a = ray count bits)
 #define VKRAY_BINDING_EMITTERS 7    // uniform texel buffer, RGBA32F: the area lights' alias table
 #define VKRAY_BINDING_AOVS 8        // storage buffer: FirstHitTexels per pixel (first_hit_layout.h)
@@ -60,9 +60,9 @@ VKRAY_SHARED_BEGIN
 // false when every shading normal is the geometric one (no vertex normals, no normal maps): no code to
 // bend a shading normal that faces away from the viewer (shade.glsl), which the geometric one never does.
 #define VKRAY_SPEC_SHADING_NORMALS 10
-// false when the scene has no point lights, and when its background is black or it is not path traced:
-// no code for lighting by them (a point light's shadow ray; the path integrator's background sample
-// and its shadow ray).
+// false when the scene has no point, spot or directional lights, and when its background is black or
+// it is not path traced: no code for lighting by them (such a light's shadow ray; the path
+// integrator's uniform background sample and its shadow ray).
 // llvmpipe runs a block under a condition that no lane meets all the same, masked, and such a block
 // holding a traversal loop costs a traversal step: on scenes/rough-spheres.json, lit by an area
 // light alone under a black sky, the two blocks took a fifth of the trace time.
