@@ -24,7 +24,7 @@ namespace {
 std::filesystem::path write_map(const TempDir& dir, const std::string& name, uint32_t width, glm::vec3 radiance) {
   Image map(width, width / 2);
   for (glm::vec3& p : map.pixels) p = radiance;
-  ExrContent content;
+  OutputContent content;
   content.full_float = true;
   write_exr(dir / name, map, nullptr, content);
   return dir / name;
@@ -36,7 +36,7 @@ TEST(EnvironmentFileTest, ARadianceFileAndAnExrOfItAreTheSameMap) {
   EXPECT_EQ(from_hdr->width, 128u);
   EXPECT_EQ(from_hdr->height, 64u);
   TempDir dir;
-  ExrContent content;
+  OutputContent content;
   content.full_float = true;
   write_exr(dir / "sky.exr", *from_hdr, nullptr, content);
   const auto from_exr = read_environment_map(dir / "sky.exr", 2.0f);
@@ -47,7 +47,7 @@ TEST(EnvironmentFileTest, ARadianceFileAndAnExrOfItAreTheSameMap) {
 TEST(EnvironmentFileTest, AMapThatIsNotTwoToOneOrHasABadTexelIsRefusedNamingIt) {
   TempDir dir;
   Image square(8, 8);
-  ExrContent content;
+  OutputContent content;
   content.full_float = true;
   write_exr(dir / "square.exr", square, nullptr, content);
   std::string message = error_of([&] { read_environment_map(dir / "square.exr", 1.0f); });

@@ -38,7 +38,7 @@ std::pair<Image, Aovs> sample_render(uint32_t w, uint32_t h) {
 TEST(ExrTest, FullFloatFilesReadBackExactly) {
   TempDir dir;
   const auto [image, aovs] = sample_render(13, 7);
-  ExrContent content{true, {Aov::object, Aov::albedo, Aov::normal, Aov::position, Aov::depth}};
+  OutputContent content{true, {Aov::object, Aov::albedo, Aov::normal, Aov::position, Aov::depth}};
   write_exr(dir / "a.exr", image, &aovs, content);
   const ExrFile read = read_exr(dir / "a.exr");
   EXPECT_TRUE(read.content.full_float);
@@ -235,7 +235,7 @@ TEST(ExrTest, WhatIsReadIsHashedAsStored) {
   // step in a 32-bit file.
   TempDir dir;
   auto [image, aovs] = sample_render(13, 7);
-  const ExrContent content{true, {Aov::depth, Aov::object}};
+  const OutputContent content{true, {Aov::depth, Aov::object}};
   write_exr(dir / "a.exr", image, &aovs, content);
   write_exr(dir / "b.exr", image, &aovs, content);
   image.pixels[20].g = std::nextafter(image.pixels[20].g, 1.0f);

@@ -210,7 +210,7 @@ PartRecord sky_record(const Scene& scene, const PixelRegion& region, const std::
 // with the record `edit` makes of sky_record's.
 std::vector<std::filesystem::path> write_parts(const Rendered& r, const std::vector<PixelRegion>& regions,
                                                const std::filesystem::path& dir, const std::string& suffix,
-                                               const ExrContent& content = {}, const std::string& shader = "",
+                                               const OutputContent& content = {}, const std::string& shader = "",
                                                const std::function<void(PartRecord&)>& edit = {}) {
   std::vector<std::filesystem::path> files;
   for (size_t i = 0; i < regions.size(); ++i) {
@@ -261,7 +261,7 @@ TEST(MergeTest, PfmPartsMergeIntoTheBytesOfTheWholeImage) {
 TEST(MergeTest, ExrPartsCarryTheirDataWindowAndPassesAndMergeExactly) {
   TempDir dir;
   const Rendered r = rendered(true);
-  ExrContent content;
+  OutputContent content;
   content.passes = {Aov::albedo, Aov::depth, Aov::object};
   const auto files = write_parts(r, kQuarters, dir.path(), ".exr", content);
   const ExrFile exr = read_exr(files[1]);

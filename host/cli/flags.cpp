@@ -103,6 +103,28 @@ void add_cpu_flags(CLI::App& command, CpuFlags& flags, const std::string& descri
   command.add_option("--threads", flags.threads, description)->check(within(kThreadsArgument));
 }
 
+void add_display_flags(CLI::App& command, DisplayFlags& flags) {
+  command
+      .add_option_function<std::string>(
+          "--tonemap", [&flags](const std::string& name) { flags.display.tonemap = *parse_tonemap(name); },
+          "How a PNG shows radiance: 'none' (default: clamped to [0, 1], then sRGB), 'aces' (ACES filmic, "
+          "Hill's fit) or 'pbr-neutral' (Khronos PBR Neutral); EXR and PFM files stay linear")
+      ->option_text("none|aces|pbr-neutral")
+      ->check(CLI::IsMember({"none", "aces", "pbr-neutral"}));
+  command
+      .add_option("--exposure", flags.display.exposure,
+                  "Exposure of a PNG in stops: radiance times 2^EV before the tone mapper (default 0)")
+      ->option_text("EV")
+      ->check(CLI::Validator(
+          [](std::string& value) -> std::string {
+            float stops = 0.0f;
+            if (!CLI::detail::lexical_cast(value, stops) || !(std::abs(stops) <= kMaxExposure))
+              return "expected a number of stops from -64 to 64, got \"" + printable(value) + "\"";
+            return "";
+          },
+          ""));
+}
+
 void apply_value_rules(CLI::App& app) {
   // `limited`: a negative number is left for the limit to refuse.
   const auto decimal = [](bool limited) {

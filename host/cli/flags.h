@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "image/display.h"
 #include "session/options.h"
 
 namespace vkray::cli {
@@ -32,6 +33,10 @@ struct GpuFlags {
   uint32_t tile_timeout_ms = 60000;
   InlineScene inline_scene = InlineScene::automatic;
 };
+// [--tonemap none|aces|pbr-neutral] [--exposure EV]: how 8-bit outputs show radiance
+struct DisplayFlags {
+  DisplayTransform display;
+};
 // [--threads N]
 struct CpuFlags {
   unsigned threads = 0;
@@ -49,6 +54,7 @@ void add_device_flags(CLI::App& command, DeviceFlags& flags, bool validate = tru
 // `inline_scene`: whether the command offers --inline-scene (`vkray check` runs both paths).
 void add_gpu_flags(CLI::App& command, GpuFlags& flags, bool inline_scene = true);
 void add_cpu_flags(CLI::App& command, CpuFlags& flags, const std::string& description);
+void add_display_flags(CLI::App& command, DisplayFlags& flags);
 
 // Rules every option value follows, set once for all commands by the option's type, so that no
 // option can miss them: an integer is decimal digits (CLI11 alone reads "0100" as octal 64 and

@@ -26,6 +26,7 @@ struct RenderArgs {
   DeviceFlags device;
   GpuFlags gpu;
   CpuFlags cpu;
+  DisplayFlags display;
   std::filesystem::path output;  // empty: <scene name>.png in the current folder
   std::string renderer = "gpu";  // "gpu" or "cpu"
   std::string aovs;              // --aov: first-hit passes, comma-separated (image/aovs.h)
@@ -41,8 +42,9 @@ int run_render(const RenderArgs& args) {
   const LoadedScene loaded = load_scene_file(scene_file(args.scene), args.scene.environment);
   const std::filesystem::path output =
       args.output.empty() ? std::filesystem::path(loaded.scene->name + ".png") : args.output;
-  ExrContent content;
+  OutputContent content;
   content.full_float = args.exr_float;
+  content.display = args.display.display;
   check_output_image(output);  // before the passes' names: one order of checks for every face
   if (!args.aovs.empty()) content.passes = parse_aov_list(args.aovs);
   check_render_output(output, content, args.scene.region.has_value());
@@ -114,6 +116,7 @@ Command add_render_command(CLI::App& app) {
   command->add_option("--aov", args->aovs, "First-hit passes to add to an .exr as layers, comma-separated: albedo, normal, "
                                            "position, depth, object");
   command->add_flag("--exr-float", args->exr_float, "Write an .exr with 32-bit float channels instead of 16-bit half");
+  add_display_flags(*command, args->display);
   add_device_flags(*command, args->device);
   add_gpu_flags(*command, args->gpu);
   command->add_option("--renderer", args->renderer, "gpu (Vulkan compute shader) or cpu (the CPU reference)")

@@ -11,17 +11,21 @@
 #include <vector>
 
 #include "image/aovs.h"
+#include "image/display.h"
 #include "image/image.h"
 #include "image/region.h"
 
 namespace vkray {
 
-struct ExrContent {
-  // 32-bit float channels; false: 16-bit half floats for the image, albedo and normal. position and
+// What a render's image file holds besides the pixels: for an EXR file, the precision and the
+// first-hit passes; for a PNG file, the display transform (image/display.h).
+struct OutputContent {
+  // EXR: 32-bit float channels; false: 16-bit half floats for the image, albedo and normal. position and
   // depth are always 32-bit (half floats would round a far depth to infinity, the miss marker), and
   // so is object.id (every id below 2^24 exact).
   bool full_float = false;
-  std::vector<Aov> passes;  // the layers written after R, G, B, in this order
+  std::vector<Aov> passes;  // EXR: the layers written after R, G, B, in this order
+  DisplayTransform display;  // PNG: exposure and tone mapper; EXR and PFM hold linear radiance
 };
 
 // Where an image lies in a larger one, as read_exr finds it in a file: the pixels are `region` (the
@@ -45,13 +49,13 @@ struct ExrPartHeader {
 // Writes `image` and the `content.passes` of `aovs` (which must then be given, of the same size),
 // ZIP-compressed scan lines, top row first; with `part`, as that part of a larger image. Like
 // write_image, under a temporary name renamed into place. Throws OutputError, LimitError.
-void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content,
+void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const OutputContent& content,
                const ExrPartHeader* part = nullptr);
 
 struct ExrFile {
   Image image;  // the data window's pixels
   Aovs aovs;  // the passes the file has; the others keep Aovs' defaults
-  ExrContent content;  // full_float: whether R is 32-bit
+  OutputContent content;  // full_float: whether R is 32-bit
   // The display window's size and the data window within it (when both lie in the first quadrant;
   // zero otherwise), and the "vkray.part" attribute, as written.
   ExrWindow window;

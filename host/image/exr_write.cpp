@@ -56,7 +56,7 @@ struct WrittenPlanes {
   std::vector<StoredPlane> stored;
 };
 
-WrittenPlanes written_planes(const Image& image, const Aovs* aovs, const ExrContent& content) {
+WrittenPlanes written_planes(const Image& image, const Aovs* aovs, const OutputContent& content) {
   const size_t pixels = image.pixels.size();
   WrittenPlanes planes;
   const auto add = [&](const std::string& name, bool full_float, auto value) {
@@ -94,7 +94,7 @@ WrittenPlanes written_planes(const Image& image, const Aovs* aovs, const ExrCont
 
 }  // namespace
 
-void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content,
+void write_exr(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const OutputContent& content,
                const ExrPartHeader* part) {
   if (!content.passes.empty() && (!aovs || aovs->width != image.width || aovs->height != image.height))
     throw InternalError(file.string() + ": first-hit passes asked for without passes of the image's size");

@@ -8,6 +8,8 @@
 
 #include <glm/glm.hpp>
 
+#include "image/display.h"
+
 namespace vkray {
 
 class AtomicFile;
@@ -37,10 +39,10 @@ uint8_t encode_srgb8_by_formula(float linear);
 float decode_srgb(float encoded);
 float decode_srgb8(uint8_t encoded);
 
-// PNG (8-bit sRGB) and PFM (32-bit float linear, rows bottom to top, little-endian) files, each
+// PNG (8-bit sRGB, through `display`: image/display.h) and PFM (32-bit float linear, rows bottom to top, little-endian) files, each
 // written under a temporary name in the same folder and renamed into place, so that a failure never
 // leaves a partial image. Throw OutputError. write_image (image_file.h) picks one by extension.
-void write_png(const Image& image, const std::filesystem::path& file);
+void write_png(const Image& image, const std::filesystem::path& file, const DisplayTransform& display = {});
 void write_pfm(const Image& image, const std::filesystem::path& file);
 // The PFM's bytes into `out`, which the caller commits (with a file that must change with it).
 void write_pfm(const Image& image, AtomicFile& out);

@@ -39,24 +39,27 @@ bool is_supported_image_path(const std::filesystem::path& file) { return image_f
 bool is_pfm(const std::filesystem::path& file) { return image_file_type(file) == ImageFileType::pfm; }
 bool is_exr(const std::filesystem::path& file) { return image_file_type(file) == ImageFileType::exr; }
 
-void write_image(const Image& image, const std::filesystem::path& file) {
+void write_image(const Image& image, const std::filesystem::path& file, const DisplayTransform& display) {
   const auto type = image_file_type(file);
   if (!type)
     throw OutputError(file.string() + ": unknown image type \"" + lower_extension(file) + "\" (expected .png, .pfm or .exr)");
   switch (*type) {
-    case ImageFileType::png: return write_png(image, file);
+    case ImageFileType::png: return write_png(image, file, display);
     case ImageFileType::pfm: return write_pfm(image, file);
     case ImageFileType::exr: return write_exr(file, image, nullptr, {});
   }
 }
 
-void write_render_image(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content) {
+void write_render_image(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const OutputContent& content) {
   check_render_image(file, content);
   if (is_exr(file)) return write_exr(file, image, aovs, content);
-  write_image(image, file);
+  write_image(image, file, content.display);
 }
 
-void check_render_image(const std::filesystem::path& file, const ExrContent& content) {
+void check_render_image(const std::filesystem::path& file, const OutputContent& content) {
+  if (!content.display.is_identity() && image_file_type(file) != ImageFileType::png)
+    throw UsageError(file.string() + ": --tonemap and --exposure are for PNG files only (EXR and PFM files hold linear "
+                     "radiance): name the output *.png");
   if (is_exr(file)) return;
   if (!content.passes.empty())
     throw UsageError(file.string() + ": first-hit passes (--aov) are written to EXR files only: name the output *.exr");

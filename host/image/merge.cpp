@@ -17,7 +17,7 @@ namespace {
 
 std::string size_text(uint32_t width, uint32_t height) { return std::to_string(width) + " x " + std::to_string(height); }
 
-std::string pass_names(const ExrContent& content) {
+std::string pass_names(const OutputContent& content) {
   std::string names;
   for (const Aov pass : content.passes) {
     if (!names.empty()) names += ',';

@@ -16,7 +16,7 @@ namespace vkray {
 struct MergedImage {
   Image image;
   std::optional<Aovs> aovs;  // when the parts have passes
-  ExrContent content;        // the parts' passes and precision: an EXR output written with it
+  OutputContent content;        // the parts' passes and precision: an EXR output written with it
   PartRecord record;         // the first part's record, region the whole image
   // Parts were rendered on more than one device (the CPU reference counts as one): the image is within parity of a
   // single render, not bit-identical to one (docs/distributed.md).

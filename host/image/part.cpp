@@ -110,7 +110,7 @@ std::filesystem::path sidecar_of(const std::filesystem::path& pfm) {
   return sidecar;
 }
 
-void write_part(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content,
+void write_part(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const OutputContent& content,
                 const PartRecord& record) {
   if (image.width != record.region.width() || image.height != record.region.height())
     throw InternalError(file.string() + ": a part's pixels do not fit its region");

@@ -53,7 +53,7 @@ std::filesystem::path sidecar_of(const std::filesystem::path& pfm);
 // together (AtomicFile::commit_together): a write that fails leaves an earlier part and its record as
 // they were. Completes `record` with its hashes. Throws UsageError for another file type,
 // OutputError, LimitError.
-void write_part(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const ExrContent& content,
+void write_part(const std::filesystem::path& file, const Image& image, const Aovs* aovs, const OutputContent& content,
                 const PartRecord& record);
 
 struct Part {
@@ -61,7 +61,7 @@ struct Part {
   PartRecord record;
   Image image;               // the region's pixels
   std::optional<Aovs> aovs;  // an EXR part's passes (content.passes), of the region's size
-  ExrContent content;        // the passes and the precision of an EXR part; PFM: none, 32-bit
+  OutputContent content;        // the passes and the precision of an EXR part; PFM: none, 32-bit
   bool exr = false;
 };
 

@@ -64,8 +64,8 @@ std::vector<Aov> parse_passes(const std::vector<std::string>& names) {
   return list.empty() ? std::vector<Aov>{} : parse_aov_list(list);
 }
 
-ExrContent output_content(const Request& request, const std::vector<Aov>& passes) {
-  ExrContent content;
+OutputContent output_content(const Request& request, const std::vector<Aov>& passes) {
+  OutputContent content;
   content.passes = passes;
   content.full_float = request.exr_float;
   if (!request.output) {

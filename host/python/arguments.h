@@ -61,6 +61,6 @@ std::vector<Aov> parse_passes(const std::vector<std::string>& names);
 
 // The file's content, checked before any work: passes and 32-bit floats only in an .exr, a region
 // only as a part (.exr or .pfm).
-ExrContent output_content(const Request& request, const std::vector<Aov>& passes);
+OutputContent output_content(const Request& request, const std::vector<Aov>& passes);
 
 }  // namespace vkray::python

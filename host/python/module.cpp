@@ -135,13 +135,13 @@ class Renderer {
     const RenderOptions options = options_of(request, !passes.empty());
     struct Loaded {
       std::shared_ptr<const Scene> scene;
-      ExrContent content;
+      OutputContent content;
       double seconds;
     };
     const CallInFlight call;  // before the lock: a call in flight may be waiting for it
     auto lock = usable_without_gil();
     const Loaded loaded = run_interruptibly([&] {
-      const ExrContent content = output_content(request, passes);
+      const OutputContent content = output_content(request, passes);
       const auto start = Clock::now();
       auto scene = load(source, &meshes_);
       meshes_.keep_only(scene->referenced_files);
@@ -229,11 +229,11 @@ py::object render_cpu(const SceneSource& source, const Request& request, const p
   options.threads = thread_count_argument(threads);
   struct Loaded {
     std::shared_ptr<const Scene> scene;
-    ExrContent content;
+    OutputContent content;
   };
   const CallInFlight call;
   const Loaded loaded = run_interruptibly([&] {
-    const ExrContent content = output_content(request, passes);
+    const OutputContent content = output_content(request, passes);
     auto scene = load(source, nullptr);
     image_settings(*scene, options);
     return Loaded{scene, content};

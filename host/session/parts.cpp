@@ -29,7 +29,7 @@ void check_part_file(const std::filesystem::path& file) {
                                      "*.exr or *.pfm");
 }
 
-void check_render_output(const std::filesystem::path& file, const ExrContent& content, bool part) {
+void check_render_output(const std::filesystem::path& file, const OutputContent& content, bool part) {
   check_output_image(file);
   check_render_image(file, content);
   if (part) check_part_file(file);
@@ -51,7 +51,7 @@ void check_finite(const RenderResult& result) {
                       "the scene compares the device with the CPU reference");
 }
 
-void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const ExrContent& content,
+void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const OutputContent& content,
                   const std::string& device) {
   check_finite(result);
   const Aovs* aovs = result.aovs ? &*result.aovs : nullptr;

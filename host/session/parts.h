@@ -22,7 +22,7 @@ void check_part_file(const std::filesystem::path& file);
 // Everything write_render would refuse of `file`, checked before any work is done, in the order
 // every face reports it: the path (OutputError, image_file.h's check_output_image), then what is
 // asked of it (UsageError: passes or 32-bit floats outside an .exr, a `part` outside .exr/.pfm).
-void check_render_output(const std::filesystem::path& file, const ExrContent& content, bool part);
+void check_render_output(const std::filesystem::path& file, const OutputContent& content, bool part);
 
 // What `result`, a render of `scene`, was rendered from. `device`: Session::device_description(), or
 // kCpuReferenceDevice.
@@ -38,7 +38,7 @@ void check_finite(const RenderResult& result);
 // region of the image as a part (write_part: .exr or .pfm, else UsageError; a part and its record
 // replace an earlier pair together or not at all). Throws OutputError, LimitError, and check_finite's
 // InternalError before anything is written.
-void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const ExrContent& content,
+void write_render(const std::filesystem::path& file, const Scene& scene, const RenderResult& result, const OutputContent& content,
                   const std::string& device);
 
 // Whether `result` is a part of a render (RenderOptions::region), written with its record.
