@@ -51,23 +51,6 @@ uint64_t first_submission_pixels(const Scene& scene, const ImageSettings& image)
   return clamped * clamped;
 }
 
-// The most samples of a pixel one dispatch traces. llvmpipe ends every loop of an invocation once
-// the invocation has made 65535 loop iterations in all (Mesa 22.3's loop limiter), without a word:
-// at 16 x 16 pixels of the Cornell box, 2048 spp in one dispatch gave an image 29% too dark (1024 did
-// not). A sample's loop iterations (the sample loop, the light loop, each ray's BVH walk) are bounded
-// by its estimated tests; a dispatch gets at most half the limit of them, and at most 64 samples.
-// A scene compiled into the shader has no walk: a ray makes no iteration, or one for each surface
-// it passes in a scene with see-through surfaces (counted as 8), and a dispatch gets at most 256
-// samples. More samples a dispatch even out what a lane's paths cost: the lanes of a batch wait for
-// the one whose paths were longest, less so the more paths each adds up (the sphere grid: 4.6%
-// fewer instructions at 256 samples a dispatch than at 32).
-// That is an estimate (a path's length is random): the shader says when its loops were cut short
-// (VKRAY_LOOPS_CUT_SHORT), and the tile is traced again with half as many samples a dispatch.
-uint32_t samples_in_one_dispatch(const Scene& scene, const ShaderVariant& variant) {
-  if (!variant.inline_scene.empty())
-    return uint32_t(std::clamp(32768.0 / ((variant.alpha ? 8.0 : 1.0) * rays_per_sample(scene)), 1.0, 256.0));
-  return uint32_t(std::clamp(32768.0 / tests_per_sample(scene), 1.0, 64.0));
-}
 
 // Every submission after the first aims at this much device time, at the rate the ones before it
 // ran: long enough that a submission's fixed costs vanish on a fast GPU, and that llvmpipe's threads
@@ -185,6 +168,24 @@ TileConstants tile_constants(const TileRect& rect, uint32_t slot, uint64_t slot_
 }
 
 }  // namespace
+
+// The most samples of a pixel one dispatch traces. llvmpipe ends every loop of an invocation once
+// the invocation has made 65535 loop iterations in all (Mesa 22.3's loop limiter), without a word:
+// at 16 x 16 pixels of the Cornell box, 2048 spp in one dispatch gave an image 29% too dark (1024 did
+// not). A sample's loop iterations (the sample loop, the light loop, each ray's BVH walk) are bounded
+// by its estimated tests; a dispatch gets at most half the limit of them, and at most 64 samples.
+// A scene compiled into the shader has no walk: a ray makes no iteration, or one for each surface
+// it passes in a scene with see-through surfaces (counted as 8), and a dispatch gets at most 256
+// samples. More samples a dispatch even out what a lane's paths cost: the lanes of a batch wait for
+// the one whose paths were longest, less so the more paths each adds up (the sphere grid: 4.6%
+// fewer instructions at 256 samples a dispatch than at 32).
+// That is an estimate (a path's length is random): the shader says when its loops were cut short
+// (VKRAY_LOOPS_CUT_SHORT), and the tile is traced again with half as many samples a dispatch.
+uint32_t samples_in_one_dispatch(const Scene& scene, const ShaderVariant& variant) {
+  if (!variant.inline_scene.empty())
+    return uint32_t(std::clamp(32768.0 / ((variant.alpha ? 8.0 : 1.0) * rays_per_sample(scene)), 1.0, 256.0));
+  return uint32_t(std::clamp(32768.0 / tests_per_sample(scene), 1.0, 64.0));
+}
 
 // Everything one render's submissions use. Declaration order is destruction order reversed: the
 // command buffer before its pool, the descriptor set before the buffers, the pipeline and the

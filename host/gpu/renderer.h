@@ -41,6 +41,9 @@ struct TraceStats {
   uint32_t tiles = 0;
 };
 
+// The most samples of a pixel one dispatch traces for `scene` (llvmpipe's loop limit; renderer.cpp).
+uint32_t samples_in_one_dispatch(const Scene& scene, const ShaderVariant& variant);
+
 class Renderer {
  public:
   explicit Renderer(std::shared_ptr<const Context> ctx);

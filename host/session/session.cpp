@@ -7,6 +7,7 @@
 #include "base/hash.h"
 #include "base/timing.h"
 #include "bvh/bvh.h"
+#include "gpu/accumulator.h"
 #include "gpu/context.h"
 #include "gpu/scene_buffers.h"
 #include "gpu/pipeline.h"
@@ -247,6 +248,19 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
   result.stats.tiles = trace.tiles;
   result.stats.inline_scene = !request.variant.inline_scene.empty();
   return result;
+}
+
+std::unique_ptr<ProgressiveRender> Session::start_progressive(const DeviceScene& scene, const RenderOptions& options,
+                                                              double rate_hint) {
+  if (options.region) throw UsageError("a progressive render of a region");
+  if (options.aovs) throw UsageError("a progressive render of the first-hit passes");
+  const ImageSettings image = image_settings(scene.scene(), options);
+  prepare(scene, options);
+  auto accumulator = on_device([&] {
+    return std::make_unique<gpu::Accumulator>(ctx_, shaders_->pipeline, scene.buffers_, image, shader_variant(own(scene), options));
+  });
+  check_validation("progressive render setup");
+  return std::unique_ptr<ProgressiveRender>(new ProgressiveRender(std::move(accumulator), image, options.tile_timeout, rate_hint));
 }
 
 void Session::check_validation(const char* during) {

@@ -15,6 +15,7 @@
 #include "bvh/bvh.h"
 #include "gpu/device_info.h"
 #include "session/options.h"
+#include "session/progressive.h"
 
 namespace vkray {
 namespace gpu {
@@ -98,6 +99,12 @@ class Session {
   // render in the process, and a face that goes on afterwards clears it), TimeoutError (a tile
   // outlived options.tile_timeout), DeviceLostError, DeviceError, ShaderError, UsageError.
   RenderResult render(const DeviceScene& scene, const RenderOptions& options);
+  // A render that the caller advances step by step (session/progressive.h), for a viewer: its image,
+  // once done, is render()'s for the same scene and options. `rate_hint`: pixels x samples a second
+  // measured before (ProgressiveRender::rate()), to size the first step; 0: a band of rows. Not
+  // with a region or the first-hit passes (UsageError). Release it before close().
+  std::unique_ptr<ProgressiveRender> start_progressive(const DeviceScene& scene, const RenderOptions& options,
+                                                       double rate_hint = 0);
 
   // ---- Ending -----------------------------------------------------------------------------------
   // Releases the device; afterwards every call but close() throws UsageError. Throws DeviceError
