@@ -76,8 +76,6 @@ double Accumulator::submit_and_wait(const AccumulationStep& step, uint32_t sampl
   tile.row_stride = row_stride((tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y);
   tile.output_offset = step.y0 * image_.width;  // the sums hold the whole image
   tile.probe_iterations = 2;
-  const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
-  const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
   const vk::PipelineLayout layout = *trace_pipeline_->layout();
   const vk::raii::CommandBuffer& cb = command_buffer_;
   cb.reset();
@@ -88,17 +86,7 @@ double Accumulator::submit_and_wait(const AccumulationStep& step, uint32_t sampl
   cb.pipelineBarrier(vk::PipelineStageFlagBits::eHost, vk::PipelineStageFlagBits::eComputeShader, {}, from_host, {}, {});
   cb.bindPipeline(vk::PipelineBindPoint::eCompute, **pipeline_);
   cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, layout, 0, descriptors_->get(), {});
-  for (tile.sample_begin = step.sample_begin; tile.sample_begin < step.sample_end; tile.sample_begin = tile.sample_end) {
-    tile.sample_end = std::min(step.sample_end, tile.sample_begin + samples_per_dispatch);
-    if (tile.sample_begin > step.sample_begin) {
-      const vk::MemoryBarrier sums(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
-      cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {}, sums, {}, {});
-    }
-    cb.pushConstants<TileConstants>(layout, vk::ShaderStageFlagBits::eCompute, 0, tile);
-    cb.dispatch(groups_x, groups_y, 1);
-  }
-  const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
-  cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+  record_sample_dispatches(cb, layout, tile, step.sample_begin, step.sample_end, samples_per_dispatch);
   cb.end();
   const auto start = Clock::now();
   const vk::CommandBuffer raw = *cb;

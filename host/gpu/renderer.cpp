@@ -187,6 +187,25 @@ uint32_t samples_in_one_dispatch(const Scene& scene, const ShaderVariant& varian
   return uint32_t(std::clamp(32768.0 / tests_per_sample(scene), 1.0, 64.0));
 }
 
+void record_sample_dispatches(const vk::raii::CommandBuffer& cb, vk::PipelineLayout layout, TileConstants tile,
+                              uint32_t sample_begin, uint32_t sample_end, uint32_t samples_per_dispatch) {
+  const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
+  const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
+  for (tile.sample_begin = sample_begin; tile.sample_begin < sample_end; tile.sample_begin = tile.sample_end) {
+    tile.sample_end = std::min(sample_end, tile.sample_begin + samples_per_dispatch);
+    if (tile.sample_begin > sample_begin) {  // the last dispatch's sums are read by this one
+      const vk::MemoryBarrier sums(vk::AccessFlagBits::eShaderWrite,
+                                   vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
+      cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {}, sums, {}, {});
+    }
+    cb.pushConstants<TileConstants>(layout, vk::ShaderStageFlagBits::eCompute, 0, tile);
+    cb.dispatch(groups_x, groups_y, 1);
+  }
+  // The shader's writes are read by the host after the fence.
+  const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
+  cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+}
+
 // Everything one render's submissions use. Declaration order is destruction order reversed: the
 // command buffer before its pool, the descriptor set before the buffers, the pipeline and the
 // scene (and through them the device) last.
@@ -261,8 +280,6 @@ void Renderer::Frame::submit_tile(const Context& ctx, const TileRect& rect, uint
   const uint32_t slot = submitted++ % kSlots;
   slots[slot] = {rect, Clock::now()};
   TileConstants tile = tile_constants(rect, slot, plan.slot_pixels);
-  const uint32_t groups_x = (tile.width + VKRAY_WORKGROUP_X - 1) / VKRAY_WORKGROUP_X;
-  const uint32_t groups_y = (tile.height + VKRAY_WORKGROUP_Y - 1) / VKRAY_WORKGROUP_Y;
   const vk::PipelineLayout layout = *trace_pipeline->layout();
   const vk::raii::CommandBuffer& cb = command_buffers[slot];
   // The slot's command buffer and output were last used by the submission before the last, waited
@@ -271,20 +288,7 @@ void Renderer::Frame::submit_tile(const Context& ctx, const TileRect& rect, uint
   cb.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
   cb.bindPipeline(vk::PipelineBindPoint::eCompute, **pipeline);
   cb.bindDescriptorSets(vk::PipelineBindPoint::eCompute, layout, 0, descriptors->get(), {});
-  // The samples in dispatches of at most samples_per_dispatch, each continuing the last one's sums.
-  for (tile.sample_begin = 0; tile.sample_begin < samples_per_pixel; tile.sample_begin = tile.sample_end) {
-    tile.sample_end = std::min(samples_per_pixel, tile.sample_begin + samples_per_dispatch);
-    if (tile.sample_begin > 0) {  // the last dispatch's sums are read by this one
-      const vk::MemoryBarrier sums(vk::AccessFlagBits::eShaderWrite,
-                                   vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eShaderWrite);
-      cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {}, sums, {}, {});
-    }
-    cb.pushConstants<TileConstants>(layout, vk::ShaderStageFlagBits::eCompute, 0, tile);
-    cb.dispatch(groups_x, groups_y, 1);
-  }
-  // The shader's writes are read by the host after the fence.
-  const vk::MemoryBarrier to_host(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
-  cb.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, to_host, {}, {});
+  record_sample_dispatches(cb, layout, tile, 0, samples_per_pixel, samples_per_dispatch);
   cb.end();
   const vk::CommandBuffer raw = *cb;
   const vk::Fence fence = *fences[slot];

@@ -17,6 +17,7 @@
 #include "image/image.h"
 #include "image/region.h"
 #include "scene/scene.h"
+#include "shared/types.h"
 
 namespace vkray::gpu {
 
@@ -43,6 +44,12 @@ struct TraceStats {
 
 // The most samples of a pixel one dispatch traces for `scene` (llvmpipe's loop limit; renderer.cpp).
 uint32_t samples_in_one_dispatch(const Scene& scene, const ShaderVariant& variant);
+
+// Records the dispatches of samples [sample_begin, sample_end) of `tile`'s pixels, at most
+// samples_per_dispatch a dispatch, each continuing the last one's sums, then the barrier that makes
+// the sums visible to the host. The pipeline and descriptors are bound.
+void record_sample_dispatches(const vk::raii::CommandBuffer& cb, vk::PipelineLayout layout, TileConstants tile,
+                              uint32_t sample_begin, uint32_t sample_end, uint32_t samples_per_dispatch);
 
 class Renderer {
  public:
