@@ -41,10 +41,16 @@ int type_rank(vk::PhysicalDeviceType type) {
   }
 }
 
-std::optional<uint32_t> compute_queue_family(const vk::raii::PhysicalDevice& pd) {
+// A family that computes; with a surface, one that also draws (the viewer's overlay) and presents
+// to it (every desktop driver has one: the first family, as a rule).
+std::optional<uint32_t> compute_queue_family(const vk::raii::PhysicalDevice& pd, const vk::raii::SurfaceKHR* surface = nullptr) {
   const auto families = pd.getQueueFamilyProperties();
-  for (uint32_t i = 0; i < families.size(); ++i)
-    if (families[i].queueFlags & vk::QueueFlagBits::eCompute) return i;
+  for (uint32_t i = 0; i < families.size(); ++i) {
+    if (!(families[i].queueFlags & vk::QueueFlagBits::eCompute)) continue;
+    if (surface && (!(families[i].queueFlags & vk::QueueFlagBits::eGraphics) || !pd.getSurfaceSupportKHR(i, **surface)))
+      continue;
+    return i;
+  }
   return std::nullopt;
 }
 
@@ -111,7 +117,8 @@ std::vector<DeviceInfo> list_devices() {
 }
 
 Context::Context(const ContextOptions& options)
-    : log_(options.validation_log), instance_(shared_instance(log_ != nullptr)) {
+    : log_(options.validation_log),
+      instance_(shared_instance(log_ != nullptr, options.surface ? options.surface->instance_extensions : std::vector<std::string>{})) {
   if (log_) {
     using S = vk::DebugUtilsMessageSeverityFlagBitsEXT;
     using T = vk::DebugUtilsMessageTypeFlagBitsEXT;
@@ -120,6 +127,9 @@ Context::Context(const ContextOptions& options)
                                                         T::eGeneral | T::eValidation | T::ePerformance,
                                                         &on_validation_message, log_.get()));
   }
+
+  if (options.surface) surface_ = vk::raii::SurfaceKHR(instance_->instance, options.surface->create(*instance_->instance));
+  const vk::raii::SurfaceKHR* surface = options.surface ? &surface_ : nullptr;
 
   // ---- choose the physical device ----
   vk::raii::PhysicalDevices devices(instance_->instance);
@@ -139,16 +149,19 @@ Context::Context(const ContextOptions& options)
       // One line: a face prints a device error's message on one line.
       throw DeviceError("no Vulkan device matches --device \"" + options.device + "\"; available:" + names);
     }
-    if (!compute_queue_family(devices[*chosen]))
-      throw DeviceError(std::string(devices[*chosen].getProperties().deviceName.data()) + " has no compute queue");
+    if (!compute_queue_family(devices[*chosen], surface))
+      throw DeviceError(std::string(devices[*chosen].getProperties().deviceName.data()) +
+                        (surface ? " has no queue that computes, draws and presents to the window" : " has no compute queue"));
   } else {
     for (size_t i = 0; i < devices.size(); ++i) {
-      if (!compute_queue_family(devices[i]) || devices[i].getProperties().apiVersion < VK_API_VERSION_1_2) continue;
+      if (!compute_queue_family(devices[i], surface) || devices[i].getProperties().apiVersion < VK_API_VERSION_1_2) continue;
       if (!chosen || type_rank(devices[i].getProperties().deviceType) <
                          type_rank(devices[*chosen].getProperties().deviceType))
         chosen = i;
     }
-    if (!chosen) throw DeviceError("no Vulkan 1.2 device with a compute queue found");
+    if (!chosen)
+      throw DeviceError(surface ? "no Vulkan 1.2 device can both compute and present to the window"
+                                : "no Vulkan 1.2 device with a compute queue found");
   }
   info_ = describe_device(devices[*chosen], uint32_t(*chosen));
   physical_device_ = std::move(devices[*chosen]);
@@ -156,7 +169,7 @@ Context::Context(const ContextOptions& options)
   properties_ = chain.get<vk::PhysicalDeviceProperties2>().properties;
   device_name_ = properties_.deviceName.data();
   driver_name_ = chain.get<vk::PhysicalDeviceDriverProperties>().driverName.data();
-  queue_family_ = *compute_queue_family(physical_device_);
+  queue_family_ = *compute_queue_family(physical_device_, surface);
 
   // ---- logical device and queue ----
   const float priority = 1.0f;
@@ -171,6 +184,7 @@ Context::Context(const ContextOptions& options)
   } else {
     device_info.unlink<vk::PhysicalDeviceShaderClockFeaturesKHR>();
   }
+  if (surface) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
   device_info.get<vk::DeviceCreateInfo>().setPEnabledExtensionNames(extensions);
   device_ = vk::raii::Device(physical_device_, device_info.get<vk::DeviceCreateInfo>());
   queue_ = vk::raii::Queue(device_, queue_family_, 0);

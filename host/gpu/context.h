@@ -1,5 +1,6 @@
 // The Vulkan instance, the chosen physical device, the logical device and its compute queue, plus
-// the validation layer's messages. Headless: no surface, no swapchain.
+// the validation layer's messages. Headless, unless asked for a window's surface (vkray view): then
+// the queue can also draw and present to it, and the device has VK_KHR_swapchain.
 #pragma once
 
 #include <atomic>
@@ -12,6 +13,7 @@
 #include <vulkan/vulkan_raii.hpp>
 
 #include "gpu/device_info.h"
+#include "gpu/surface_request.h"
 
 namespace vkray::gpu {
 
@@ -35,6 +37,8 @@ struct ContextOptions {
   // Where the Khronos validation layer's messages go (each is also printed to stderr); null: the
   // layer is off.
   std::shared_ptr<ValidationLog> validation_log;
+  // A window to present to; null: headless.
+  std::shared_ptr<const SurfaceRequest> surface;
 };
 
 class Context {
@@ -45,6 +49,8 @@ class Context {
   const vk::raii::Device& device() const { return device_; }
   const vk::raii::PhysicalDevice& physical_device() const { return physical_device_; }
   const vk::raii::Queue& queue() const { return queue_; }
+  // The window's surface (ContextOptions::surface); null when headless.
+  const vk::raii::SurfaceKHR& surface() const { return surface_; }
   uint32_t queue_family() const { return queue_family_; }
   const vk::PhysicalDeviceLimits& limits() const { return properties_.limits; }
   const std::string& device_name() const { return device_name_; }
@@ -75,6 +81,7 @@ class Context {
   // Declaration order is destruction order reversed: the messenger outlives the device.
   std::shared_ptr<const Instance> instance_;  // the process's (gpu/instance.h)
   vk::raii::DebugUtilsMessengerEXT messenger_{nullptr};
+  vk::raii::SurfaceKHR surface_{nullptr};  // outlives the device, and the swapchains made on it
   vk::raii::PhysicalDevice physical_device_{nullptr};
   vk::PhysicalDeviceProperties properties_;
   DeviceInfo info_;

@@ -1,6 +1,8 @@
 #include "gpu/instance.h"
 
 #include <algorithm>
+#include <map>
+#include <utility>
 #include <mutex>
 #include <string>
 #include <string_view>
@@ -14,7 +16,7 @@ namespace {
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
-std::shared_ptr<Instance> make_instance(bool validation) {
+std::shared_ptr<Instance> make_instance(bool validation, const std::vector<std::string>& wanted) {
   auto result = std::make_shared<Instance>();
   const vk::raii::Context& context = result->context;
   if (context.enumerateInstanceVersion() < VK_API_VERSION_1_2)
@@ -29,6 +31,13 @@ std::shared_ptr<Instance> make_instance(bool validation) {
                         " is not installed (Debian: apt-get install vulkan-validationlayers)");
     layers.push_back(kValidationLayer);
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  const auto available = context.enumerateInstanceExtensionProperties();
+  for (const std::string& name : wanted) {
+    if (std::none_of(available.begin(), available.end(),
+                     [&](const vk::ExtensionProperties& e) { return name == e.extensionName.data(); }))
+      throw DeviceError("the Vulkan loader lacks the instance extension " + name + ", which a window needs");
+    extensions.push_back(name.c_str());
   }
   const vk::ApplicationInfo app("vkray", 1, "vkray", 1, VK_API_VERSION_1_2);
   // Synchronization validation on top of the default checks: a missing barrier is a bug too.
@@ -47,7 +56,9 @@ std::shared_ptr<Instance> make_instance(bool validation) {
 // ever for its first submission; they are left as they are, never used nor destroyed there.
 struct Instances {
   std::mutex mutex;  // a fresh one in a forked child: a parent's thread may have held this one
-  std::shared_ptr<Instance> slots[2];  // without, with validation
+  // By validation and the extensions asked for: without and with validation for a headless device,
+  // and the same for each window system's set (one, in a process with a window).
+  std::map<std::pair<bool, std::vector<std::string>>, std::shared_ptr<Instance>> slots;
 };
 Instances& instances() {
   static PerProcess<Instances> all;
@@ -61,11 +72,11 @@ std::string api_version_string(uint32_t v) {
          std::to_string(VK_API_VERSION_PATCH(v));
 }
 
-std::shared_ptr<const Instance> shared_instance(bool validation) {
+std::shared_ptr<const Instance> shared_instance(bool validation, const std::vector<std::string>& extensions) {
   Instances& all = instances();
   const std::lock_guard lock(all.mutex);
-  auto& slot = all.slots[validation ? 1 : 0];
-  if (!slot) slot = make_instance(validation);
+  auto& slot = all.slots[{validation, extensions}];
+  if (!slot) slot = make_instance(validation, extensions);
   return slot;
 }
 

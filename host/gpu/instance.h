@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <vulkan/vulkan_raii.hpp>
 
@@ -30,9 +31,11 @@ struct Instance {
 };
 
 // The instance for `validation` (VK_LAYER_KHRONOS_validation with synchronization validation and
-// VK_EXT_debug_utils, or neither). Throws DeviceError when the loader is older than Vulkan 1.2 or the
-// layer is missing; a later call tries again. Thread-safe; in a forked child, the child's own.
-std::shared_ptr<const Instance> shared_instance(bool validation);
+// VK_EXT_debug_utils, or neither), with `extensions` besides (a window system's, for a surface: one
+// instance for each set asked for). Throws DeviceError when the loader is older than Vulkan 1.2, or
+// the layer or an extension is missing; a later call tries again. Thread-safe; in a forked child, the
+// child's own.
+std::shared_ptr<const Instance> shared_instance(bool validation, const std::vector<std::string>& extensions = {});
 
 // A Vulkan version number as "1.3.230".
 std::string api_version_string(uint32_t version);

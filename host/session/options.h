@@ -6,12 +6,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 
 #include "base/errors.h"
 #include "base/threads.h"
+#include "gpu/surface_request.h"
 #include "image/aovs.h"
 #include "image/image.h"
 #include "scene/scene.h"
@@ -56,6 +58,8 @@ struct SessionOptions {
   std::string device;                // index or part of the name (`vkray devices`); empty: the best device
   bool validation = false;           // the Khronos validation layer; any message it prints is an error
   std::filesystem::path shader_dir;  // trace.comp and its includes; empty: the installed (or source) shaders
+  // A window the device presents to (vkray view); null: headless.
+  std::shared_ptr<const gpu::SurfaceRequest> surface;
 };
 
 // How the GPU path traces a scene of at most kMaxInlinePrimitives primitives.

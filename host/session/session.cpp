@@ -63,6 +63,7 @@ Session::Session(const SessionOptions& options)
   context_options.device = options.device;
   if (options.validation) validation_log_ = std::make_shared<gpu::ValidationLog>();
   context_options.validation_log = validation_log_;
+  context_options.surface = options.surface;
   ctx_ = std::make_shared<const gpu::Context>(context_options);
   shaders_ = std::make_unique<Shaders>();
   shaders_->cache = std::make_shared<const vk::raii::PipelineCache>(ctx_->device(), vk::PipelineCacheCreateInfo{});

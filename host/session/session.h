@@ -112,7 +112,8 @@ class Session {
   // included. Every DeviceScene must be released first (InternalError otherwise).
   void close();
 
-  // The device itself, for tests that run kernels of their own on it.
+  // The device itself, for tests that run kernels of their own on it, and for a viewer's swapchain
+  // (SessionOptions::surface) on its queue.
   const gpu::Context& context() const { return device(); }
 
  private:
