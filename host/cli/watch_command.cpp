@@ -12,7 +12,7 @@
 #include "base/interrupt.h"
 #include "base/timing.h"
 #include "cli/commands.h"
-#include "cli/file_watcher.h"
+#include "base/file_watcher.h"
 #include "cli/flags.h"
 #include "cli/report.h"
 #include "image/image.h"

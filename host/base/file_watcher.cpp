@@ -1,4 +1,4 @@
-#include "cli/file_watcher.h"
+#include "base/file_watcher.h"
 
 #include <poll.h>
 #include <sys/inotify.h>
@@ -75,7 +75,6 @@ bool FileWatcher::relevant(const std::filesystem::path& file) const {
 
 std::vector<std::filesystem::path> FileWatcher::wait(std::chrono::milliseconds settle, int stop_fd) {
   std::set<std::filesystem::path> changed;
-  alignas(inotify_event) char buffer[16384];
   for (;;) {
     pollfd fds[] = {{fd_, POLLIN, 0}, {stop_fd, POLLIN, 0}};
     // Block until the first change; after it, wait only `settle` for more.
@@ -86,19 +85,38 @@ std::vector<std::filesystem::path> FileWatcher::wait(std::chrono::milliseconds s
     if (ready < 0) throw InternalError(std::string("cannot wait for file changes: poll: ") + std::strerror(errno));
     if (fds[1].revents & POLLIN) return {};
     if (ready == 0) return {changed.begin(), changed.end()};  // settled
-    for (;;) {
-      const ssize_t n = ::read(fd_, buffer, sizeof buffer);
-      if (n <= 0) break;
-      for (ssize_t at = 0; at < n;) {
-        const auto* event = reinterpret_cast<const inotify_event*>(buffer + at);
-        at += static_cast<ssize_t>(sizeof(inotify_event) + event->len);
-        const auto folder = watches_.find(event->wd);
-        if (folder == watches_.end() || event->len == 0) continue;
-        const std::filesystem::path file = folder->second / event->name;
-        if (relevant(file)) changed.insert(file);
+    read_events(changed);
+  }
+}
+
+bool FileWatcher::read_events(std::set<std::filesystem::path>& changed) {
+  alignas(inotify_event) char buffer[16384];
+  bool any = false;
+  for (;;) {
+    const ssize_t n = ::read(fd_, buffer, sizeof buffer);
+    if (n <= 0) break;
+    for (ssize_t at = 0; at < n;) {
+      const auto* event = reinterpret_cast<const inotify_event*>(buffer + at);
+      at += static_cast<ssize_t>(sizeof(inotify_event) + event->len);
+      const auto folder = watches_.find(event->wd);
+      if (folder == watches_.end() || event->len == 0) continue;
+      const std::filesystem::path file = folder->second / event->name;
+      if (relevant(file)) {
+        changed.insert(file);
+        any = true;
       }
     }
   }
+  return any;
+}
+
+std::vector<std::filesystem::path> FileWatcher::poll(std::chrono::milliseconds settle) {
+  const auto now = std::chrono::steady_clock::now();
+  if (read_events(pending_)) last_change_ = now;
+  if (pending_.empty() || now - last_change_ < settle) return {};
+  std::vector<std::filesystem::path> changed(pending_.begin(), pending_.end());
+  pending_.clear();
+  return changed;
 }
 
 }  // namespace vkray

@@ -28,6 +28,9 @@ class FileWatcher {
   // write in several steps), or until `stop_fd` is readable. Returns the changed files, or nothing
   // when stopped.
   std::vector<std::filesystem::path> wait(std::chrono::milliseconds settle, int stop_fd);
+  // Without blocking: the files changed since the last call that returned some, once nothing more
+  // has changed for `settle`; nothing otherwise (a loop that draws frames calls it every frame).
+  std::vector<std::filesystem::path> poll(std::chrono::milliseconds settle);
 
   size_t file_count() const { return files_.size(); }
   size_t folder_count() const { return watches_.size(); }
@@ -41,6 +44,11 @@ class FileWatcher {
   std::filesystem::path folder_;
   std::set<std::string> folder_extensions_;
   std::map<int, std::filesystem::path> watches_;  // inotify watch descriptor -> folder
+  // poll()'s changes not yet returned, and when the last of them came.
+  std::set<std::filesystem::path> pending_;
+  std::chrono::steady_clock::time_point last_change_;
+  // Reads the events waiting (without blocking) into `changed`; returns whether any was relevant.
+  bool read_events(std::set<std::filesystem::path>& changed);
 };
 
 }  // namespace vkray
