@@ -8,6 +8,7 @@
 
 #include "base/checked.h"
 #include "base/interrupt.h"
+#include "scene/camera.h"
 #include "load/environment_file.h"
 #include "scene/transform.h"
 
@@ -82,12 +83,8 @@ void SceneParser::parse_camera(const Value& v) {
   check_coordinates(v["position"], cam.position, "the camera");
 
   // A direction is judged in double, where any finite float vector has a finite, non-zero length
-  // unless it is zero (in float, the square of 1e20 overflows and that of 1e-30 vanishes). Its
-  // value stays the float computation wherever that is finite, as it always was.
-  const auto unit = [](glm::vec3 d) {
-    const float length = glm::length(d);
-    return length > 0.0f && std::isfinite(length) ? d / length : glm::vec3(glm::normalize(glm::dvec3(d)));
-  };
+  // unless it is zero; its value is unit_direction's (scene/camera.h).
+  const auto unit = [](glm::vec3 d) { return unit_direction(d); };
   const bool by_target = one_of(v, "look_at", "direction");
   const Value aim = by_target ? v["look_at"] : v["direction"];
   if (by_target) check_coordinates(aim, three_numbers(aim), "look_at");

@@ -1,5 +1,7 @@
 #include "scene/camera.h"
 
+#include <cmath>
+
 namespace vkray {
 
 CameraBasis camera_basis(const Camera& camera, uint32_t image_height) {
@@ -10,6 +12,11 @@ CameraBasis camera_basis(const Camera& camera, uint32_t image_height) {
   basis.up = glm::cross(basis.right, basis.forward);
   basis.focal_px = camera.focal_length * static_cast<float>(image_height);
   return basis;
+}
+
+glm::vec3 unit_direction(glm::vec3 d) {
+  const float length = glm::length(d);
+  return length > 0.0f && std::isfinite(length) ? d / length : glm::vec3(glm::normalize(glm::dvec3(d)));
 }
 
 SampleStrata sample_strata(uint32_t samples_per_pixel) {

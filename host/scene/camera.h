@@ -20,6 +20,12 @@ struct CameraBasis {
 
 CameraBasis camera_basis(const Camera& camera, uint32_t image_height);
 
+// The camera's view direction for a scene file's "direction", or its look_at minus its position:
+// `d` over its float length where that is finite and non-zero, else normalized in double (in float,
+// the square of 1e20 overflows and that of 1e-30 vanishes). The one place this is computed, so that
+// a camera written out by `vkray view` (position and look_at) reads back to the same bits.
+glm::vec3 unit_direction(glm::vec3 d);
+
 struct SampleStrata {
   uint32_t x = 1, y = 1;  // x * y >= spp, x = ceil(sqrt(spp)), y = ceil(spp / x)
   float inv_x = 1.0f, inv_y = 1.0f;
