@@ -18,7 +18,7 @@ std::unique_ptr<CommandLine> make_command_line() {
   app.footer(kExitCodes);
   app.set_version_flag("--version", std::string("vkray ") + version_string());
   app.require_subcommand(1);
-  line->commands = {add_render_command(app), add_merge_command(app), add_parity_command(app), add_check_command(app), add_watch_command(app),
+  line->commands = {add_render_command(app), add_merge_command(app), add_parity_command(app), add_check_command(app), add_watch_command(app), add_view_command(app),
                     add_bench_command(app), add_devices_command(app)};
   apply_value_rules(app);
   return line;

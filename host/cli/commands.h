@@ -22,6 +22,7 @@ Command add_render_command(CLI::App& app);
 Command add_parity_command(CLI::App& app);
 Command add_check_command(CLI::App& app);
 Command add_watch_command(CLI::App& app);
+Command add_view_command(CLI::App& app);
 Command add_bench_command(CLI::App& app);
 Command add_devices_command(CLI::App& app);
 Command add_merge_command(CLI::App& app);
