@@ -113,11 +113,31 @@ TEST_F(ProgressiveTest, ImageSoFarIsEachPixelsMeanOfItsSamples) {
     }
 }
 
-TEST_F(ProgressiveTest, RefusesRegionsAndPasses) {
+TEST_F(ProgressiveTest, FirstHitPassesEndAtTheRendersBitForBit) {
+  const auto scene = shipped("depth-of-field.json");
+  const DeviceScene on_device = session().upload(scene);
+  RenderOptions options = with_image({}, {40, 32, 4});
+  options.aovs = true;
+  const RenderResult rendered = session().render(on_device, options);
+  auto progressive = session().start_progressive(on_device, options);
+  ASSERT_TRUE(progressive->has_aovs());
+  run_to_end(*progressive, bands_then_two_samples_then_bands(4));
+  Image shown;
+  progressive->image(shown);
+  EXPECT_TRUE(same_bits(shown, rendered.image));
+  Aovs passes;
+  progressive->aovs(passes);
+  const Aovs& want = *rendered.aovs;
+  EXPECT_TRUE(passes.albedo == want.albedo && passes.normal == want.normal && passes.position == want.position);
+  EXPECT_EQ(std::memcmp(passes.depth.data(), want.depth.data(), want.depth.size() * sizeof(float)), 0);
+  EXPECT_TRUE(passes.object == want.object);
+}
+
+TEST_F(ProgressiveTest, RefusesRegions) {
   const auto scene = shipped("cornell.json");
   const DeviceScene on_device = session().upload(scene);
   RenderOptions options = with_image({}, {16, 16, 1});
-  options.aovs = true;
+  options.region = PixelRegion{0, 0, 8, 8};
   EXPECT_THROW(session().start_progressive(on_device, options), UsageError);
 }
 

@@ -6,6 +6,7 @@
 #include "base/errors.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
+#include "image/aovs.h"
 #include "image/image_file.h"
 #include "session/parts.h"
 #ifdef VKRAY_HAVE_VIEWER
@@ -21,6 +22,8 @@ struct ViewArgs {
   GpuFlags gpu;
   DisplayFlags display;
   std::filesystem::path output;  // empty: <scene name>.png in the current folder
+  std::string aovs;              // --aov: first-hit passes for an .exr, comma-separated
+  bool exr_float = false;
   bool exit_when_done = false;
   std::filesystem::path frame_log;
 };
@@ -34,7 +37,13 @@ int run_view(const ViewArgs& args) {
   options.render = render_options(&args.scene, &args.gpu, nullptr);
   options.output = args.output.empty() ? std::filesystem::path(options.scene.stem().string() + ".png") : args.output;
   options.content.display = args.display.display;
-  check_render_output(options.output, options.content, false);
+  options.content.full_float = args.exr_float;
+  check_output_image(options.output);  // before the passes' names: one order of checks for every face
+  if (!args.aovs.empty()) options.content.passes = parse_aov_list(args.aovs);
+  // --tonemap and --exposure are the window's too: an EXR or PFM output is saved linear, not refused.
+  OutputContent saved = options.content;
+  if (image_file_type(options.output) != ImageFileType::png) saved.display = {};
+  check_render_output(options.output, saved, false);
   options.exit_when_done = args.exit_when_done;
   options.frame_log = args.frame_log;
   return view::run_viewer(options);
@@ -55,8 +64,11 @@ Command add_view_command(CLI::App& app) {
               "mouse (F1 lists them), save with P; the scene and the shaders reload in place when they change.");
   add_scene_flags(*command, args->scene);
   command->add_option("-o,--output", args->output,
-                      "What P saves: .png (as the window shows it), .pfm or .exr (linear radiance); default: <scene "
-                      "name>.png in the current folder");
+                      "What P saves: .png (as the window shows it), .pfm or .exr (linear radiance, with --aov's "
+                      "passes); default: <scene name>.png in the current folder");
+  command->add_option("--aov", args->aovs, "First-hit passes to accumulate and add to an .exr as layers, "
+                                           "comma-separated: albedo, normal, position, depth, object");
+  command->add_flag("--exr-float", args->exr_float, "Write an .exr with 32-bit float channels instead of 16-bit half");
   add_display_flags(*command, args->display);
   add_device_flags(*command, args->device);
   add_gpu_flags(*command, args->gpu);

@@ -22,9 +22,9 @@ constexpr std::chrono::milliseconds kTeardownWait{60000};
 Accumulator::Accumulator(std::shared_ptr<const Context> ctx, std::shared_ptr<const TracePipeline> trace_pipeline,
                          std::shared_ptr<const SceneBuffers> scene, const ImageSettings& image, const ShaderVariant& variant)
     : ctx_(std::move(ctx)), trace_pipeline_(std::move(trace_pipeline)), scene_(std::move(scene)), image_(image) {
-  if (variant.aovs) throw InternalError("an accumulation with first-hit passes");
+  aovs_ = variant.aovs;
   const uint64_t pixels = uint64_t(image.width) * image.height;
-  const uint64_t bytes = pixels * sizeof(glm::vec4);
+  const uint64_t bytes = pixels * (aovs_ ? sizeof(FirstHitTexels) : sizeof(glm::vec4));  // the larger
   if (bytes > ctx_->limits().maxStorageBufferRange)
     throw DeviceError("a " + std::to_string(image.width) + " x " + std::to_string(image.height) + " image's sums (" +
                       std::to_string(bytes) + " bytes) do not fit one storage buffer of " + ctx_->device_name() +
@@ -34,8 +34,10 @@ Accumulator::Accumulator(std::shared_ptr<const Context> ctx, std::shared_ptr<con
   const FrameUniforms frame = pack_frame(scene_->scene(), scene_->primitive_count(), scene_->lighting(), image);
   uniforms_ = upload_buffer(*ctx_, &frame, sizeof(frame), vk::BufferUsageFlagBits::eUniformBuffer);
   using M = vk::MemoryPropertyFlagBits;
-  output_ = create_buffer(*ctx_, bytes, vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
-  aov_output_ = create_buffer(*ctx_, sizeof(FirstHitTexels), vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible, M::eHostCached);
+  output_ = create_buffer(*ctx_, pixels * sizeof(glm::vec4), vk::BufferUsageFlagBits::eStorageBuffer, M::eHostVisible,
+                          M::eHostCached);
+  aov_output_ = create_buffer(*ctx_, (aovs_ ? pixels : 1) * sizeof(FirstHitTexels), vk::BufferUsageFlagBits::eStorageBuffer,
+                              M::eHostVisible, M::eHostCached);
   DescriptorWriter writer = trace_pipeline_->descriptors().writer();
   writer.buffer(VKRAY_BINDING_FRAME, *uniforms_.buffer).buffer(VKRAY_BINDING_OUTPUT, *output_.buffer);
   writer.buffer(VKRAY_BINDING_AOVS, *aov_output_.buffer);
@@ -60,6 +62,8 @@ Accumulator::~Accumulator() {
   // Still running: what it uses is never destroyed under it.
   static_cast<void>(output_.buffer.release());
   static_cast<void>(output_.memory.release());
+  static_cast<void>(aov_output_.buffer.release());
+  static_cast<void>(aov_output_.memory.release());
   static_cast<void>(command_buffer_.release());
   static_cast<void>(command_pool_.release());
   static_cast<void>(fence_.release());
@@ -123,6 +127,11 @@ double Accumulator::trace(const AccumulationStep& step, std::chrono::millisecond
   output_.invalidate(ctx_->device());
   const auto* texels = static_cast<glm::vec4*>(output_.mapped);
   saved_.assign(texels + first, texels + first + count);
+  if (aovs_) {
+    aov_output_.invalidate(ctx_->device());
+    const auto* first_hits = static_cast<const FirstHitTexels*>(aov_output_.mapped);
+    saved_aovs_.assign(first_hits + first, first_hits + first + count);
+  }
   uint64_t rays_before = 0;
   if (step.sample_begin > 0)
     for (const glm::vec4& t : saved_) rays_before += std::bit_cast<uint32_t>(t.w);
@@ -141,6 +150,11 @@ double Accumulator::trace(const AccumulationStep& step, std::chrono::millisecond
     std::memcpy(static_cast<glm::vec4*>(output_.mapped) + first, saved_.data(), count * sizeof(glm::vec4));
     if (!output_.coherent)
       ctx_->device().flushMappedMemoryRanges(vk::MappedMemoryRange(*output_.memory, 0, VK_WHOLE_SIZE));
+    if (aovs_) {
+      std::memcpy(static_cast<FirstHitTexels*>(aov_output_.mapped) + first, saved_aovs_.data(), count * sizeof(FirstHitTexels));
+      if (!aov_output_.coherent)
+        ctx_->device().flushMappedMemoryRanges(vk::MappedMemoryRange(*aov_output_.memory, 0, VK_WHOLE_SIZE));
+    }
   }
 }
 
@@ -151,6 +165,15 @@ void Accumulator::read(uint32_t y0, uint32_t y1, Image& sums) const {
   const auto* texels = static_cast<const glm::vec4*>(output_.mapped);
   const RadianceUnscale unscale(scene_->lighting().radiance_exponent);
   for (size_t i = size_t(y0) * image_.width; i < size_t(y1) * image_.width; ++i) sums.pixels[i] = unscale(glm::vec3(texels[i]));
+}
+
+void Accumulator::read_aovs(uint32_t y0, uint32_t y1, Aovs& aovs) const {
+  if (!aovs_ || aovs.width != image_.width || aovs.height != image_.height || y1 > image_.height)
+    throw InternalError("an accumulation's first-hit passes read without passes, or into passes of another size");
+  aov_output_.invalidate(ctx_->device());
+  const auto* first_hits = static_cast<const FirstHitTexels*>(aov_output_.mapped);
+  for (uint32_t y = y0; y < y1; ++y)
+    for (uint32_t x = 0; x < image_.width; ++x) aovs.set(x, y, first_hit_sums(first_hits[size_t(y) * image_.width + x]));
 }
 
 }  // namespace vkray::gpu

@@ -14,7 +14,9 @@
 #include "gpu/context.h"
 #include "gpu/pipeline.h"
 #include "gpu/scene_buffers.h"
+#include "image/aovs.h"
 #include "image/image.h"
+#include "shared/first_hit_layout.h"
 
 namespace vkray::gpu {
 
@@ -47,6 +49,11 @@ class Accumulator {
   // Renderer::render returns them): each the sum of a pixel's samples so far, each over the whole
   // render's sample count.
   void read(uint32_t y0, uint32_t y1, Image& sums) const;
+  // The first-hit passes of rows [y0, y1) into the same rows of `aovs` (width x height), each the
+  // mean over the samples so far that hit something, as Renderer::render gives them. Only when made
+  // with ShaderVariant::aovs.
+  void read_aovs(uint32_t y0, uint32_t y1, Aovs& aovs) const;
+  bool has_aovs() const { return aovs_; }
   // Camera and shadow rays traced so far.
   uint64_t rays() const { return rays_; }
 
@@ -66,13 +73,16 @@ class Accumulator {
   uint32_t samples_per_dispatch_;
   Buffer uniforms_;
   Buffer output_;      // the sums: one vec4 per pixel, host-visible
-  Buffer aov_output_;  // a placeholder: a viewer asks for no first-hit passes
+  bool aovs_ = false;
+  Buffer aov_output_;  // the first-hit sums, one FirstHitTexels per pixel (a placeholder without passes)
   std::optional<DescriptorSet> descriptors_;
   vk::raii::CommandPool command_pool_{nullptr};
   vk::raii::CommandBuffer command_buffer_{nullptr};
   vk::raii::Fence fence_{nullptr};
   bool in_flight_ = false;
-  std::vector<glm::vec4> saved_;  // the step's rows as they were, put back when its loops were cut short
+  // The step's rows as they were, put back when its loops were cut short.
+  std::vector<glm::vec4> saved_;
+  std::vector<FirstHitTexels> saved_aovs_;
   uint64_t rays_ = 0;
 };
 

@@ -62,17 +62,6 @@ constexpr double kSubmissionSeconds = 0.4;
 // The most pixels a submission (an output slot) holds: 64 MiB a slot, two slots.
 constexpr uint64_t kMostSlotPixels = uint64_t(1) << 22;
 
-// A pixel's first-hit sums as the shader left them.
-FirstHitSums first_hit_sums(const FirstHitTexels& texels) {
-  FirstHitSums sums;
-  sums.albedo = first_hit_albedo(texels);
-  sums.hits = first_hit_count(texels);
-  sums.normal = first_hit_normal(texels);
-  sums.object = first_hit_object(texels);
-  sums.position = first_hit_position(texels);
-  sums.depth = first_hit_depth(texels);
-  return sums;
-}
 
 bool is_timeout(const std::exception_ptr& error) {
   try {
@@ -168,6 +157,17 @@ TileConstants tile_constants(const TileRect& rect, uint32_t slot, uint64_t slot_
 }
 
 }  // namespace
+
+FirstHitSums first_hit_sums(const FirstHitTexels& texels) {
+  FirstHitSums sums;
+  sums.albedo = first_hit_albedo(texels);
+  sums.hits = first_hit_count(texels);
+  sums.normal = first_hit_normal(texels);
+  sums.object = first_hit_object(texels);
+  sums.position = first_hit_position(texels);
+  sums.depth = first_hit_depth(texels);
+  return sums;
+}
 
 // The most samples of a pixel one dispatch traces. llvmpipe ends every loop of an invocation once
 // the invocation has made 65535 loop iterations in all (Mesa 22.3's loop limiter), without a word:

@@ -17,6 +17,7 @@
 #include "image/image.h"
 #include "image/region.h"
 #include "scene/scene.h"
+#include "shared/first_hit_layout.h"
 #include "shared/types.h"
 
 namespace vkray::gpu {
@@ -41,6 +42,9 @@ struct TraceStats {
   uint64_t rays = 0;  // camera rays + shadow rays
   uint32_t tiles = 0;
 };
+
+// A pixel's first-hit sums as the shader left them.
+FirstHitSums first_hit_sums(const FirstHitTexels& texels);
 
 // The most samples of a pixel one dispatch traces for `scene` (llvmpipe's loop limit; renderer.cpp).
 uint32_t samples_in_one_dispatch(const Scene& scene, const ShaderVariant& variant);

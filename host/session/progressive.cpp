@@ -73,4 +73,13 @@ void ProgressiveRender::image(Image& image) const {
   mean_of(rows_ahead_, settings_.height, samples_);
 }
 
+bool ProgressiveRender::has_aovs() const { return accumulator_->has_aovs(); }
+
+void ProgressiveRender::aovs(Aovs& aovs) const {
+  if (aovs.width != settings_.width || aovs.height != settings_.height) aovs = Aovs(settings_.width, settings_.height);
+  // Rows with at least one sample: those ahead of the band, and all of them after a whole sample.
+  const uint32_t rows = samples_ > 0 ? settings_.height : rows_ahead_;
+  if (rows > 0) accumulator_->read_aovs(0, rows, aovs);
+}
+
 }  // namespace vkray

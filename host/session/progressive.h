@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "image/aovs.h"
 #include "image/image.h"
 #include "scene/scene.h"
 
@@ -38,6 +39,11 @@ class ProgressiveRender {
   // The image so far into `image` (settings' width x height): each pixel's mean of its samples.
   // Rows without a sample yet are left as they were.
   void image(Image& image) const;
+  // With RenderOptions::aovs: the first-hit passes so far into `aovs` (settings' size), each the mean
+  // over the samples that hit something; once done(), Session::render's. Rows without a sample yet
+  // are left as they were.
+  bool has_aovs() const;
+  void aovs(Aovs& aovs) const;
 
   // Pixels x samples a second, as the last steps ran (0 before the first).
   double rate() const { return rate_; }

@@ -254,7 +254,6 @@ RenderResult Session::render(const DeviceScene& scene, const RenderOptions& opti
 std::unique_ptr<ProgressiveRender> Session::start_progressive(const DeviceScene& scene, const RenderOptions& options,
                                                               double rate_hint) {
   if (options.region) throw UsageError("a progressive render of a region");
-  if (options.aovs) throw UsageError("a progressive render of the first-hit passes");
   const ImageSettings image = image_settings(scene.scene(), options);
   prepare(scene, options);
   auto accumulator = on_device([&] {

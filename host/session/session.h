@@ -101,8 +101,9 @@ class Session {
   RenderResult render(const DeviceScene& scene, const RenderOptions& options);
   // A render that the caller advances step by step (session/progressive.h), for a viewer: its image,
   // once done, is render()'s for the same scene and options. `rate_hint`: pixels x samples a second
-  // measured before (ProgressiveRender::rate()), to size the first step; 0: a band of rows. Not
-  // with a region or the first-hit passes (UsageError). Release it before close().
+  // measured before (ProgressiveRender::rate()), to size the first step; 0: a band of rows. With
+  // options.aovs it accumulates the first-hit passes too. Not with a region (UsageError). Release it
+  // before close().
   std::unique_ptr<ProgressiveRender> start_progressive(const DeviceScene& scene, const RenderOptions& options,
                                                        double rate_hint = 0);
 
