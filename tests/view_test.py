@@ -195,6 +195,52 @@ def test_accumulation_ends_at_the_render_bit_for_bit(display, tmp_path, scene, s
     assert (tmp_path / "view.pfm").read_bytes() == (tmp_path / "render.pfm").read_bytes()
 
 
+def read_exr_channels(path):
+    import OpenImageIO as oiio
+    image = oiio.ImageInput.open(str(path))
+    assert image, oiio.geterror()
+    names = list(image.spec().channelnames)
+    pixels = image.read_image("float")
+    image.close()
+    return names, pixels
+
+
+def test_first_hit_passes_accumulate_into_the_renders_exr(display, tmp_path):
+    size = ["--width", "72", "--height", "48", "--spp", "4"]
+    passes = ["--aov", "albedo,normal,position,depth,object", "--exr-float"]
+    viewer = Viewer(display, [str(SCENES / "depth-of-field.json"), *size, *passes, "-o", "view.exr", "--exit-when-done",
+                              "--validate"], tmp_path)
+    assert viewer.process.wait(120) == 0, viewer.output()
+    viewer.close()
+    assert_no_validation_messages(viewer)
+    render(SCENES / "depth-of-field.json", tmp_path / "render.exr", *size, *passes)
+    view_names, view_pixels = read_exr_channels(tmp_path / "view.exr")
+    render_names, render_pixels = read_exr_channels(tmp_path / "render.exr")
+    assert view_names == render_names and "depth.Z" in view_names
+    assert np.array_equal(view_pixels, render_pixels, equal_nan=True)
+
+
+def test_the_render_follows_the_windows_size(display, tmp_path):
+    log = tmp_path / "frames.jsonl"
+    viewer = Viewer(display, [str(SCENES / "cornell.json"), "--width", "64", "--height", "48", "--spp", "2", "-o",
+                              "view.pfm", "--frame-log", str(log), "--validate"], tmp_path)
+    result = viewer._xdotool("windowsize", viewer.window, "80", "40")
+    assert result.returncode == 0, result.stderr
+    deadline = time.time() + 60
+    while time.time() < deadline:
+        lines = log.read_text().splitlines() if log.exists() else []
+        if lines and json.loads(lines[-1])["width"] == 80 and json.loads(lines[-1])["samples"] == 2:
+            break
+        time.sleep(0.1)
+    viewer.keys("p")
+    viewer.wait_line(r"wrote view\.pfm \(2 of 2 samples\)")
+    assert viewer.close() == 0, viewer.output()
+    assert_no_validation_messages(viewer)
+    assert read_pfm(tmp_path / "view.pfm").shape == (40, 80, 3)
+    render(SCENES / "cornell.json", tmp_path / "render.pfm", "--width", "80", "--height", "40", "--spp", "2")
+    assert (tmp_path / "view.pfm").read_bytes() == (tmp_path / "render.pfm").read_bytes()
+
+
 def test_a_scripted_session_saves_what_render_renders_of_the_same_view(display, tmp_path):
     # The lab's scene: keys move the camera and the light, the mouse orbits and zooms, I switches to
     # the path tracer; then the overlay is hidden, and the image and the window saved. The saved image

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -17,9 +18,13 @@ glm::vec3 rotate(glm::vec3 v, glm::vec3 axis, float radians) {
   return v * c + glm::cross(axis, v) * s + axis * glm::dot(axis, v) * (1.0f - c);
 }
 
+// The shortest decimal that reads back as the same float (9 significant digits always do).
 std::string number(float v) {
   char text[32];
-  std::snprintf(text, sizeof text, "%.9g", double(v));
+  for (int digits = 6; digits <= 9; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, double(v));
+    if (std::strtof(text, nullptr) == v) break;
+  }
   return text;
 }
 

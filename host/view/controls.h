@@ -52,7 +52,7 @@ float zoom(Camera& camera, float distance, float notches);
 glm::vec3 settle(Camera& camera, float distance);
 
 // The camera as a scene file's "camera" object, to paste into one: position, look_at, up,
-// focal_length (and the lens). Numbers to 9 significant digits, which give a float back exactly.
+// focal_length (and the lens). Each number the shortest decimal that reads back as the same float.
 std::string camera_json(const Camera& camera, glm::vec3 look_at);
 // A point's coordinates the same way: "[x, y, z]".
 std::string point_json(glm::vec3 p);

@@ -83,7 +83,7 @@ void Overlay::build(const OverlayContent& content) {
   ImGui::NewFrame();
   if (content.show) {
     ImGui::SetNextWindowPos(ImVec2(8, 8));
-    ImGui::SetNextWindowBgAlpha(0.6f);
+    ImGui::SetNextWindowBgAlpha(0.75f);
     ImGui::Begin("status", nullptr, kPanel);
     for (const std::string& line : content.status) ImGui::TextUnformatted(line.c_str());
     ImGui::Separator();

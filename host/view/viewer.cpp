@@ -11,6 +11,8 @@
 #include <vector>
 
 #include <GLFW/glfw3.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "base/errors.h"
 #include "base/file_watcher.h"
@@ -35,7 +37,7 @@ using Seconds = std::chrono::duration<double>;
 // Work a frame may hold while the user is moving things (so that the window answers within a frame
 // or two), and once input has been still for kSettle (more samples a frame, fewer frames to pay for).
 constexpr Seconds kInteractiveBudget{0.025};
-constexpr Seconds kSettledBudget{0.06};
+constexpr Seconds kSettledBudget{0.04};
 constexpr Seconds kSettle{0.5};
 // How long a frame waits for input when there is nothing to render: the file watcher is polled this often.
 constexpr double kIdleWait = 0.05;
@@ -181,6 +183,7 @@ Viewer::Viewer(const ViewerOptions& options)
       output_(options.output),
       display_(options.content.display) {
   check_output_image(output_);  // before the window: a typo costs nothing
+  options_.render.aovs = !options_.content.passes.empty();  // accumulated with the image, for an EXR
   options_.session.shader_dir =
       absolute_normal(options_.session.shader_dir.empty() ? default_shader_dir() : options_.session.shader_dir);
   load_scene_file();  // a broken scene is reported before any window opens
@@ -536,15 +539,18 @@ void Viewer::update_pixels() {
   if (image_.width != width_ || image_.height != height_) return;  // nothing rendered at this size yet
   pixels_.resize(size_t(width_) * height_ * 4);
   const bool bgra = presenter_->order() == PixelOrder::bgra;
-  uint8_t rgb[3];
-  for (size_t i = 0; i < image_.pixels.size(); ++i) {
-    display_.encode(image_.pixels[i], rgb);
-    uint8_t* out = &pixels_[i * 4];
-    out[0] = rgb[bgra ? 2 : 0];
-    out[1] = rgb[1];
-    out[2] = rgb[bgra ? 0 : 2];
-    out[3] = 255;
-  }
+  // On every core: between two steps the device waits for this (on lavapipe, its threads are the cores).
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, image_.pixels.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+    uint8_t rgb[3];
+    for (size_t i = range.begin(); i < range.end(); ++i) {
+      display_.encode(image_.pixels[i], rgb);
+      uint8_t* out = &pixels_[i * 4];
+      out[0] = rgb[bgra ? 2 : 0];
+      out[1] = rgb[1];
+      out[2] = rgb[bgra ? 0 : 2];
+      out[3] = 255;
+    }
+  });
 }
 
 std::string Viewer::view_json() const {
@@ -566,7 +572,7 @@ OverlayContent Viewer::overlay_content() const {
                                                                                : "samples -");
   }
   content.status.push_back("frame " + fixed(frame_ms_, 1) + " ms   " + rate_text(samples_per_second_) + "samples/s");
-  content.status.push_back("device " + session_->device_description());
+  content.status.push_back("device " + session_->device_name());
   content.status.push_back("exposure " + std::string(display_.exposure >= 0 ? "+" : "") + fixed(display_.exposure, 1) +
                            " EV   tone mapper " + std::string(tonemap_name(display_.tonemap)));
   content.camera_json = view_json();
@@ -612,7 +618,9 @@ void Viewer::save_image() {
   content.display = image_file_type(output_) == ImageFileType::png ? display_ : DisplayTransform{};
   try {
     // Rows that already have one more sample are saved with it: the image is each pixel's mean.
-    write_render_image(output_, image, nullptr, content);
+    Aovs passes;
+    if (progressive_->has_aovs()) progressive_->aovs(passes);
+    write_render_image(output_, image, progressive_->has_aovs() ? &passes : nullptr, content);
     const std::string text = "wrote " + output_.string() + " (" + std::to_string(progressive_->samples()) + " of " +
                              std::to_string(progressive_->target()) + " samples)";
     say(text, false);
@@ -636,7 +644,8 @@ void Viewer::say(const std::string& message, bool error) {
 void Viewer::log_frame(double frame_ms) {
   if (!frame_log_) return;
   const double t = seconds_between(start_, Clock::now());
-  *frame_log_ << "{\"t\": " << fixed(t, 4) << ", \"frame_ms\": " << fixed(frame_ms, 2)
+  const double unix_time = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  *frame_log_ << "{\"t\": " << fixed(t, 4) << ", \"time\": " << fixed(unix_time, 4) << ", \"frame_ms\": " << fixed(frame_ms, 2)
               << ", \"samples\": " << (progressive_ ? progressive_->samples() : 0)
               << ", \"rows_ahead\": " << (progressive_ ? progressive_->rows_ahead() : 0)
               << ", \"target\": " << (progressive_ ? progressive_->target() : 0) << ", \"restarts\": " << restarts_

@@ -20,10 +20,13 @@ struct ViewerOptions {
   // samples_per_pixel is where accumulation stops, with the image of `vkray render --spp N`.
   RenderOptions render;
   std::filesystem::path output;  // what P saves (and --exit-when-done); by extension, as render writes
-  OutputContent content;         // its display transform is the window's at the start
+  // Its display transform is the window's at the start; its passes (an EXR's first-hit passes) are
+  // accumulated with the image.
+  OutputContent content;
   bool exit_when_done = false;   // save and exit once every pixel has all its samples
-  // A JSON line per frame (time, frame time, samples, and how long the input or reload it shows
-  // waited): what `tools/bench-view` measures. Empty: none.
+  // A JSON line per frame that traced or answered input: seconds since the start and since the
+  // epoch, the frame's time, samples, restarts, and how long the input or reload it shows waited
+  // (what `tools/bench-view` measures). Empty: none.
   std::filesystem::path frame_log;
 };
 
