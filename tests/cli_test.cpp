@@ -356,7 +356,7 @@ TEST(CliTest, AnUnknownCommandIsNamed) {
   TempDir dir;
   const Result run = vkray("rendr scene.json", dir.path());
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_NE(run.err.find("unknown command \"rendr\" (commands: render, merge, parity, check, watch, bench, devices)"), std::string::npos)
+  EXPECT_NE(run.err.find("unknown command \"rendr\" (commands: render, merge, parity, check, watch, view, bench, devices)"), std::string::npos)
       << run.err;
 }
 

@@ -68,9 +68,12 @@ TEST(ControlsTest, PanFollowsTheMouseAndZoomApproaches) {
   // so the camera moves 1.5 units to the left.
   pan(camera, 3.0f, {100.0f, 0.0f}, 200);
   EXPECT_NEAR(glm::dot(camera.position, frame.right), -1.5f, 1e-5f);
-  const float distance = zoom(camera, 3.0f, 1.0f);
+  const float distance = zoom(camera, 3.0f, 1.0f, 0.01f);
   EXPECT_NEAR(distance, 2.7f, 1e-5f);
   EXPECT_NEAR(camera.position.z, -2.7f, 1e-5f);
+  // Never past the closest distance, however far the wheel turns.
+  EXPECT_EQ(zoom(camera, 2.7f, 1000.0f, 0.01f), 0.01f);
+  EXPECT_NEAR(camera.position.z, -0.01f, 1e-5f);
 }
 
 TEST(ControlsTest, ASettledCameraReadsBackToTheSameBits) {

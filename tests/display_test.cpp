@@ -84,6 +84,14 @@ TEST(DisplayTest, NamesRoundTrip) {
   EXPECT_FALSE(parse_tonemap(""));
 }
 
+TEST(DisplayTest, InfinityShowsAsWhite) {
+  for (Tonemap t : {Tonemap::none, Tonemap::aces, Tonemap::pbr_neutral}) {
+    const DisplayTransform d{t, 3.0f};
+    EXPECT_EQ(d.apply(glm::vec3(INFINITY)), glm::vec3(1.0f)) << tonemap_name(t);
+    EXPECT_EQ(d.apply(glm::vec3(3e38f)), glm::vec3(1.0f)) << tonemap_name(t);
+  }
+}
+
 TEST(DisplayTest, NanAndNegativeShowAsBlack) {
   for (Tonemap t : {Tonemap::none, Tonemap::aces, Tonemap::pbr_neutral}) {
     const DisplayTransform d{t, 2.0f};

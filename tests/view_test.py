@@ -136,14 +136,21 @@ def read_png(path):
     return pixels[:, :, :3]
 
 
-def wait_until_done(log, timeout=120):
-    """Until the frame log's last frame has every sample, and no frame has come since for a while."""
+def restarts(log):
+    """How many accumulations the viewer has started, by its frame log."""
+    lines = log.read_text().splitlines() if log.exists() else []
+    return json.loads(lines[-1])["restarts"] if lines else 0
+
+
+def wait_until_done(log, after_restarts=0, timeout=120):
+    """Until the frame log's last frame, of an accumulation started after `after_restarts` of them,
+    has every sample, and no frame has come since for a while."""
     deadline = time.time() + timeout
     while time.time() < deadline:
         lines = log.read_text().splitlines() if log.exists() else []
         if lines:
             last = json.loads(lines[-1])
-            if last["samples"] == last["target"] > 0:
+            if last["samples"] == last["target"] > 0 and last["restarts"] > after_restarts:
                 time.sleep(0.5)
                 if log.read_text().splitlines()[-1] == lines[-1]:
                     return
@@ -241,29 +248,43 @@ def test_the_render_follows_the_windows_size(display, tmp_path):
     assert (tmp_path / "view.pfm").read_bytes() == (tmp_path / "render.pfm").read_bytes()
 
 
-def test_a_scripted_session_saves_what_render_renders_of_the_same_view(display, tmp_path):
-    # The lab's scene: keys move the camera and the light, the mouse orbits and zooms, I switches to
-    # the path tracer; then the overlay is hidden, and the image and the window saved. The saved image
-    # is `vkray render`'s of the view the viewer prints, and the window shows exactly its PNG.
+def start_on_a_copy(display, tmp_path, scene_name, size):
+    """The viewer on a copy of the shipped scenes (a scene of the view is written beside them), its
+    first accumulation done. Returns the viewer, the scene file, the frame log and its restarts."""
     shutil.copytree(SCENES, tmp_path / "scenes")
-    scene = tmp_path / "scenes" / "cornell.json"
-    size = ["--width", "96", "--height", "80", "--spp", "4"]
+    scene = tmp_path / "scenes" / scene_name
     log = tmp_path / "frames.jsonl"
     viewer = Viewer(display, [str(scene), *size, "-o", "view.pfm", "--validate", "--frame-log", str(log)], tmp_path)
-    viewer.keys("Up", "Up", "Right", "w", "w", "d", "q")
-    viewer.mouse("40", "30", "mousedown", "1", "mousemove_relative", "--", "12", "-6", "mouseup", "1")
-    viewer.mouse("48", "40", "click", "4")  # the wheel: zoom in a notch
-    viewer.keys("i", "Tab")
     wait_until_done(log)
+    return viewer, scene, log, restarts(log)
+
+
+def save_and_close(viewer, spp):
+    """P (the image, done) and F12 (the window), then Esc; returns the `vkray: view:` line."""
     viewer.keys("p")
-    _, saved = viewer.wait_line(r"wrote view\.pfm \(4 of 4 samples\)")
+    viewer.wait_line(r"wrote view\.pfm \(%d of %d samples\)" % (spp, spp))
     _, view = viewer.wait_line(r"^vkray: view: ")
-    assert "integrator path" in view
-    # The window as shown, under the PNG's display transform (the default: clamp and sRGB).
     viewer.keys("F12")
     viewer.wait_line(r"wrote .*view-window\.png")
     assert viewer.close() == 0, viewer.output()
     assert_no_validation_messages(viewer)
+    return view
+
+
+def test_a_scripted_session_saves_what_render_renders_of_the_same_view(display, tmp_path):
+    # The lab's scene: keys move the camera and the light, the mouse orbits and zooms, I switches to
+    # the path tracer; then the overlay is hidden, and the image and the window saved. The saved image
+    # is `vkray render`'s of the view the viewer prints, and the window shows exactly its PNG.
+    size = ["--width", "96", "--height", "80", "--spp", "4"]
+    viewer, scene, log, before = start_on_a_copy(display, tmp_path, "cornell.json", size)
+    viewer.keys("Up", "Up", "Right", "w", "w", "d", "q")
+    viewer.mouse("40", "30", "mousedown", "1", "mousemove_relative", "--", "12", "-6", "mouseup", "1")
+    viewer.mouse("48", "40", "click", "4")  # the wheel: zoom in a notch
+    viewer.keys("i", "Tab")
+    wait_until_done(log, before)
+    # The window as shown is under the PNG's display transform (the default: clamp and sRGB).
+    view = save_and_close(viewer, 4)
+    assert "integrator path" in view
 
     scene_with_view(scene, view, tmp_path / "scenes" / "viewed.json")
     render(tmp_path / "scenes" / "viewed.json", tmp_path / "render.pfm", *size)
@@ -280,8 +301,9 @@ def test_a_shader_edit_reloads_in_place_and_a_broken_one_keeps_the_last_image(di
     shaders = tmp_path / "shaders"
     shutil.copytree(SHADERS, shaders)
     size = ["--width", "64", "--height", "48", "--spp", "1"]
+    log = tmp_path / "frames.jsonl"
     viewer = Viewer(display, [str(SCENES / "cornell.json"), *size, "--shader-dir", str(shaders), "-o", "view.pfm",
-                              "--validate"], tmp_path)
+                              "--validate", "--frame-log", str(log)], tmp_path)
     shade = shaders / "direct.glsl"
     original = shade.read_text()
     # A syntax error: reported as file:line, and the window goes on.
@@ -292,9 +314,10 @@ def test_a_shader_edit_reloads_in_place_and_a_broken_one_keeps_the_last_image(di
     red = original.replace("vec3 direct_radiance(", "vec3 direct_radiance_unused(", 1)
     assert red != original
     red += "\nvec3 direct_radiance(Ray ray, inout uint stream, inout uint rays) { return vec3(1.0, 0.0, 0.0); }\n"
+    before = restarts(log)
     shade.write_text(red)
     index, _ = viewer.wait_line(r"reload: compile", after=index + 1)
-    time.sleep(1)  # 64 x 48 pixels, one sample: a frame
+    wait_until_done(log, before)
     viewer.keys("p")
     viewer.wait_line(r"wrote view\.pfm \(1 of 1 samples\)", after=index)
     assert viewer.close() == 0, viewer.output()
@@ -332,3 +355,22 @@ def test_a_thousand_resets_leave_memory_flat(display, tmp_path):
     after_1100 = press_until(1100)
     assert viewer.close() == 0, viewer.output()
     assert after_1100 - after_100 <= 4 * 1024, f"anonymous memory grew from {after_100} to {after_1100} KiB"
+
+
+def test_display_keys_and_a_focus_click_show_what_render_writes(display, tmp_path):
+    # The thin-lens scene: a middle click focuses where it points, + + raises the exposure a stop,
+    # T picks ACES; the window then shows exactly `vkray render`'s PNG of the printed view with
+    # --exposure 1 --tonemap aces.
+    size = ["--width", "96", "--height", "64", "--spp", "2"]
+    viewer, scene, log, before = start_on_a_copy(display, tmp_path, "depth-of-field.json", size)
+    viewer.mouse("24", "34", "click", "2")  # a sphere behind the one in focus
+    viewer.wait_line(r"^vkray: focus distance 9\.")
+    viewer.keys("equal", "equal", "t", "Tab")
+    wait_until_done(log, before)
+    view = save_and_close(viewer, 2)
+    assert "focus_distance" in view
+    scene_with_view(scene, view, tmp_path / "scenes" / "viewed.json")
+    render(tmp_path / "scenes" / "viewed.json", tmp_path / "render.pfm", *size)
+    assert (tmp_path / "view.pfm").read_bytes() == (tmp_path / "render.pfm").read_bytes()
+    render(tmp_path / "scenes" / "viewed.json", tmp_path / "render.png", *size, "--exposure", "1", "--tonemap", "aces")
+    assert np.array_equal(read_png(tmp_path / "view-window.png"), read_png(tmp_path / "render.png"))

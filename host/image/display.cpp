@@ -63,8 +63,9 @@ float DisplayTransform::scale() const { return std::exp2(exposure); }
 
 glm::vec3 DisplayTransform::apply(glm::vec3 radiance) const {
   glm::vec3 c = exposure == 0.0f ? radiance : radiance * scale();
-  for (int i = 0; i < 3; ++i)
-    if (!(c[i] >= 0.0f)) c[i] = 0.0f;  // NaN and negatives: nothing to show (the tone mappers take c >= 0)
+  // NaN and negatives: nothing to show (the tone mappers take c >= 0); infinity, and anything past
+  // where every tone mapper is white, as 1e18, which their arithmetic carries without overflow.
+  for (int i = 0; i < 3; ++i) c[i] = c[i] >= 0.0f ? std::min(c[i], 1e18f) : 0.0f;
   switch (tonemap) {
     case Tonemap::none: break;
     case Tonemap::aces: c = aces(c); break;

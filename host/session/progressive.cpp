@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "gpu/accumulator.h"
+#include "session/on_device.h"
 
 namespace vkray {
 namespace {
@@ -40,10 +41,10 @@ bool ProgressiveRender::advance(std::chrono::duration<double> budget) {
   } else {
     // A band of the next sample, from the first row that lacks it.
     const double rows = std::floor(affordable / double(width) / kBandRows) * kBandRows;
-    const uint32_t band = uint32_t(std::clamp<double>(rows, kBandRows, height - rows_ahead_));
+    const uint32_t band = uint32_t(std::min<double>(std::max<double>(rows, kBandRows), height - rows_ahead_));
     step = {rows_ahead_, rows_ahead_ + band, samples_, samples_ + 1};
   }
-  const double seconds = accumulator_->trace(step, timeout_);
+  const double seconds = on_device([&] { return accumulator_->trace(step, timeout_); });
   trace_seconds_ += seconds;
   const double measured = double(step.pixel_samples(width)) / std::max(seconds, 1e-6);
   rate_ = rate_ > 0 ? std::min(measured, rate_ * kMostGrowth) : measured;

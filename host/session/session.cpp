@@ -15,19 +15,10 @@
 #include "gpu/shader_cache.h"
 #include "gpu/shader_compiler.h"
 #include "session/paths.h"
+#include "session/on_device.h"
 
 namespace vkray {
 namespace {
-
-// Runs `work` on the device, turning Vulkan-Hpp's report of a lost device into vkray's.
-template <typename Work>
-auto on_device(Work&& work) -> decltype(work()) {
-  try {
-    return work();
-  } catch (const vk::DeviceLostError& e) {
-    throw DeviceLostError(std::string(e.what()) + ": the device was lost");
-  }
-}
 
 // Compiling a scene into the shader makes pipeline creation slower (on lavapipe with 2 cores and the
 // shader caches warm, by 15-25 ms a primitive) and each ray cheaper, by more the more a sample traces

@@ -81,14 +81,17 @@ void pan(Camera& camera, float distance, glm::vec2 pixels, uint32_t image_height
   camera.position += (-frame.right * pixels.x + frame.up * pixels.y) * per_pixel;
 }
 
-float zoom(Camera& camera, float distance, float notches) {
-  const float new_distance = distance * std::pow(0.9f, notches);
+float zoom(Camera& camera, float distance, float notches, float closest) {
+  const float new_distance = std::max(distance * std::pow(0.9f, notches), std::min(closest, distance));
   camera.position += camera.forward * (distance - new_distance);
   return new_distance;
 }
 
 glm::vec3 settle(Camera& camera, float distance) {
-  const glm::vec3 look_at = camera.position + camera.forward * distance;
+  glm::vec3 look_at = camera.position + camera.forward * distance;
+  // A point too close to tell from the position (a zero distance, or below its float spacing)
+  // gives no direction: look one unit ahead instead.
+  if (!(glm::length(look_at - camera.position) > 0.0f)) look_at = camera.position + camera.forward;
   camera.forward = unit_direction(look_at - camera.position);  // as the scene parser computes it
   return look_at;
 }

@@ -42,9 +42,10 @@ void orbit(Camera& camera, float distance, float yaw, float pitch);
 // Right drag: the camera slides in its image plane by `pixels` (x right, y down) of an image
 // `image_height` pixels high, as far as makes the point `distance` ahead follow the mouse.
 void pan(Camera& camera, float distance, glm::vec2 pixels, uint32_t image_height);
-// Wheel: the camera moves toward the point `distance` ahead, by 10% of the distance a notch; returns
-// the new distance (never below 1% of the old one a notch).
-float zoom(Camera& camera, float distance, float notches);
+// Wheel: the camera moves toward the point `distance` ahead, by 10% of the distance a notch (away
+// from it for negative notches); returns the new distance, never below `closest`.
+
+float zoom(Camera& camera, float distance, float notches, float closest);
 
 // Sets the camera's view direction to the one a scene file with its position and look_at = position +
 // forward * distance gives (unit_direction, scene/camera.h), and returns that look_at: written out

@@ -66,7 +66,12 @@ Presenter::Presenter(const gpu::Context& ctx) : ctx_(&ctx) {
   const vk::SubpassDependency after_copy(
       VK_SUBPASS_EXTERNAL, 0, vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eColorAttachmentOutput,
       vk::AccessFlagBits::eTransferWrite, vk::AccessFlagBits::eColorAttachmentRead | vk::AccessFlagBits::eColorAttachmentWrite);
-  render_pass_ = vk::raii::RenderPass(ctx_->device(), vk::RenderPassCreateInfo({}, attachment, subpass, after_copy));
+  // And before a read back (F12) copies the image out, after the pass's final layout transition.
+  const vk::SubpassDependency before_read_back(0, VK_SUBPASS_EXTERNAL, vk::PipelineStageFlagBits::eColorAttachmentOutput,
+                                               vk::PipelineStageFlagBits::eTransfer, vk::AccessFlagBits::eColorAttachmentWrite,
+                                               vk::AccessFlagBits::eTransferRead);
+  const vk::SubpassDependency dependencies[] = {after_copy, before_read_back};
+  render_pass_ = vk::raii::RenderPass(ctx_->device(), vk::RenderPassCreateInfo({}, attachment, subpass, dependencies));
 
   acquired_ = vk::raii::Semaphore(ctx_->device(), vk::SemaphoreCreateInfo{});
   pool_ = vk::raii::CommandPool(ctx_->device(), {vk::CommandPoolCreateFlagBits::eResetCommandBuffer, ctx_->queue_family()});

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <GLFW/glfw3.h>
+#include <vulkan/vulkan_raii.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -98,6 +99,8 @@ class Viewer {
   // ---- The device and what presents on it ----
   void open_device();
   void close_device();
+  // After a lost device (the current exception): opens it again, once.
+  void reopen_device();
 
   // ---- The scene and the shaders ----
   void load_scene_file();  // throws what loading throws
@@ -154,6 +157,7 @@ class Viewer {
   bool needs_restart_ = true;
   double rate_hint_ = 0;
   uint64_t restarts_ = 0;  // accumulations started
+  bool reopened_ = false;  // the device was lost once and opened again
 
   // What the window shows.
   uint32_t width_ = 0, height_ = 0;  // the render's size: the window's framebuffer
@@ -193,14 +197,14 @@ Viewer::Viewer(const ViewerOptions& options)
   const ImageSettings image = image_settings(*loaded_, options_.render);
   width_ = image.width;
   height_ = image.height;
-  window_ = std::make_unique<Window>("vkray view: " + loaded_->name, width_, height_);
-  open_device();
-  panels_.keys = kKeys;
-  watcher_.set_folder(options_.session.shader_dir, {".comp", ".glsl", ".h", ".inc"});
   if (!options_.frame_log.empty()) {
     frame_log_ = std::make_unique<std::ofstream>(options_.frame_log);
     if (!*frame_log_) throw OutputError(options_.frame_log.string() + ": cannot be written (--frame-log)");
   }
+  window_ = std::make_unique<Window>("vkray view: " + loaded_->name, width_, height_);
+  open_device();
+  panels_.keys = kKeys;
+  watcher_.set_folder(options_.session.shader_dir, {".comp", ".glsl", ".h", ".inc"});
 }
 
 Viewer::~Viewer() {
@@ -223,10 +227,20 @@ void Viewer::open_device() {
     session_->compile_shaders();
     shader_broken_ = false;
   } catch (const ShaderError&) {
+    if (options_.exit_when_done) throw;  // it would never be done
     say(failure_text(std::current_exception()), true);
     shader_broken_ = true;
   }
   needs_restart_ = true;
+}
+
+void Viewer::reopen_device() {
+  std::cerr << "vkray: " << failure_text(std::current_exception()) << "; opening the device again\n";
+  if (reopened_) throw;  // lost again: it cannot be brought back
+  reopened_ = true;
+  close_device();
+  open_device();
+  say("the device was lost and opened again", true);
 }
 
 void Viewer::close_device() {
@@ -270,7 +284,7 @@ void Viewer::restart() {
   needs_restart_ = false;
   ++restarts_;
   trace_failed_ = false;
-  if (progressive_) rate_hint_ = progressive_->rate();
+  if (progressive_ && progressive_->rate() > 0) rate_hint_ = progressive_->rate();
   progressive_.reset();
   if (scene_broken_ || shader_broken_ || !session_->has_shaders()) return;
   try {
@@ -285,6 +299,7 @@ void Viewer::restart() {
   } catch (const Cancelled&) {
     throw;
   } catch (...) {  // the shaders do not compile with the scene's code, a scene too large for the device
+    if (options_.exit_when_done) throw;  // it would never be done
     say(failure_text(std::current_exception()), true);
     trace_failed_ = true;
   }
@@ -317,6 +332,7 @@ void Viewer::reload(const std::vector<std::filesystem::path>& changed) {
       const auto start = Clock::now();
       load_scene_file();
       on_device_.reset();  // uploaded again, the geometry may have changed
+      rate_hint_ = 0;
       steps_ = steps_for(*loaded_);
       scene_broken_ = false;
       line += "scene " + fixed(ms_since(start), 0) + " ms";
@@ -415,6 +431,7 @@ void Viewer::key(int key, int mods) {
     case GLFW_KEY_I:
       integrator_ = integrator_ == Integrator::Type::direct ? Integrator::Type::path : Integrator::Type::direct;
       needs_restart_ = true;
+      rate_hint_ = 0;  // the other integrator's rate says nothing of this one's: start from a band
       break;
     case GLFW_KEY_EQUAL:
     case GLFW_KEY_KP_ADD:
@@ -467,10 +484,13 @@ void Viewer::handle(const InputEvent& event) {
       if (event.action == GLFW_PRESS && focus) {
         if (const auto depth = hit_depth(at)) {
           camera_.focus_distance = *depth;
-          needs_restart_ = camera_.aperture_radius > 0.0f;
-          say("focus distance " + fixed(*depth, 4) +
-                  (camera_.aperture_radius > 0.0f ? "" : " (the camera is a pinhole: give it an aperture_radius to see it)"),
-              false);
+          // The camera has changed: from now on it is written out as the viewer holds it.
+          if (!look_at_) look_at_ = settle(camera_, std::max(loaded_->extent(), 1e-3f));
+          needs_restart_ = true;
+          const std::string text = "focus distance " + fixed(*depth, 4) +
+                                   (camera_.aperture_radius > 0.0f ? "" : " (the camera is a pinhole: give it an aperture_radius to see it)");
+          say(text, false);
+          std::cerr << "vkray: " << text << "\n";
         }
       } else if (event.action == GLFW_PRESS) {
         drag_ = event.key == GLFW_MOUSE_BUTTON_LEFT ? Drag::orbit : event.key == GLFW_MOUSE_BUTTON_RIGHT ? Drag::pan : Drag::none;
@@ -498,7 +518,7 @@ void Viewer::handle(const InputEvent& event) {
     }
     case InputEvent::Kind::scroll:
       if (event.position.y != 0.0) {
-        pivot_ = zoom(camera_, pivot_distance(), float(event.position.y));
+        pivot_ = zoom(camera_, pivot_distance(), float(event.position.y), 1e-4f * std::max(loaded_->extent(), 1e-3f));
         look_at_ = settle(camera_, *pivot_);
         needs_restart_ = true;
       }
@@ -519,6 +539,7 @@ void Viewer::trace(Seconds budget) {
   } catch (const Cancelled&) {
     throw;
   } catch (...) {  // a tile past its timeout (a shader that loops), a validation message
+    if (options_.exit_when_done) throw;  // it would never be done
     say(failure_text(std::current_exception()), true);
     std::cerr << "vkray: " << failure_text(std::current_exception()) << "\n";
     trace_failed_ = true;
@@ -626,11 +647,16 @@ void Viewer::save_image() {
     say(text, false);
     std::cerr << "vkray: " << text << "\n";
     // The view, so that `vkray render` can render it: the camera and the first light as they are now.
-    std::cerr << "vkray: view: " << view_json();
-    if (!loaded_->lights.empty() && loaded_->lights[0].type != Light::Type::directional)
+    // Before any move the camera is the scene file's own (which written out again would not read back
+    // to the same bits).
+    std::cerr << "vkray: view: " << (look_at_ ? view_json() : std::string("the scene file's camera"));
+    if (!loaded_->lights.empty() && loaded_->lights[0].type != Light::Type::directional) {
       std::cerr << ", first light at " << point_json(light_position_.value_or(loaded_->lights[0].position));
+      if (loaded_->lights[0].type == Light::Type::spot) std::cerr << " pointing " << point_json(loaded_->lights[0].direction);
+    }
     std::cerr << ", integrator " << (integrator_ == Integrator::Type::path ? "path" : "direct") << "\n";
   } catch (const Error&) {
+    if (options_.exit_when_done) throw;  // the one thing asked for failed
     say(failure_text(std::current_exception()), true);
     std::cerr << "vkray: " << failure_text(std::current_exception()) << "\n";
   }
@@ -679,19 +705,18 @@ void Viewer::loop() {
     const auto frame_start = Clock::now();
     const bool busy = progressive_ && !progressive_->done() && !trace_failed_;
     window_->poll(busy || needs_restart_ ? 0.0 : kIdleWait);
-    for (const InputEvent& event : window_->take_events()) handle(event);
     throw_if_interrupted();
-    if (const auto changed = watcher_.poll(kReloadSettle); !changed.empty()) reload(changed);
-
     // The window's size is the render's.
     const glm::uvec2 size = window_->framebuffer_size();
-    if (size.x > 0 && size.y > 0 && (size.x != width_ || size.y != height_)) {
-      width_ = std::min(size.x, kMaxImageSide);
-      height_ = std::min(size.y, kMaxImageSide);
+    const glm::uvec2 render_size = glm::min(size, glm::uvec2(kMaxImageSide));
+    if (size.x > 0 && size.y > 0 && (render_size.x != width_ || render_size.y != height_)) {
+      width_ = render_size.x;
+      height_ = render_size.y;
       needs_restart_ = true;
     }
-    const bool had_input = input_pending_.has_value(), had_reload = reload_pending_.has_value();
     try {
+      for (const InputEvent& event : window_->take_events()) handle(event);
+      if (const auto changed = watcher_.poll(kReloadSettle); !changed.empty()) reload(changed);
       if (needs_restart_) restart();
       trace(Clock::now() - last_input_ < kSettle ? kInteractiveBudget : kSettledBudget);
       if (save_requested_) {
@@ -701,14 +726,20 @@ void Viewer::loop() {
       if (size.x == 0 || size.y == 0) continue;  // minimised: nothing to show
       present(std::exchange(window_save_requested_, false));
     } catch (const DeviceLostError&) {
-      std::cerr << "vkray: " << failure_text(std::current_exception()) << "; opening the device again\n";
-      close_device();
-      open_device();
-      say("the device was lost and opened again", true);
+      reopen_device();
+      continue;
+    } catch (const vk::DeviceLostError&) {  // from the swapchain or the overlay, which call Vulkan directly
+      reopen_device();
+      continue;
+    } catch (const TimeoutError&) {  // a frame or a step waited past its time: shown, and the next change tries again
+      if (options_.exit_when_done) throw;
+      say(failure_text(std::current_exception()), true);
+      std::cerr << "vkray: " << failure_text(std::current_exception()) << "\n";
+      trace_failed_ = true;
       continue;
     }
     frame_ms_ = ms_since(frame_start);
-    if (had_input || had_reload) {
+    if (input_pending_ || reload_pending_) {
       log_frame(frame_ms_);
       input_pending_.reset();
       reload_pending_.reset();

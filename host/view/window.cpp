@@ -17,11 +17,10 @@ struct Callbacks {
     of(w).events_.push_back({InputEvent::Kind::key, key, action, mods, {}});
   }
   static void button(GLFWwindow* w, int button, int action, int mods) {
-    double x = 0, y = 0;
-    glfwGetCursorPos(w, &x, &y);
-    of(w).events_.push_back({InputEvent::Kind::button, button, action, mods, {x, y}});
+    of(w).events_.push_back({InputEvent::Kind::button, button, action, mods, of(w).pointer_});
   }
   static void cursor(GLFWwindow* w, double x, double y) {
+    of(w).pointer_ = {x, y};
     of(w).events_.push_back({InputEvent::Kind::cursor, 0, 0, 0, {x, y}});
   }
   static void scroll(GLFWwindow* w, double dx, double dy) {
@@ -61,6 +60,7 @@ Window::Window(const std::string& title, uint32_t width, uint32_t height) {
     throw DeviceError("cannot open a window of " + std::to_string(width) + " x " + std::to_string(height) + ": " + reason);
   }
   glfwSetWindowUserPointer(window_, this);
+  glfwGetCursorPos(window_, &pointer_.x, &pointer_.y);
   glfwSetKeyCallback(window_, Callbacks::key);
   glfwSetMouseButtonCallback(window_, Callbacks::button);
   glfwSetCursorPosCallback(window_, Callbacks::cursor);

@@ -52,6 +52,9 @@ class Window {
   friend struct Callbacks;
   GLFWwindow* window_ = nullptr;
   std::vector<InputEvent> events_;
+  // Where the last cursor event put the pointer: a button event happened there (asking the server
+  // instead gives where the pointer is now, past motion still queued).
+  glm::dvec2 pointer_{0.0};
 };
 
 }  // namespace vkray::view
