@@ -4,6 +4,8 @@
 #include <map>
 
 #include "base/errors.h"
+#include "image/aovs.h"
+#include "image/image_file.h"
 
 #include "session/paths.h"
 
@@ -123,6 +125,20 @@ void add_display_flags(CLI::App& command, DisplayFlags& flags) {
             return "";
           },
           ""));
+}
+
+void add_exr_flags(CLI::App& command, ExrFlags& flags, const std::string& aov_help) {
+  command.add_option("--aov", flags.aovs, aov_help + ", comma-separated: albedo, normal, position, depth, object");
+  command.add_flag("--exr-float", flags.exr_float, "Write an .exr with 32-bit float channels instead of 16-bit half");
+}
+
+OutputContent output_content(const std::filesystem::path& output, const ExrFlags& exr, const DisplayFlags& display) {
+  OutputContent content;
+  content.full_float = exr.exr_float;
+  content.display = display.display;
+  check_output_image(output);
+  if (!exr.aovs.empty()) content.passes = parse_aov_list(exr.aovs);
+  return content;
 }
 
 void apply_value_rules(CLI::App& app) {

@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "image/display.h"
+#include "image/exr.h"
 #include "session/options.h"
 
 namespace vkray::cli {
@@ -37,6 +38,11 @@ struct GpuFlags {
 struct DisplayFlags {
   DisplayTransform display;
 };
+// [--aov LIST] [--exr-float]: what an EXR output holds besides the image
+struct ExrFlags {
+  std::string aovs;  // first-hit passes, comma-separated (image/aovs.h)
+  bool exr_float = false;
+};
 // [--threads N]
 struct CpuFlags {
   unsigned threads = 0;
@@ -55,6 +61,11 @@ void add_device_flags(CLI::App& command, DeviceFlags& flags, bool validate = tru
 void add_gpu_flags(CLI::App& command, GpuFlags& flags, bool inline_scene = true);
 void add_cpu_flags(CLI::App& command, CpuFlags& flags, const std::string& description);
 void add_display_flags(CLI::App& command, DisplayFlags& flags);
+// `aov_help`: what the command does with the passes.
+void add_exr_flags(CLI::App& command, ExrFlags& flags, const std::string& aov_help);
+// What an output image holds by the flags, checked in the one order every face uses: the file
+// (check_output_image: its type, its folder), then the passes' names. Throws OutputError, UsageError.
+OutputContent output_content(const std::filesystem::path& output, const ExrFlags& exr, const DisplayFlags& display);
 
 // Rules every option value follows, set once for all commands by the option's type, so that no
 // option can miss them: an integer is decimal digits (CLI11 alone reads "0100" as octal 64 and

@@ -29,8 +29,7 @@ struct RenderArgs {
   DisplayFlags display;
   std::filesystem::path output;  // empty: <scene name>.png in the current folder
   std::string renderer = "gpu";  // "gpu" or "cpu"
-  std::string aovs;              // --aov: first-hit passes, comma-separated (image/aovs.h)
-  bool exr_float = false;
+  ExrFlags exr;
   bool quiet = false;
 };
 
@@ -42,11 +41,7 @@ int run_render(const RenderArgs& args) {
   const LoadedScene loaded = load_scene_file(scene_file(args.scene), args.scene.environment);
   const std::filesystem::path output =
       args.output.empty() ? std::filesystem::path(loaded.scene->name + ".png") : args.output;
-  OutputContent content;
-  content.full_float = args.exr_float;
-  content.display = args.display.display;
-  check_output_image(output);  // before the passes' names: one order of checks for every face
-  if (!args.aovs.empty()) content.passes = parse_aov_list(args.aovs);
+  const OutputContent content = output_content(output, args.exr, args.display);
   check_render_output(output, content, args.scene.region.has_value());
   RenderOptions options = render_options(&args.scene, &args.gpu, &args.cpu);
   options.aovs = !content.passes.empty();
@@ -113,9 +108,7 @@ Command add_render_command(CLI::App& app) {
   add_region_flag(*command, args->scene);
   command->add_option("-o,--output", args->output, "Output image, .png (8-bit sRGB), .pfm (float, linear) or .exr "
                                                    "(half float, linear); default: <scene name>.png in the current folder");
-  command->add_option("--aov", args->aovs, "First-hit passes to add to an .exr as layers, comma-separated: albedo, normal, "
-                                           "position, depth, object");
-  command->add_flag("--exr-float", args->exr_float, "Write an .exr with 32-bit float channels instead of 16-bit half");
+  add_exr_flags(*command, args->exr, "First-hit passes to add to an .exr as layers");
   add_display_flags(*command, args->display);
   add_device_flags(*command, args->device);
   add_gpu_flags(*command, args->gpu);

@@ -6,7 +6,6 @@
 #include "base/errors.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
-#include "image/aovs.h"
 #include "image/image_file.h"
 #include "session/parts.h"
 #ifdef VKRAY_HAVE_VIEWER
@@ -22,8 +21,7 @@ struct ViewArgs {
   GpuFlags gpu;
   DisplayFlags display;
   std::filesystem::path output;  // empty: <scene name>.png in the current folder
-  std::string aovs;              // --aov: first-hit passes for an .exr, comma-separated
-  bool exr_float = false;
+  ExrFlags exr;
   bool exit_when_done = false;
   std::filesystem::path frame_log;
 };
@@ -36,10 +34,7 @@ int run_view(const ViewArgs& args) {
   options.session = session_options(args.device);
   options.render = render_options(&args.scene, &args.gpu, nullptr);
   options.output = args.output.empty() ? std::filesystem::path(options.scene.stem().string() + ".png") : args.output;
-  options.content.display = args.display.display;
-  options.content.full_float = args.exr_float;
-  check_output_image(options.output);  // before the passes' names: one order of checks for every face
-  if (!args.aovs.empty()) options.content.passes = parse_aov_list(args.aovs);
+  options.content = output_content(options.output, args.exr, args.display);
   // --tonemap and --exposure are the window's too: an EXR or PFM output is saved linear, not refused.
   OutputContent saved = options.content;
   if (image_file_type(options.output) != ImageFileType::png) saved.display = {};
@@ -66,9 +61,7 @@ Command add_view_command(CLI::App& app) {
   command->add_option("-o,--output", args->output,
                       "What P saves: .png (as the window shows it), .pfm or .exr (linear radiance, with --aov's "
                       "passes); default: <scene name>.png in the current folder");
-  command->add_option("--aov", args->aovs, "First-hit passes to accumulate and add to an .exr as layers, "
-                                           "comma-separated: albedo, normal, position, depth, object");
-  command->add_flag("--exr-float", args->exr_float, "Write an .exr with 32-bit float channels instead of 16-bit half");
+  add_exr_flags(*command, args->exr, "First-hit passes to accumulate and add to an .exr as layers");
   add_display_flags(*command, args->display);
   add_device_flags(*command, args->device);
   add_gpu_flags(*command, args->gpu);

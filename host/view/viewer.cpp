@@ -98,6 +98,8 @@ class Viewer {
   void loop();
   // ---- The device and what presents on it ----
   void open_device();
+  // What holds the device, released before the session (whose close() checks the validation log).
+  void release_device_objects();
   void close_device();
   // After a lost device (the current exception): opens it again, once.
   void reopen_device();
@@ -207,13 +209,7 @@ Viewer::Viewer(const ViewerOptions& options)
   watcher_.set_folder(options_.session.shader_dir, {".comp", ".glsl", ".h", ".inc"});
 }
 
-Viewer::~Viewer() {
-  progressive_.reset();
-  on_device_.reset();
-  overlay_.reset();
-  presenter_.reset();
-  session_.reset();
-}
+Viewer::~Viewer() { close_device(); }
 
 void Viewer::open_device() {
   SessionOptions session_options = options_.session;
@@ -243,11 +239,15 @@ void Viewer::reopen_device() {
   say("the device was lost and opened again", true);
 }
 
-void Viewer::close_device() {
+void Viewer::release_device_objects() {
   progressive_.reset();
   on_device_.reset();
   overlay_.reset();
   presenter_.reset();
+}
+
+void Viewer::close_device() {
+  release_device_objects();
   session_.reset();
 }
 
@@ -691,10 +691,7 @@ int Viewer::run() {
   }
   // As for render: the device's teardown can raise validation messages (objects left alive), and
   // they must fail the command.
-  progressive_.reset();
-  on_device_.reset();
-  overlay_.reset();
-  presenter_.reset();
+  release_device_objects();
   session_->close();
   std::cerr << "vkray: closed\n";
   return kExitOk;
