@@ -126,8 +126,11 @@ CompiledShader compile_compute_shader(const std::filesystem::path& entry,
   program.addShader(&shader);
   if (!program.link(messages)) throw ShaderError(entry_path.string() + ": link error: " + format_log(program.getInfoLog()));
 
+  // No SPIRV-Tools validation here: glslang would only log what it found (the SPIR-V stands), and it
+  // costs more than the rest of the compile (about 0.17 s of 0.28 s for trace.comp); the validation
+  // layer checks every module vkray creates under --validate, as the tests run.
   glslang::SpvOptions options;
-  options.validate = true;
+  options.validate = false;
   spv::SpvBuildLogger logger;
   glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), result.spirv, &logger, &options);
   const std::string spv_messages = logger.getAllMessages();
