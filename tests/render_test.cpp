@@ -1,11 +1,13 @@
 // Rendered pixels against values worked out by hand from the shading contract, for both renderers:
 // the GPU path and the CPU reference must each get them right on their own.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include <algorithm>
 
@@ -224,6 +226,54 @@ TEST_F(RenderTest, SceneCompiledInMatchesTheBvhPixelForPixel) {
     for (size_t i = 0; i < bvh.pixels.size(); ++i) differ += bvh.pixels[i] != compiled_in.pixels[i];
     EXPECT_EQ(differ, 0u) << file;
   }
+}
+
+TEST_F(RenderTest, ConstantsAppliedOnTheHostGiveTheDriversPixels) {
+  // gpu/specialize.h removes the code a variant cannot reach before the driver sees it; the driver,
+  // given the whole module and the values (VKRAY_SPECIALIZE=driver), must render the same bytes.
+  struct Case {
+    const char* file;
+    InlineScene inline_scene;
+  };
+  const Case cases[] = {{"cornell.json", InlineScene::never}, {"cornell.json", InlineScene::always},
+                        {"cornell-glass.json", InlineScene::never}, {"rough-spheres.json", InlineScene::never}};
+  std::vector<Image> host;
+  for (const Case& c : cases) {
+    RenderOptions options;
+    options.inline_scene = c.inline_scene;
+    host.push_back(render(load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / c.file), {64, 48, 2}, options));
+  }
+  ASSERT_EQ(setenv("VKRAY_SPECIALIZE", "driver", 1), 0);
+  SessionOptions session_options;
+  session_options.validation = true;
+  session_options.shader_dir = shader_dir();
+  Session driver(session_options);
+  for (size_t i = 0; i < std::size(cases); ++i) {
+    RenderOptions options = with_image({}, {64, 48, 2});
+    options.inline_scene = cases[i].inline_scene;
+    const auto scene = std::make_shared<const Scene>(load_scene(std::filesystem::path(VKRAY_SCENE_DIR) / cases[i].file));
+    const Image image = driver.render(driver.upload(scene), options).image;
+    ASSERT_EQ(image.pixels.size(), host[i].pixels.size());
+    size_t differ = 0;
+    for (size_t p = 0; p < image.pixels.size(); ++p) differ += image.pixels[p] != host[i].pixels[p];
+    EXPECT_EQ(differ, 0u) << cases[i].file << (cases[i].inline_scene == InlineScene::always ? ", compiled in" : "");
+  }
+  unsetenv("VKRAY_SPECIALIZE");
+  driver.close();
+}
+
+TEST_F(RenderTest, AnUnknownPlaceToSpecializeIsAUsageError) {
+  ASSERT_EQ(setenv("VKRAY_SPECIALIZE", "gpu", 1), 0);
+  SessionOptions session_options;
+  session_options.shader_dir = shader_dir();
+  Session session(session_options);
+  try {
+    session.compile_shaders();
+    ADD_FAILURE() << "no error";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("VKRAY_SPECIALIZE is 'gpu'; it takes host (the default) or driver"), std::string::npos) << e.what();
+  }
+  unsetenv("VKRAY_SPECIALIZE");
 }
 
 TEST_F(RenderTest, PolicyChoosesThePath) {

@@ -1,4 +1,5 @@
-// Run-time shader compilation: includes, and errors that point at the right file and line.
+// Run-time shader compilation: includes, errors that point at the right file and line, the cache,
+// and a variant's SPIR-V specialized on the host.
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -8,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <sys/stat.h>
 
@@ -18,6 +20,7 @@
 #include "gpu/pipeline.h"
 #include "gpu/shader_cache.h"
 #include "gpu/shader_compiler.h"
+#include "gpu/specialize.h"
 #include "scene/scene.h"
 #include "shared/types.h"
 #include "support/temp_dir.h"
@@ -140,6 +143,63 @@ TEST(ShaderCompilerTest, DeclaresTheSpecializationConstantsOfThePipelinesTable) 
     table.emplace(VKRAY_SPEC_MATERIALS + t, std::pair("SCENE_HAS_" + std::string(material_type_name(MaterialType(t))),
                                                       ((defaults_on_host.materials >> t) & 1u) != 0));
   EXPECT_EQ(declared, table);
+}
+
+// The functions a module names (glslang names each "name(parameter types").
+std::vector<std::string> function_names(const std::vector<uint32_t>& code) {
+  std::vector<uint32_t> functions;
+  std::map<uint32_t, std::string> names;
+  for (size_t at = 5; at < code.size();) {
+    const uint32_t words = code[at] >> spv::WordCountShift, opcode = code[at] & spv::OpCodeMask;
+    if (words == 0 || at + words > code.size()) break;
+    if (opcode == spv::OpName) names[code[at + 1]] = reinterpret_cast<const char*>(&code[at + 2]);
+    if (opcode == spv::OpFunction) functions.push_back(code[at + 2]);
+    at += words;
+  }
+  std::vector<std::string> found;
+  for (uint32_t f : functions) found.push_back(names[f].substr(0, names[f].find('(')));
+  return found;
+}
+
+bool has_specialization_constants(const std::vector<uint32_t>& code) {
+  for (size_t at = 5; at < code.size();) {
+    const uint32_t words = code[at] >> spv::WordCountShift, opcode = code[at] & spv::OpCodeMask;
+    if (words == 0 || at + words > code.size()) break;
+    if (opcode == spv::OpSpecConstantTrue || opcode == spv::OpSpecConstantFalse || opcode == spv::OpSpecConstantOp ||
+        (opcode == spv::OpDecorate && code[at + 2] == spv::DecorationSpecId))
+      return true;
+    at += words;
+  }
+  return false;
+}
+
+TEST(SpecializeTest, FreezesTheConstantsAndDropsTheCodeTheVariantCannotReach) {
+  const std::filesystem::path dir = VKRAY_SHADER_DIR;
+  const gpu::CompiledShader shader = gpu::compile_compute_shader(dir / "trace.comp", {dir});
+  ASSERT_TRUE(has_specialization_constants(shader.spirv));
+  const auto has = [](const std::vector<std::string>& names, const std::string& name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+  };
+  ASSERT_TRUE(has(function_names(shader.spirv), "path_step"));
+  ASSERT_TRUE(has(function_names(shader.spirv), "direct_radiance"));
+  for (const bool path : {false, true}) {
+    std::map<uint32_t, bool> values;
+    for (const gpu::SpecConstant& row : gpu::kSpecConstants) values[row.id] = gpu::ShaderVariant().*row.member;
+    values[VKRAY_SPEC_PATH] = path;
+    const std::optional<std::vector<uint32_t>> code = gpu::specialize(shader.spirv, values);
+    ASSERT_TRUE(code);
+    EXPECT_FALSE(has_specialization_constants(*code));
+    const std::vector<std::string> names = function_names(*code);
+    EXPECT_EQ(has(names, "path_step"), path);
+    EXPECT_EQ(has(names, "direct_radiance"), !path);
+    // A variant is a fraction of the module that has every feature.
+    EXPECT_LT(code->size(), shader.spirv.size() * 3 / 4) << (path ? "path" : "direct");
+  }
+}
+
+TEST(SpecializeTest, DeclinesWhatIsNotSpirV) {
+  EXPECT_FALSE(gpu::specialize({0x07230203u, 0x10000u, 0u, 10u, 0u, 0xdeadbeefu}, {{VKRAY_SPEC_PATH, true}}));
+  EXPECT_FALSE(gpu::specialize({1u, 2u, 3u}, {}));
 }
 
 TEST(ShaderCompilerTest, ErrorInAnIncludedFileNamesThatFileAndLine) {

@@ -1,13 +1,19 @@
 #include "gpu/pipeline.h"
 
 #include <algorithm>
-#include <array>
+#include <cstdlib>
+#include <map>
+#include <optional>
 #include <span>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include <glslang/SPIRV/spirv.hpp>
 
 #include "base/errors.h"
 #include "gpu/shader_cache.h"
+#include "gpu/specialize.h"
 #include "shared/materials.h"
 #include "shared/types.h"
 
@@ -64,7 +70,34 @@ bool declares(const std::vector<uint32_t>& spirv, spv::Capability capability) {
   return false;
 }
 
+// VKRAY_SPECIALIZE (docs/commands.md): `host` (the default) applies the specialization constants to
+// the SPIR-V before the driver sees it; `driver` gives the driver the whole module and the values.
+bool specialize_on_host() {
+  const char* setting = std::getenv("VKRAY_SPECIALIZE");
+  if (!setting || std::string_view(setting) == "host") return true;
+  if (std::string_view(setting) == "driver") return false;
+  throw UsageError(std::string("VKRAY_SPECIALIZE is '") + setting + "'; it takes host (the default) or driver");
+}
+
+// Each specialization constant's value for `variant`, by SpecId.
+std::map<uint32_t, bool> specialization_values(const ShaderVariant& variant) {
+  std::map<uint32_t, bool> values;
+  for (const SpecConstant& c : kSpecConstants) values[c.id] = variant.*c.member;
+  for (uint32_t type = 0; type < VKRAY_MATERIAL_TYPE_COUNT; ++type) values[VKRAY_SPEC_MATERIALS + type] = (variant.materials >> type) & 1u;
+  return values;
+}
+
+CompiledShader compile_inline_variant(const std::optional<std::filesystem::path>& shader_cache, const std::filesystem::path& shader_dir,
+                                      const ShaderVariant& variant) {
+  return compile_compute_shader_cached(shader_cache, shader_dir / "trace.comp", {shader_dir}, {{"inline_scene.glsl", variant.inline_scene}});
+}
+
 }  // namespace
+
+void prepare_inline_variant(const std::optional<std::filesystem::path>& shader_cache, const std::filesystem::path& shader_dir,
+                            const ShaderVariant& variant) {
+  specialize(compile_inline_variant(shader_cache, shader_dir, variant).spirv, specialization_values(variant));
+}
 
 TracePipeline::TracePipeline(std::shared_ptr<const Context> ctx, std::filesystem::path shader_dir,
                              CompiledShader shader, std::shared_ptr<const vk::raii::PipelineCache> cache,
@@ -74,7 +107,8 @@ TracePipeline::TracePipeline(std::shared_ptr<const Context> ctx, std::filesystem
       shader_dir_(std::move(shader_dir)),
       shader_cache_(std::move(shader_cache)),
       shader_(std::move(shader)),
-      descriptors_(ctx_->device(), kTraceBindings) {
+      descriptors_(ctx_->device(), kTraceBindings),
+      specialize_on_host_(specialize_on_host()) {
   check(shader_);
   const vk::PushConstantRange push(vk::ShaderStageFlagBits::eCompute, 0, sizeof(TileConstants));
   const vk::DescriptorSetLayout set_layout = *descriptors_.layout();
@@ -86,7 +120,13 @@ TracePipeline::~TracePipeline() = default;
 
 std::shared_ptr<const vk::raii::Pipeline> TracePipeline::pipeline(const ShaderVariant& variant) const {
   const std::lock_guard lock(mutex_);
-  if (const auto found = pipelines_.find(variant); found != pipelines_.end()) return found->second;
+  if (const auto found = pipelines_.find(variant); found != pipelines_.end()) {
+    if (!variant.inline_scene.empty()) {  // the most recently used is kept longest, and prepared on a reload
+      inline_order_.erase(std::find(inline_order_.begin(), inline_order_.end(), variant));
+      inline_order_.push_back(variant);
+    }
+    return found->second;
+  }
   auto created = create(variant);
   if (!variant.inline_scene.empty()) {
     inline_order_.push_back(variant);
@@ -104,6 +144,12 @@ void TracePipeline::forget_inline_variants() const {
   inline_order_.clear();
 }
 
+std::optional<ShaderVariant> TracePipeline::newest_inline_variant() const {
+  const std::lock_guard lock(mutex_);
+  if (inline_order_.empty()) return std::nullopt;
+  return inline_order_.back();
+}
+
 void TracePipeline::check(const CompiledShader& shader) const {
   const std::filesystem::path entry = shader_dir_ / "trace.comp";
   descriptors_.check(shader, entry);
@@ -116,27 +162,33 @@ void TracePipeline::check(const CompiledShader& shader) const {
 }
 
 std::shared_ptr<const vk::raii::Pipeline> TracePipeline::create(const ShaderVariant& variant) const {
-  // A scene compiled in is a module of its own; the module may go once the pipeline exists.
-  vk::raii::ShaderModule inline_module{nullptr};
+  // A scene compiled in is a module of its own.
+  std::optional<CompiledShader> inline_shader;
   if (!variant.inline_scene.empty()) {
-    const CompiledShader shader =
-        compile_compute_shader_cached(shader_cache_, shader_dir_ / "trace.comp", {shader_dir_}, {{"inline_scene.glsl", variant.inline_scene}});
-    check(shader);
-    inline_module = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, shader.spirv));
+    inline_shader = compile_inline_variant(shader_cache_, shader_dir_, variant);
+    check(*inline_shader);
   }
-  const vk::ShaderModule module = variant.inline_scene.empty() ? *module_ : *inline_module;
-  constexpr size_t kCount = std::size(kSpecConstants) + VKRAY_MATERIAL_TYPE_COUNT;
-  std::array<VkBool32, kCount> values{};
-  std::array<vk::SpecializationMapEntry, kCount> entries{};
-  for (size_t i = 0; i < kCount; ++i) {
-    const bool material = i >= std::size(kSpecConstants);
-    const uint32_t type = uint32_t(i - std::size(kSpecConstants));
-    values[i] = material ? (variant.materials >> type) & 1u : variant.*kSpecConstants[i].member;
-    const uint32_t id = material ? VKRAY_SPEC_MATERIALS + type : kSpecConstants[i].id;
-    entries[i] = vk::SpecializationMapEntry(id, uint32_t(i * sizeof(VkBool32)), sizeof(VkBool32));
+  const std::map<uint32_t, bool> by_id = specialization_values(variant);
+  std::vector<VkBool32> values;
+  std::vector<vk::SpecializationMapEntry> entries;
+  for (const auto& [id, value] : by_id) {
+    entries.emplace_back(id, uint32_t(values.size() * sizeof(VkBool32)), sizeof(VkBool32));
+    values.push_back(value);
   }
+  // The variant's own module, its constants applied (gpu/specialize.h); the module may go once the
+  // pipeline exists. Where the optimizer declines, or VKRAY_SPECIALIZE=driver, the driver specializes.
+  const std::vector<uint32_t>& spirv = inline_shader ? inline_shader->spirv : shader_.spirv;
+  const std::optional<std::vector<uint32_t>> specialized = specialize_on_host_ ? specialize(spirv, by_id) : std::nullopt;
+  vk::raii::ShaderModule own_module{nullptr};
+  if (specialized) {
+    own_module = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, *specialized));
+  } else if (inline_shader) {
+    own_module = vk::raii::ShaderModule(ctx_->device(), vk::ShaderModuleCreateInfo({}, inline_shader->spirv));
+  }
+  const vk::ShaderModule module = *own_module ? *own_module : *module_;
   const vk::SpecializationInfo specialization(entries, vk::ArrayProxyNoTemporaries<const VkBool32>(values));
-  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, module, "main", &specialization);
+  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, module, "main",
+                                                specialized ? nullptr : &specialization);
   return std::make_shared<const vk::raii::Pipeline>(
       ctx_->device(), cache_ ? vk::Optional<const vk::raii::PipelineCache>(*cache_) : nullptr,
       vk::ComputePipelineCreateInfo({}, stage, *layout_));

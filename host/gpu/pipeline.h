@@ -51,6 +51,13 @@ inline constexpr SpecConstant kSpecConstants[] = {
 #undef VKRAY_SPEC_CONSTANT_ROW
 };
 
+// What pipeline(variant) would compile for a variant with a scene compiled in, from the shaders in
+// `shader_dir`, done now and without a device: the SPIR-V into `shader_cache` and its specialization
+// into specialize()'s memory (gpu/specialize.h), where the pipeline finds them. A reload runs it beside
+// its compile of trace.comp. Throws ShaderError as compiling does.
+void prepare_inline_variant(const std::optional<std::filesystem::path>& shader_cache, const std::filesystem::path& shader_dir,
+                            const ShaderVariant& variant);
+
 class TracePipeline {
  public:
   // `shader`: shader_dir/trace.comp as compiled (compile_compute_shader); variants with a scene
@@ -77,6 +84,8 @@ class TracePipeline {
   // Drops the variants with a scene compiled in (their code comes from the shader files, which may
   // have changed though this SPIR-V did not); a render that holds one keeps it.
   void forget_inline_variants() const;
+  // The variant of the pipeline made last with a scene compiled in (none: no such pipeline).
+  std::optional<ShaderVariant> newest_inline_variant() const;
 
  private:
   std::shared_ptr<const vk::raii::Pipeline> create(const ShaderVariant& variant) const;
@@ -91,6 +100,7 @@ class TracePipeline {
   DescriptorTable descriptors_;
   vk::raii::PipelineLayout layout_{nullptr};
   vk::raii::ShaderModule module_{nullptr};
+  bool specialize_on_host_;  // VKRAY_SPECIALIZE, read when made
   mutable std::mutex mutex_;
   mutable std::map<ShaderVariant, std::shared_ptr<const vk::raii::Pipeline>> pipelines_;
   mutable std::deque<ShaderVariant> inline_order_;  // variants with a scene compiled in, oldest first

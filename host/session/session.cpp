@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <future>
+#include <optional>
+#include <string>
+#include <system_error>
 
 #include "base/errors.h"
 #include "base/hash.h"
@@ -83,7 +87,22 @@ std::vector<std::filesystem::path> Session::shader_sources() const {
 Session::ShaderCompile Session::compile_shaders() {
   device();
   const auto start = Clock::now();
+  // The pipeline in use with a scene compiled in is compiled and specialized again beside trace.comp
+  // (each holds one core), where the next render's pipeline finds it. Its errors are that render's
+  // to report.
+  std::future<void> ahead;
+  if (has_shaders() && shader_cache_)
+    if (std::optional<gpu::ShaderVariant> variant = shaders_->pipeline->newest_inline_variant()) try {
+        ahead = std::async(std::launch::async, [cache = shader_cache_, dir = shader_dir_, variant = std::move(*variant)] {
+          try {
+            gpu::prepare_inline_variant(cache, dir, variant);
+          } catch (...) {  // the render that needs the variant compiles it again, and reports
+          }
+        });
+      } catch (const std::system_error&) {  // no thread to be had: the render compiles it, as without
+      }
   gpu::CompiledShader compiled = gpu::compile_compute_shader_cached(shader_cache_, shader_dir_ / "trace.comp", {shader_dir_});
+  if (ahead.valid()) ahead.wait();
   std::vector<std::filesystem::path> sources = compiled.sources;
   const bool changed = !has_shaders() || compiled.spirv != shaders_->pipeline->shader().spirv;
   if (changed) {
