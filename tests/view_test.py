@@ -39,7 +39,15 @@ def display():
                 break
             number += chunk
     assert number.strip(), "Xvfb did not start"
-    yield ":" + number.decode().strip()
+    name = ":" + number.decode().strip()
+    # Xvfb names its display once it listens; wait until a client is served as well, so that a first
+    # window on a busy machine does not race the server's start.
+    deadline = time.time() + 30
+    while subprocess.run(["xdotool", "getdisplaygeometry"], env=dict(os.environ, DISPLAY=name),
+                         capture_output=True).returncode != 0:
+        assert time.time() < deadline and xvfb.poll() is None, f"Xvfb on {name} serves no client"
+        time.sleep(0.1)
+    yield name
     xvfb.terminate()
     xvfb.wait(10)
 
