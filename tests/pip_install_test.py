@@ -1,0 +1,89 @@
+"""vkray installed as Python users install things: `pip install` from the source tree into a fresh
+virtual environment (scikit-build-core over the CMake build, pyproject.toml), then used from outside
+the source tree: the `vkray` command, the module, and a farm job on two workers, each reading the
+shaders and scenes the install put in the environment.
+
+Run by CTest (tests/CMakeLists.txt) with VKRAY_SOURCE_DIR (the tree to install) and the test
+driver's environment. The install builds vkray in a folder of its own, as pip does. pip fetches the
+build requirements and the dependencies (scikit-build-core, pybind11, numpy, distributed) from PyPI,
+or from whatever index pip is configured to use.
+"""
+import os
+import subprocess
+import sys
+import venv
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+SOURCE = Path(os.environ["VKRAY_SOURCE_DIR"])
+
+
+def environment():
+    """This environment without what points Python or vkray at the source tree or its build."""
+    return {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VKRAY_EXECUTABLE", "VKRAY_SCENE_DIR",
+                                                            "VKRAY_SHADER_DIR", "PYTHONHOME")}
+
+
+def run(args, cwd, timeout=600):
+    done = subprocess.run([str(a) for a in args], cwd=cwd, env=environment(), capture_output=True, text=True,
+                          timeout=timeout)
+    assert done.returncode == 0, f"{' '.join(map(str, args))} exited {done.returncode}:\n{done.stdout}\n{done.stderr}"
+    return done.stdout
+
+
+def read_pfm(path):
+    data = Path(path).read_bytes()
+    header = data.split(b"\n", 3)
+    assert header[0] == b"PF", path
+    width, height = map(int, header[1].split())
+    assert float(header[2]) < 0, "little-endian"
+    pixels = np.frombuffer(header[3], dtype="<f4").reshape(height, width, 3)
+    return pixels[::-1]  # PFM's bottom row comes first
+
+
+@pytest.fixture(scope="module")
+def env(tmp_path_factory):
+    """A fresh venv with vkray[farm] installed from the source tree."""
+    root = tmp_path_factory.mktemp("pip") / "venv"
+    venv.EnvBuilder(with_pip=True).create(root)
+    python = root / "bin" / "python"
+    run([python, "-m", "pip", "install", "--quiet", "--disable-pip-version-check", f"{SOURCE}[farm]"], cwd=root.parent,
+        timeout=3000)
+    return root
+
+
+def test_the_install_holds_the_command_the_module_and_their_data(env):
+    python = env / "bin" / "python"
+    where = run([python, "-c", "import vkray, importlib.metadata as m; "
+                 "print(vkray.__file__); print(vkray.__version__); print(m.version('vkray'))"], cwd=env.parent).splitlines()
+    assert Path(where[0]).is_relative_to(env), where[0]
+    # One version: the command's, the module's, and the package's metadata (CMakeLists.txt's project()).
+    assert run([env / "bin" / "vkray", "--version"], cwd=env.parent).strip() == "vkray " + where[1]
+    assert where[1].split()[0] == where[2]
+    for data in ("shaders/trace.comp", "scenes/cornell.json", "checks"):
+        assert (env / "share" / "vkray" / data).exists(), data
+
+
+def test_the_command_and_the_module_render_the_same_pixels(env, tmp_path):
+    size = ["--width", "64", "--height", "48", "--spp", "2"]
+    run([env / "bin" / "vkray", "render", "-q", *size, "-o", tmp_path / "command.pfm"], cwd=tmp_path)
+    scene = env / "share" / "vkray" / "scenes" / "cornell.json"
+    run([env / "bin" / "python", "-c", "import sys, numpy, vkray; "
+         f"numpy.save(sys.argv[1], vkray.render({str(scene)!r}, width=64, height=48, spp=2))", tmp_path / "module.npy"],
+        cwd=tmp_path)
+    command = read_pfm(tmp_path / "command.pfm")
+    module = np.load(tmp_path / "module.npy")
+    assert module.shape == (48, 64, 3)
+    assert np.array_equal(command, module)
+    assert command.mean() > 0.01  # the Cornell box, not a black image
+
+
+def test_a_farm_job_on_two_workers_gives_the_bytes_of_one_render(env, tmp_path):
+    scene = env / "share" / "vkray" / "scenes" / "cornell-path.json"
+    size = ["--width", "48", "--height", "32", "--spp", "2"]
+    run([env / "bin" / "python", "-m", "vkray.farm", scene, "-o", tmp_path / "farm.pfm", "--workers", "2",
+         "--regions", "4", "-q", *size], cwd=tmp_path)
+    run([env / "bin" / "vkray", "render", scene, "-q", *size, "-o", tmp_path / "one.pfm"], cwd=tmp_path)
+    assert (tmp_path / "farm.pfm").read_bytes() == (tmp_path / "one.pfm").read_bytes()
