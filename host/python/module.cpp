@@ -29,6 +29,7 @@
 #include "python/arguments.h"
 #include "python/calls.h"
 #include "python/exceptions.h"
+#include "python/image_files.h"
 #include "session/cpu_render.h"
 #include "session/options.h"
 #include "session/parts.h"
@@ -45,38 +46,9 @@ namespace {
 // Copies of the render as numpy arrays: a float32 (height, width, 3) array, or with `passes` a
 // dict of it ("color") and the passes asked for.
 py::object to_numpy(const RenderResult& result, const std::vector<Aov>& passes) {
-  const Image& image = result.image;
-  const auto h = py::ssize_t(image.height), w = py::ssize_t(image.width);
-  const auto rgb = [&](const std::vector<glm::vec3>& pixels) {
-    py::array_t<float> a({h, w, py::ssize_t(3)});
-    std::memcpy(a.mutable_data(), pixels.data(), pixels.size() * sizeof(glm::vec3));
-    return a;
-  };
-  py::array_t<float> color = rgb(image.pixels);
-  if (passes.empty()) return py::object(color);
-  py::dict out;
-  out["color"] = color;
-  const Aovs& aovs = *result.aovs;
-  for (const Aov pass : passes) {
-    switch (pass) {
-      case Aov::albedo: out["albedo"] = rgb(aovs.albedo); break;
-      case Aov::normal: out["normal"] = rgb(aovs.normal); break;
-      case Aov::position: out["position"] = rgb(aovs.position); break;
-      case Aov::depth: {
-        py::array_t<float> a({h, w});
-        std::memcpy(a.mutable_data(), aovs.depth.data(), aovs.depth.size() * sizeof(float));
-        out["depth"] = a;
-        break;
-      }
-      case Aov::object: {
-        py::array_t<int32_t> a({h, w});
-        std::memcpy(a.mutable_data(), aovs.object.data(), aovs.object.size() * sizeof(int32_t));
-        out["object"] = a;
-        break;
-      }
-    }
-  }
-  return py::object(out);
+  const py::dict arrays = image_arrays(result.image, result.aovs ? &*result.aovs : nullptr, passes);
+  if (passes.empty()) return arrays["color"];
+  return arrays;
 }
 
 // vkray._vkray._check_output: what a render to `output` would raise before any work.
@@ -361,6 +333,10 @@ PYBIND11_MODULE(_vkray, m) {
   m.def("parity", &vp::parity, py::arg("source"), py::arg("width"), py::arg("height"), py::arg("spp"), py::arg("seed"),
         py::arg("device"), py::arg("validate"), py::arg("threads"));
   m.def("devices", &vp::devices);
+  m.def("_read_image", &vp::read_image_file, py::arg("file"),
+        "A render's .exr (with its passes) or .pfm: ({\"color\": ..., pass: ...}, whether the colour is 32-bit).");
+  m.def("_write_image", &vp::write_image_file, py::arg("file"), py::arg("arrays"), py::arg("exr_float"),
+        "Writes {\"color\": ..., pass: ...} as `vkray render -o` writes a render.");
   m.def("_read_integer",
         [](const std::string& name, const std::string& text, uint32_t min, uint32_t max) {
           return vkray::ArgumentLimit{name, min, max}.read(text);

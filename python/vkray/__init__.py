@@ -38,6 +38,7 @@ except ModuleNotFoundError as _missing:  # a venv, pyenv or conda Python without
                               f"{sys.executable} -m pip install numpy", name="numpy") from _missing
 
 from . import _vkray
+from ._denoise import denoise
 from ._vkray import DeviceError, Error, InternalError, SceneError, UsageError, __version__
 
 __all__ = [
@@ -49,10 +50,13 @@ __all__ = [
     "SceneError",
     "UsageError",
     "bands",
+    "denoise",
     "devices",
     "merge",
     "parity",
+    "read_image",
     "render",
+    "write_image",
     "__version__",
 ]
 
@@ -191,6 +195,49 @@ def _request(width: Optional[int], height: Optional[int], spp: Optional[int], se
                            None if output is None else _path("output", output), _flag("exr_float", exr_float))
 
 
+def read_image(file: Union[str, "os.PathLike[str]"]) -> dict[str, np.ndarray]:
+    """A render's image file as numpy arrays: an .exr (its colour and the first-hit passes it holds)
+    or a .pfm, as the dict ``render(..., aovs=...)`` returns ("color", then each pass).
+
+    Raises:
+        SceneError: the file cannot be read (the message says why).
+        UsageError: a .png (8-bit display values, not radiance), another type, or a part of a render.
+    """
+    return _vkray._read_image(_path("file", file))[0]
+
+
+def write_image(output: Union[str, "os.PathLike[str]"], image: RenderOutput, *, exr_float: bool = False) -> None:
+    """Writes an image, (height, width, 3) floats, or a render's dict (its "color" and passes) as
+    ``vkray render -o`` writes a render: .png (8-bit sRGB, clamped), .pfm, or .exr with the passes as
+    layers (16-bit half floats for colour, albedo and normal; 32-bit with ``exr_float``). The file is
+    written whole or not at all.
+
+    Raises:
+        UsageError: arrays of the wrong shape or type, passes or ``exr_float`` for a .png or .pfm.
+        SceneError: the output cannot be written.
+    """
+    arrays = dict(image) if isinstance(image, Mapping) else {"color": image}
+    _vkray._write_image(_path("output", output), arrays, _flag("exr_float", exr_float))
+
+
+def _guided(aovs: Union[str, Iterable[str]], region: Optional[Region]) -> list[str]:
+    """For a render with denoise=True: the passes asked for, then the denoiser's guides."""
+    if region is not None:
+        raise UsageError("denoise=True with a region: a denoiser looks across the region's edges; render the "
+                         "regions, merge them (vkray.merge), then denoise the whole image (vkray.denoise)")
+    names = _pass_names(aovs)
+    return names + [g for g in ("albedo", "normal") if g not in names]
+
+
+def _denoised(result: dict[str, np.ndarray], aovs: Union[str, Iterable[str]]) -> RenderOutput:
+    """The render's colour denoised, with the passes asked for (as a render without denoise returns)."""
+    image = denoise(result["color"], result["albedo"], result["normal"])
+    asked = _pass_names(aovs)
+    if not asked:
+        return image
+    return {"color": image, **{name: result[name] for name in asked if name != "color"}}
+
+
 class Renderer:
     """A Vulkan device kept open for any number of renders.
 
@@ -218,9 +265,13 @@ class Renderer:
                spp: Optional[int] = None, seed: Optional[int] = None, aovs: Union[str, Iterable[str]] = (),
                region: Optional[Region] = None,
                base_dir: Optional[Union[str, "os.PathLike[str]"]] = None,
-               environment: Optional[Union[str, "os.PathLike[str]"]] = None) -> RenderOutput:
+               environment: Optional[Union[str, "os.PathLike[str]"]] = None, denoise: bool = False) -> RenderOutput:
         """Renders ``scene`` (see ``vkray.render``) on this renderer's device."""
-        return self._renderer.render(_source(scene, base_dir, environment), _request(width, height, spp, seed, aovs, region))
+        source = _source(scene, base_dir, environment)
+        if _flag("denoise", denoise):
+            return _denoised(self._renderer.render(source, _request(width, height, spp, seed, _guided(aovs, region), region)),
+                             aovs)
+        return self._renderer.render(source, _request(width, height, spp, seed, aovs, region))
 
     def render_to_file(self, scene: Scene, output: Union[str, "os.PathLike[str]"], *, width: Optional[int] = None,
                        height: Optional[int] = None, spp: Optional[int] = None, seed: Optional[int] = None,
@@ -260,7 +311,7 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
            seed: Optional[int] = None, renderer: str = "gpu", device: Optional[str] = None,
            aovs: Union[str, Iterable[str]] = (), region: Optional[Region] = None,
            base_dir: Optional[Union[str, "os.PathLike[str]"]] = None, threads: int = 0,
-           environment: Optional[Union[str, "os.PathLike[str]"]] = None) -> RenderOutput:
+           environment: Optional[Union[str, "os.PathLike[str]"]] = None, denoise: bool = False) -> RenderOutput:
     """Renders a scene and returns linear radiance as a float32 array of shape (height, width, 3).
 
     Args:
@@ -280,6 +331,8 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
         threads: for "cpu": threads to use, 1 to 256; 0, one per hardware thread.
         environment: an environment map (.hdr or .exr, equirectangular) that lights the scene in
             place of its own environment and background, as ``vkray render --environment`` does.
+        denoise: denoise the image with Intel Open Image Denoise (``vkray.denoise``, which needs
+            pyoidn), guided by the albedo and normal passes, rendered for it; not with a region.
 
     Raises:
         SceneError: the scene or a file it names cannot be used (the message names the file and key).
@@ -292,11 +345,15 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
     if renderer == "gpu":
         with Renderer(device) as r:
             return r.render(scene, width=width, height=height, spp=spp, seed=seed, aovs=aovs, region=region,
-                            base_dir=base_dir, environment=environment)
+                            base_dir=base_dir, environment=environment, denoise=denoise)
     if renderer == "cpu":
         if device is not None:
             raise UsageError("device is for renderer='gpu'; the CPU reference runs on the host")
-        return _vkray.render_cpu(_source(scene, base_dir, environment), _request(width, height, spp, seed, aovs, region), threads)
+        source = _source(scene, base_dir, environment)
+        if _flag("denoise", denoise):
+            return _denoised(_vkray.render_cpu(source, _request(width, height, spp, seed, _guided(aovs, region), region),
+                                               threads), aovs)
+        return _vkray.render_cpu(source, _request(width, height, spp, seed, aovs, region), threads)
     raise UsageError(f"renderer is 'gpu' or 'cpu', not {renderer!r}")
 
 

@@ -46,6 +46,7 @@ from typing import Any, Optional, Sequence
 
 import vkray
 
+from ._commands import add_image_options, run_command
 from ._farm_cluster import _close, _connect, _gpu_workers, _require_dask
 from ._farm_errors import _CannotWrite, _ClusterError, _MissingDask, _Usage
 from ._farm_outputs import _commit, _frame_output, _merge_frames
@@ -102,10 +103,7 @@ def _parser() -> argparse.ArgumentParser:
                         "workers, and the first result of each is used (default 4)")
     p.add_argument("--slow-floor", type=_seconds, default=10.0, metavar="SECONDS",
                    help="the least time that makes a worker slow, whatever the median (default 10)")
-    p.add_argument("--width", metavar="W", help="image width in pixels (default: the scene's)")
-    p.add_argument("--height", metavar="H", help="image height in pixels (default: the scene's)")
-    p.add_argument("--spp", metavar="N", help="samples per pixel (default: the scene's)")
-    p.add_argument("--seed", metavar="S", help="sample streams (default: the scene's)")
+    add_image_options(p)
     p.add_argument("--aov", default="", metavar="LIST", help="first-hit passes for an .exr output, comma-separated")
     p.add_argument("--exr-float", action="store_true", help="32-bit float channels in an .exr output")
     p.add_argument("-q", "--quiet", action="store_true", help="print only errors")
@@ -278,16 +276,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, _interrupt)
         signal.signal(signal.SIGTERM, _interrupt)
-    try:
-        return run(argv)
-    except KeyboardInterrupt:
-        print("vkray.farm: interrupted; nothing written", file=sys.stderr)
-        return 130
-    except Exception as e:
-        code = next((code for kind, code in _EXIT_CODES if isinstance(e, kind)), None)
-        own = code is not None and not isinstance(e, MemoryError)
-        print(f"vkray.farm: error: {e if own else f'{type(e).__name__}: {e}'}", file=sys.stderr)
-        return 3 if code is None else code
+    return run_command("vkray.farm", lambda: run(argv), _EXIT_CODES)
 
 
 if __name__ == "__main__":
