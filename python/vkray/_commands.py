@@ -18,16 +18,21 @@ def add_image_options(parser: Any) -> None:
     parser.add_argument("--seed", metavar="S", help="sample streams (default: the scene's)")
 
 
-def run_command(prog: str, run: Callable[[], int], exit_codes: Sequence[tuple[type, int]]) -> int:
+def run_command(prog: str, run: Callable[[], int], exit_codes: Sequence[tuple[type, int]],
+                interrupted: Callable[[], bool] = lambda: False) -> int:
     """``run()``'s exit code; for an exception, "PROG: error: MESSAGE" on stderr and the code
     ``exit_codes`` gives its kind (first match), or 3 for one it does not list, named with its type
-    (a cluster's or a library's own failure); 130, "nothing written", for Ctrl-C."""
+    (a cluster's or a library's own failure); 130, "nothing written", for Ctrl-C, and for any
+    exception once ``interrupted()`` says a signal stopped the command."""
     try:
         return run()
     except KeyboardInterrupt:
         print(f"{prog}: interrupted; nothing written", file=sys.stderr)
         return 130
     except Exception as e:
+        if interrupted():
+            print(f"{prog}: interrupted; nothing written", file=sys.stderr)
+            return 130
         code: Optional[int] = next((code for kind, code in exit_codes if isinstance(e, kind)), None)
         own = code is not None and not isinstance(e, MemoryError)
         print(f"{prog}: error: {e if own else f'{type(e).__name__}: {e}'}", file=sys.stderr)

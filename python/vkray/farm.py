@@ -255,8 +255,15 @@ _EXIT_CODES = ((_Usage, 2), (_CannotWrite, 1), (_MissingDask, 1), (MemoryError, 
 _shielded = False
 
 
+# Set when a signal raised KeyboardInterrupt: whatever the job fails with after that (a
+# KeyboardInterrupt raised inside an import comes out as CPython's TypeError) is the interruption.
+_interrupted = False
+
+
 def _interrupt(signum: int, frame: Any) -> None:
+    global _interrupted
     if not _shielded:
+        _interrupted = True
         raise KeyboardInterrupt
 
 
@@ -276,7 +283,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, _interrupt)
         signal.signal(signal.SIGTERM, _interrupt)
-    return run_command("vkray.farm", lambda: run(argv), _EXIT_CODES)
+    return run_command("vkray.farm", lambda: run(argv), _EXIT_CODES, interrupted=lambda: _interrupted)
 
 
 if __name__ == "__main__":
