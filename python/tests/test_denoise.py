@@ -48,6 +48,14 @@ def test_without_pyoidn_the_message_says_how_to_install_it(monkeypatch):
     assert error.value.name == "pyoidn"
 
 
+def test_without_pyoidn_a_denoised_render_fails_before_it_renders(monkeypatch, scenes):
+    monkeypatch.setitem(sys.modules, "pyoidn", None)
+    with vkray.Renderer() as r:
+        with pytest.raises(ModuleNotFoundError):
+            r.render(scenes / "cornell.json", width=16, height=16, denoise=True)
+        assert r.last_stats is None  # nothing was rendered
+
+
 def test_a_region_is_not_denoised_alone(scenes):
     with pytest.raises(vkray.UsageError) as error:
         vkray.render(scenes / "cornell.json", width=16, height=16, region="1/2", denoise=True)

@@ -38,6 +38,7 @@ except ModuleNotFoundError as _missing:  # a venv, pyenv or conda Python without
                               f"{sys.executable} -m pip install numpy", name="numpy") from _missing
 
 from . import _vkray
+from . import _denoise
 from ._denoise import denoise
 from ._vkray import DeviceError, Error, InternalError, SceneError, UsageError, __version__
 
@@ -225,6 +226,7 @@ def _guided(aovs: Union[str, Iterable[str]], region: Optional[Region]) -> list[s
     if region is not None:
         raise UsageError("denoise=True with a region: a denoiser looks across the region's edges; render the "
                          "regions, merge them (vkray.merge), then denoise the whole image (vkray.denoise)")
+    _denoise._oidn()  # before the render, not after it
     names = _pass_names(aovs)
     return names + [g for g in ("albedo", "normal") if g not in names]
 
