@@ -7,6 +7,7 @@ pip installed vkray[denoise], with VKRAY_REQUIRE_OIDN=1, where a missing pyoidn 
 
 import importlib.util
 import os
+import subprocess
 import sys
 
 import numpy as np
@@ -213,3 +214,24 @@ def test_a_scene_is_rendered_with_the_guides_and_denoised(tmp_path, scenes, caps
     assert code == 0, err
     expected = vkray.render(scenes / "cornell-path.json", width=48, height=32, spp=4, denoise=True)
     assert np.array_equal(vkray.read_image(tmp_path / "out.pfm")["color"], expected)
+
+
+# ---- python3 -m vkray.farm --denoise -------------------------------------------------------------
+
+@needs_oidn
+def test_a_farm_job_denoises_the_merged_frames_as_one_render_would(tmp_path, scenes, capsys):
+    pytest.importorskip("distributed", reason="the farm needs Dask's distributed (vkray[farm])")
+    size = ["--width", "64", "--height", "48", "--spp", "4"]
+    farm = subprocess.run([sys.executable, "-m", "vkray.farm", scenes / "cornell-path.json", *size, "--aov", "depth",
+                           "--workers", "2", "--regions", "4", "--denoise", "-o", tmp_path / "farm.exr"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert farm.returncode == 0, farm.stderr
+    assert "denoised frame 0 (64x48)" in farm.stderr, farm.stderr
+    # A denoiser looks across the bands' edges: the frame is denoised whole, after the merge, and
+    # is the image the denoiser gives a single render, with the guides kept beside the passes asked for.
+    code, err = denoise_command([scenes / "cornell-path.json", *size, "--aov", "depth", "-o", tmp_path / "one.exr"],
+                                capsys)
+    assert code == 0, err
+    assert (tmp_path / "farm.exr").read_bytes() == (tmp_path / "one.exr").read_bytes()
+    assert list(vkray.read_image(tmp_path / "farm.exr")) == ["color", "albedo", "normal", "depth"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["farm.exr", "one.exr"]  # the parts are gone

@@ -433,6 +433,17 @@ def test_a_python_without_dask_is_told_what_to_install_for_it(scenes, tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_denoise_without_pyoidn_fails_before_any_work(scenes, tmp_path):
+    hide_pyoidn = ("import runpy, sys; sys.modules['pyoidn'] = None; sys.argv[0] = 'vkray.farm'; "
+                   "runpy.run_module('vkray.farm', run_name='__main__', alter_sys=True)")
+    job = run(sys.executable, "-c", hide_pyoidn, f"{scenes}/cornell-path.json", "-o", "x.exr", "--denoise",
+              check=False, cwd=tmp_path)
+    assert job.returncode == 1, job.stderr
+    assert "--denoise needs Intel Open Image Denoise (pyoidn)" in job.stderr, job.stderr
+    assert "Traceback" not in job.stderr and "parts" not in job.stderr, job.stderr  # no cluster was started
+    assert list(tmp_path.iterdir()) == []
+
+
 def commit_case(tmp_path: Path, old: dict[int, str]) -> tuple[list[Path], list[Path], Path]:
     """Three merged frames in a parts folder, ready for `_commit`, and their targets, those in `old`
     there already with that text; the last target's folder is missing, so that its rename fails."""

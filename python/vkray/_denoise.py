@@ -40,7 +40,8 @@ def _image(name: str, value: Any, shape: Optional[tuple[int, ...]]) -> np.ndarra
     return np.ascontiguousarray(value, dtype=np.float32)
 
 
-def _oidn() -> Any:
+def _oidn(user: str = "vkray.denoise") -> Any:
+    """pyoidn, or a ModuleNotFoundError that says `user` needs it and how to install it for this Python."""
     try:
         import pyoidn
     except ModuleNotFoundError:
@@ -52,7 +53,7 @@ def _oidn() -> Any:
         else:
             advice = (f"install it for this Python: {sys.executable} -m pip install pyoidn (or pip install "
                       "'.[denoise]' in vkray's source tree)")
-        raise ModuleNotFoundError(f"vkray.denoise needs Intel Open Image Denoise (pyoidn), which {sys.executable} "
+        raise ModuleNotFoundError(f"{user} needs Intel Open Image Denoise (pyoidn), which {sys.executable} "
                                   f"cannot import; {advice}", name="pyoidn") from None
     return pyoidn
 

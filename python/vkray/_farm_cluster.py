@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 from typing import Any, Optional
 
-from ._farm_errors import _ClusterError, _MissingDask, _Usage
+from ._farm_errors import _ClusterError, _MissingPackage, _Usage
 
 # How long closing the client, and then the LocalCluster, may take.
 _CLOSE_SECONDS = 20
@@ -29,7 +29,7 @@ def _require_dask() -> None:
         advice += " (or run the farm with /usr/bin/python3 after apt-get install python3-distributed)"
     elif os.path.exists("/etc/debian_version"):
         advice = "install it: apt-get install python3-distributed (or " + advice + ")"
-    raise _MissingDask(f"the farm needs Dask's distributed, which {sys.executable} cannot import; {advice}")
+    raise _MissingPackage(f"the farm needs Dask's distributed, which {sys.executable} cannot import; {advice}")
 
 
 def _gpu_addresses(workers: dict[str, Any]) -> list[str]:

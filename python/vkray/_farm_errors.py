@@ -10,8 +10,9 @@ class _CannotWrite(Exception):
     """An output, or a part in the folder beside it, cannot be written: bad input (1)."""
 
 
-class _MissingDask(Exception):
-    """Dask's distributed is not importable by the Python that runs the farm: bad input (1)."""
+class _MissingPackage(Exception):
+    """A package the job needs is not importable by the Python that runs the farm (Dask's
+    distributed, or pyoidn for --denoise): bad input (1)."""
 
 
 class _ClusterError(Exception):

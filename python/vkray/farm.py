@@ -4,7 +4,10 @@ The image is cut into bands of about equal work (``vkray.bands``, the bands ``vk
 I/N`` renders); each band is a Dask task that renders it on a worker's GPU as a part file, and the
 parts come back to this process, which merges them (``vkray.merge``) into OUT: byte for byte the
 image a single ``vkray render -o OUT`` gives when the workers share a build and a device type. More
-scenes after ``--frames`` are more frames, each its own set of tasks.
+scenes after ``--frames`` are more frames, each its own set of tasks. With ``--denoise`` the parts
+hold the albedo and normal passes too, and each merged frame is denoised here, whole (a denoiser looks
+across the bands' edges), with Intel Open Image Denoise (``vkray.denoise``): the image
+``python3 -m vkray.denoise SCENE -o OUT`` gives.
 
 Without ``--scheduler`` a ``LocalCluster`` of ``--workers`` processes runs here. With one, the tasks
 go to that cluster's workers that declare a GPU (``dask worker ADDRESS --resources GPU=1``), one task
@@ -46,10 +49,11 @@ from typing import Any, Optional, Sequence
 
 import vkray
 
+from . import _denoise
 from ._commands import add_image_options, run_command
 from ._farm_cluster import _close, _connect, _gpu_workers, _require_dask
-from ._farm_errors import _CannotWrite, _ClusterError, _MissingDask, _Usage
-from ._farm_outputs import _commit, _frame_output, _merge_frames
+from ._farm_errors import _CannotWrite, _ClusterError, _MissingPackage, _Usage
+from ._farm_outputs import GUIDES, _commit, _denoise_frames, _frame_output, _merge_frames
 from ._farm_parts import _PART_SUFFIX, _frame_parts, _Job, _Part
 from ._farm_worker import _render_part  # noqa: F401  (the task, also as vkray.farm._render_part)
 
@@ -106,6 +110,9 @@ def _parser() -> argparse.ArgumentParser:
     add_image_options(p)
     p.add_argument("--aov", default="", metavar="LIST", help="first-hit passes for an .exr output, comma-separated")
     p.add_argument("--exr-float", action="store_true", help="32-bit float channels in an .exr output")
+    p.add_argument("--denoise", action="store_true",
+                   help="denoise each merged frame with Intel Open Image Denoise (pyoidn), guided by its albedo and "
+                        "normal passes, which the parts then render too; an .exr output keeps them")
     p.add_argument("-q", "--quiet", action="store_true", help="print only errors")
     return p
 
@@ -169,9 +176,22 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     # The library's own checks of an output, so that the farm refuses what `vkray render -o` refuses,
     # with the same message and exit code.
     vkray._vkray._check_output(output, aovs, args.exr_float, False)
-    suffix = _PART_SUFFIX[output.suffix.lower()]
     settings = {"width": args.width, "height": args.height, "spp": args.spp, "seed": args.seed, "aovs": args.aov,
                 "exr_float": args.exr_float}
+    suffix = _PART_SUFFIX[output.suffix.lower()]
+    kept = aovs  # the passes each output holds
+    if args.denoise:
+        try:
+            _denoise._oidn("--denoise")
+        except ModuleNotFoundError as e:
+            raise _MissingPackage(str(e)) from None
+        # The parts render the guides too, at full precision: the denoiser's input is the image a
+        # single render gives. An .exr output keeps them.
+        rendered_passes = aovs + [guide for guide in GUIDES if guide not in aovs]
+        kept = rendered_passes if output.suffix.lower() == ".exr" else []
+        vkray._vkray._check_output(output, kept, args.exr_float, False)
+        settings.update(aovs=",".join(rendered_passes), exr_float=True)
+        suffix = ".exr"
     # Every scene read here first, so that a bad one fails before any worker starts.
     scenes = [str(Path(s).resolve()) for s in [args.scene, *args.frames]]
     rows = min(vkray.bands(scene, 1, width=args.width, height=args.height)[0][3] for scene in scenes)
@@ -181,7 +201,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
 
     targets = [_frame_output(output, frame, len(scenes)) for frame in range(len(scenes))]
     for target in targets:
-        vkray._vkray._check_output(target, aovs, args.exr_float, False)
+        vkray._vkray._check_output(target, kept, args.exr_float, False)
 
     client = cluster = folder = workspace = None
     try:
@@ -220,7 +240,10 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         # Every part is here: now, and only now, the outputs are written, each merged under a name
         # of its own in the parts' folder and then all renamed into place (one file system).
         merged = _merge_frames([_frame_parts(folder, frame, suffix) for frame in range(len(scenes))], folder,
-                               output.suffix)
+                               suffix if args.denoise else output.suffix)
+        if args.denoise:
+            merged = _denoise_frames(merged, folder, output.suffix, kept, args.exr_float,
+                                     lambda line: _log(args.quiet, line))
         with _no_interrupts():
             try:
                 _commit(merged, targets, folder)
@@ -236,17 +259,18 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
             for remove in (folder, workspace):
                 if remove is not None:
                     shutil.rmtree(remove, ignore_errors=True)
-    _log(args.quiet, f"{len(jobs)} parts rendered in {rendered:.2f} s, merged in {merged_in:.2f} s")
+    _log(args.quiet, f"{len(jobs)} parts rendered in {rendered:.2f} s, merged{' and denoised' if args.denoise else ''} "
+                     f"in {merged_in:.2f} s")
     return 0
 
 
 # ---- exit codes and interruptions -----------------------------------------------------------------
 
 # The exit code of each kind of error, in the command line's classes: 1 bad input (an output that
-# cannot be written, a machine without Dask or without the host memory for the job), 2 usage, 3
-# device or cluster, 70 a bug of vkray's. Anything else is the cluster's (a worker lost too often,
+# cannot be written, a machine without Dask (or pyoidn, for --denoise) or without the host memory
+# for the job), 2 usage, 3 device or cluster, 70 a bug of vkray's. Anything else is the cluster's (a worker lost too often,
 # KilledWorker): 3.
-_EXIT_CODES = ((_Usage, 2), (_CannotWrite, 1), (_MissingDask, 1), (MemoryError, 1), (_ClusterError, 3),
+_EXIT_CODES = ((_Usage, 2), (_CannotWrite, 1), (_MissingPackage, 1), (MemoryError, 1), (_ClusterError, 3),
                (vkray.SceneError, 1), (vkray.UsageError, 2), (vkray.DeviceError, 3), (vkray.InternalError, 70))
 
 
