@@ -268,8 +268,8 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
 
 # The exit code of each kind of error, in the command line's classes: 1 bad input (an output that
 # cannot be written, a machine without Dask (or pyoidn, for --denoise) or without the host memory
-# for the job), 2 usage, 3 device or cluster, 70 a bug of vkray's. Anything else is the cluster's (a worker lost too often,
-# KilledWorker): 3.
+# for the job), 2 usage, 3 device or cluster, 70 a bug of vkray's. Anything else is the cluster's
+# (a worker lost too often, KilledWorker): 3.
 _EXIT_CODES = ((_Usage, 2), (_CannotWrite, 1), (_MissingPackage, 1), (MemoryError, 1), (_ClusterError, 3),
                (vkray.SceneError, 1), (vkray.UsageError, 2), (vkray.DeviceError, 3), (vkray.InternalError, 70))
 
