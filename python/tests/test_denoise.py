@@ -7,19 +7,41 @@ pip installed vkray[denoise], with VKRAY_REQUIRE_OIDN=1, where a missing pyoidn 
 
 import importlib.util
 import os
+import signal
 import subprocess
 import sys
+import time
+import types
 
 import numpy as np
 import pytest
 
 import vkray
+from vkray import _denoise
 
 HAVE_OIDN = importlib.util.find_spec("pyoidn") is not None or bool(os.environ.get("VKRAY_REQUIRE_OIDN"))
 needs_oidn = pytest.mark.skipif(not HAVE_OIDN, reason="pyoidn is not installed for this Python; "
                                 "tests/pip_install_test.py runs these in a venv that has it")
 
 IMAGE = np.full((6, 8, 3), 0.5, np.float32)
+
+
+@pytest.fixture(autouse=True)
+def oidn_not_yet_opened(monkeypatch):
+    """Each test finds pyoidn as it sets it up: vkray opens OIDN once per process and keeps it."""
+    monkeypatch.setattr(_denoise, "_ready", None)
+
+
+class UnloadablePyoidn(types.ModuleType):
+    """A pyoidn whose OIDN library does not load (pyoidn loads it when a device is first made)."""
+
+    def __init__(self):
+        super().__init__("pyoidn")
+        self.__file__ = "/nowhere/pyoidn/__init__.py"
+
+    class Device:
+        def __init__(self):
+            raise OSError("cannot load library 'libOpenImageDenoise.so.2': no such file")
 
 
 @pytest.mark.parametrize("args, kwargs, says", [
@@ -53,6 +75,16 @@ def test_without_pyoidn_a_denoised_render_fails_before_it_renders(monkeypatch, s
     monkeypatch.setitem(sys.modules, "pyoidn", None)
     with vkray.Renderer() as r:
         with pytest.raises(ModuleNotFoundError):
+            r.render(scenes / "cornell.json", width=16, height=16, denoise=True)
+        assert r.last_stats is None  # nothing was rendered
+
+
+def test_an_oidn_that_cannot_run_is_a_device_error_before_the_render(monkeypatch, scenes):
+    monkeypatch.setitem(sys.modules, "pyoidn", UnloadablePyoidn())
+    with pytest.raises(vkray.DeviceError, match="Open Image Denoise .* cannot run: cannot load library"):
+        vkray.denoise(IMAGE)
+    with vkray.Renderer() as r:
+        with pytest.raises(vkray.DeviceError):
             r.render(scenes / "cornell.json", width=16, height=16, denoise=True)
         assert r.last_stats is None  # nothing was rendered
 
@@ -193,6 +225,51 @@ def test_without_pyoidn_the_command_says_so_before_any_work(render_with_guides, 
     code, err = denoise_command([render_with_guides, "-o", tmp_path / "out.exr"], capsys)
     assert code == 1 and "needs Intel Open Image Denoise (pyoidn)" in err
     assert not (tmp_path / "out.exr").exists()
+
+
+def test_an_oidn_that_cannot_run_exits_3_and_writes_nothing(render_with_guides, tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "pyoidn", UnloadablePyoidn())
+    code, err = denoise_command([render_with_guides, "-o", tmp_path / "out.exr"], capsys)
+    assert code == 3 and "vkray.denoise: error: Open Image Denoise" in err and "Traceback" not in err, err
+    assert not (tmp_path / "out.exr").exists()
+
+
+def test_passes_for_an_output_that_is_not_an_exr_are_refused_as_vkray_render_refuses_them(tmp_path, scenes, capsys):
+    code, err = denoise_command([scenes / "cornell-path.json", "--aov", "depth", "-o", tmp_path / "out.png"], capsys)
+    assert code == 2 and "written to EXR files only" in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+# A pyoidn that opens its device and is never asked to denoise: the command renders as with OIDN.
+# It says "opened" when the command opens it, just before the render (its signal handlers are set).
+FAKE_PYOIDN_THEN_RUN = """
+import runpy, sys, types
+class Device:
+    def __enter__(self): return self
+    def __exit__(self, *exc): return False
+    def commit(self): print("opened", flush=True)
+    def get_error(self): return None
+sys.modules["pyoidn"] = types.SimpleNamespace(Device=Device, __file__="fake")
+sys.argv[0] = "vkray.denoise"
+runpy.run_module("vkray.denoise", run_name="__main__", alter_sys=True)
+"""
+
+
+def test_sigterm_stops_the_command_as_ctrl_c_does_and_nothing_is_written(tmp_path, scenes):
+    job = subprocess.Popen([sys.executable, "-c", FAKE_PYOIDN_THEN_RUN, scenes / "cornell-path.json", "--width", "256",
+                            "--height", "256", "--spp", "65536", "-o", tmp_path / "out.exr"],
+                           cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert job.stdout.readline() == "opened\n", job.communicate()[1]
+        time.sleep(0.5)  # into the render, which takes minutes
+        assert job.poll() is None, job.communicate()[1]
+        job.send_signal(signal.SIGTERM)
+        err = job.communicate(timeout=60)[1]
+    finally:
+        job.kill()
+    assert job.returncode == 130, err
+    assert "vkray.denoise: interrupted; nothing written" in err, err
+    assert list(tmp_path.iterdir()) == []
 
 
 @needs_oidn

@@ -233,7 +233,7 @@ def _guided(aovs: Union[str, Iterable[str]], region: Optional[Region]) -> list[s
 
 def _denoised(result: dict[str, np.ndarray], aovs: Union[str, Iterable[str]]) -> RenderOutput:
     """The render's colour denoised, with the passes asked for (as a render without denoise returns)."""
-    image = denoise(result["color"], result["albedo"], result["normal"])
+    image = _denoise.denoise(result["color"], result["albedo"], result["normal"])
     asked = _pass_names(aovs)
     if not asked:
         return image

@@ -10,12 +10,14 @@ it with ``--aov albedo,normal``); an .exr output keeps every pass the input had.
 .gltf, .glb): rendered with the guides, then denoised; an .exr output holds the guides and the passes
 ``--aov`` asks for. OUTPUT is .exr, .pfm or .png, written whole or not at all. Exit codes as
 ``vkray render``'s: 1 bad input (a file without the guides, an output that cannot be written, pyoidn
-not installed), 2 usage, 3 device, 130 interrupted; on any failure nothing is written.
+not installed), 2 usage, 3 device (OIDN's included), 130 interrupted (Ctrl-C, SIGTERM); on any
+failure nothing is written.
 """
 
 from __future__ import annotations
 
 import argparse
+import inspect
 import sys
 import time
 import types
@@ -39,12 +41,14 @@ class _BadInput(Exception):
     """An input that cannot be used as asked (exit 1)."""
 
 
-_EXIT_CODES = ((_Usage, 2), (_BadInput, 1), (ModuleNotFoundError, 1), (vkray.SceneError, 1), (vkray.UsageError, 2),
-               (vkray.DeviceError, 3), (vkray.InternalError, 70))
+_EXIT_CODES = ((_Usage, 2), (_BadInput, 1), (ModuleNotFoundError, 1), (MemoryError, 1), (vkray.SceneError, 1),
+               (vkray.UsageError, 2), (vkray.DeviceError, 3), (vkray.InternalError, 70))
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python3 -m vkray.denoise",
+    # The console script a pip install makes is named as it was run; otherwise the module.
+    prog = "vkray-denoise" if Path(sys.argv[0]).name == "vkray-denoise" else "python3 -m vkray.denoise"
+    p = argparse.ArgumentParser(prog=prog,
                                 description="A render denoised with Intel Open Image Denoise, guided by its albedo "
                                             "and normal passes: from a render's .exr or .pfm, or a scene rendered for it.")
     p.add_argument("input", metavar="INPUT", help="a render's .exr or .pfm, or a scene (.json, .gltf, .glb) to render")
@@ -87,8 +91,9 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     guides = [] if args.without_guides else list(_GUIDES)
     written = extra + [g for g in guides if g not in extra]
     exr = Path(args.output).suffix.lower() == ".exr"
-    # The output is checked before any work, as `vkray render` checks it, and OIDN before a render.
-    vkray._vkray._check_output(args.output, written if exr else [], args.exr_float, False)
+    # The output is checked before any work, as `vkray render` checks it (--aov for an output that is
+    # not an EXR is refused as it refuses it); OIDN before a render, and an input file before OIDN.
+    vkray._vkray._check_output(args.output, written if exr else extra, args.exr_float, False)
 
     start = time.monotonic()
     if from_scene:
@@ -122,7 +127,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
 class _CallableModule(types.ModuleType):
     """Importing vkray.denoise (the console script does) binds the package's name ``denoise`` to this
-    module; calling it still denoises, as ``vkray.denoise(...)`` does everywhere else."""
+    module; calling it still denoises, as ``vkray.denoise(...)`` does everywhere else, with the
+    function's signature (``inspect.signature``)."""
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         return _denoise.denoise(*args, **kwargs)
@@ -132,3 +138,4 @@ if __name__ == "__main__":
     sys.exit(main())
 else:
     sys.modules[__name__].__class__ = _CallableModule
+    __signature__ = inspect.signature(_denoise.denoise)

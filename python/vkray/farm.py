@@ -37,20 +37,17 @@ frames, putting them in place) and _farm_errors (the farm's kinds of failure).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import shutil
-import signal
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import Optional, Sequence
 
 import vkray
 
 from . import _denoise
-from ._commands import add_image_options, run_command
+from ._commands import add_image_options, no_interrupts, run_command
 from ._farm_cluster import _close, _connect, _gpu_workers, _require_dask
 from ._farm_errors import _CannotWrite, _ClusterError, _MissingPackage, _Usage
 from ._farm_outputs import GUIDES, _commit, _denoise_frames, _frame_output, _merge_frames
@@ -244,7 +241,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         if args.denoise:
             merged = _denoise_frames(merged, folder, output.suffix, kept, args.exr_float,
                                      lambda line: _log(args.quiet, line))
-        with _no_interrupts():
+        with no_interrupts():
             try:
                 _commit(merged, targets, folder)
             except OSError as e:
@@ -254,7 +251,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         merged_in = time.perf_counter() - started - rendered
     finally:
         # A second Ctrl-C or a SIGTERM from a batch system must not leave the parts or the cluster.
-        with _no_interrupts():
+        with no_interrupts():
             _close(client, cluster)
             for remove in (folder, workspace):
                 if remove is not None:
@@ -274,40 +271,10 @@ _EXIT_CODES = ((_Usage, 2), (_CannotWrite, 1), (_MissingPackage, 1), (MemoryErro
                (vkray.SceneError, 1), (vkray.UsageError, 2), (vkray.DeviceError, 3), (vkray.InternalError, 70))
 
 
-# While set, Ctrl-C and SIGTERM are ignored: the outputs are being renamed into place (milliseconds),
-# or the parts and the cluster cleaned up.
-_shielded = False
-
-
-# Set when a signal raised KeyboardInterrupt: whatever the job fails with after that (a
-# KeyboardInterrupt raised inside an import comes out as CPython's TypeError) is the interruption.
-_interrupted = False
-
-
-def _interrupt(signum: int, frame: Any) -> None:
-    global _interrupted
-    if not _shielded:
-        _interrupted = True
-        raise KeyboardInterrupt
-
-
-@contextlib.contextmanager
-def _no_interrupts():
-    global _shielded
-    previous, _shielded = _shielded, True
-    try:
-        yield
-    finally:
-        _shielded = previous
-
-
 def main(argv: Optional[Sequence[str]] = None) -> int:
     # SIGTERM (a batch system's cancel, `kill`) stops the farm as Ctrl-C does: the cluster it
     # started is closed and nothing is written.
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, _interrupt)
-        signal.signal(signal.SIGTERM, _interrupt)
-    return run_command("vkray.farm", lambda: run(argv), _EXIT_CODES, interrupted=lambda: _interrupted)
+    return run_command("vkray.farm", lambda: run(argv), _EXIT_CODES)
 
 
 if __name__ == "__main__":
