@@ -228,16 +228,25 @@ def _guided(aovs: Union[str, Iterable[str]], region: Optional[Region]) -> list[s
                          "regions, merge them (vkray.merge), then denoise the whole image (vkray.denoise)")
     _denoise._oidn()  # before the render, not after it
     names = _pass_names(aovs)
-    return names + [g for g in ("albedo", "normal") if g not in names]
+    return names + [g for g in _denoise.GUIDES if g not in names]
 
 
 def _denoised(result: dict[str, np.ndarray], aovs: Union[str, Iterable[str]]) -> RenderOutput:
     """The render's colour denoised, with the passes asked for (as a render without denoise returns)."""
-    image = _denoise.denoise(result["color"], result["albedo"], result["normal"])
+    image = _denoise.denoise(result["color"], *(result[g] for g in _denoise.GUIDES))
     asked = _pass_names(aovs)
     if not asked:
         return image
     return {"color": image, **{name: result[name] for name in asked if name != "color"}}
+
+
+def _rendered(render_with: Any, width: Optional[int], height: Optional[int], spp: Optional[int], seed: Optional[int],
+              aovs: Union[str, Iterable[str]], region: Optional[Region], denoise: bool) -> RenderOutput:
+    """``render_with(request)``, a render of the GPU or the CPU reference; with ``denoise``, rendered
+    with the guides too and returned denoised, as a render without it returns."""
+    if not _flag("denoise", denoise):
+        return render_with(_request(width, height, spp, seed, aovs, region))
+    return _denoised(render_with(_request(width, height, spp, seed, _guided(aovs, region), region)), aovs)
 
 
 class Renderer:
@@ -270,10 +279,8 @@ class Renderer:
                environment: Optional[Union[str, "os.PathLike[str]"]] = None, denoise: bool = False) -> RenderOutput:
         """Renders ``scene`` (see ``vkray.render``) on this renderer's device."""
         source = _source(scene, base_dir, environment)
-        if _flag("denoise", denoise):
-            return _denoised(self._renderer.render(source, _request(width, height, spp, seed, _guided(aovs, region), region)),
-                             aovs)
-        return self._renderer.render(source, _request(width, height, spp, seed, aovs, region))
+        return _rendered(lambda request: self._renderer.render(source, request), width, height, spp, seed, aovs, region,
+                         denoise)
 
     def render_to_file(self, scene: Scene, output: Union[str, "os.PathLike[str]"], *, width: Optional[int] = None,
                        height: Optional[int] = None, spp: Optional[int] = None, seed: Optional[int] = None,
@@ -352,10 +359,8 @@ def render(scene: Scene, *, width: Optional[int] = None, height: Optional[int] =
         if device is not None:
             raise UsageError("device is for renderer='gpu'; the CPU reference runs on the host")
         source = _source(scene, base_dir, environment)
-        if _flag("denoise", denoise):
-            return _denoised(_vkray.render_cpu(source, _request(width, height, spp, seed, _guided(aovs, region), region),
-                                               threads), aovs)
-        return _vkray.render_cpu(source, _request(width, height, spp, seed, aovs, region), threads)
+        return _rendered(lambda request: _vkray.render_cpu(source, request, threads), width, height, spp, seed, aovs,
+                         region, denoise)
     raise UsageError(f"renderer is 'gpu' or 'cpu', not {renderer!r}")
 
 

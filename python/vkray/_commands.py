@@ -48,6 +48,13 @@ def add_image_options(parser: Any) -> None:
     parser.add_argument("--seed", metavar="S", help="sample streams (default: the scene's)")
 
 
+def read_image_option(name: str, text: Optional[str]) -> Optional[int]:
+    """--width, --height, --spp or --seed (`name`) as add_image_options took it, read and checked as
+    `vkray render` reads its flags: against the library's table of limits, a UsageError in its words."""
+    from ._vkray import _ARGUMENT_LIMITS, _read_integer
+    return None if text is None else _read_integer(f"--{name}", text, *_ARGUMENT_LIMITS[name])
+
+
 def run_command(prog: str, run: Callable[[], int], exit_codes: Sequence[tuple[type, int]]) -> int:
     """``run()``'s exit code; for an exception, "PROG: error: MESSAGE" on stderr and the code
     ``exit_codes`` gives its kind (first match), or 3 for one it does not list, named with its type

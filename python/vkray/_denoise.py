@@ -22,6 +22,9 @@ from ._vkray import DeviceError, UsageError
 #: The qualities OIDN offers, fastest last.
 QUALITIES = ("high", "balanced", "fast")
 
+#: The first-hit passes that guide the denoiser, in the order denoise() takes them.
+GUIDES = ("albedo", "normal")
+
 
 def _image(name: str, value: Any, shape: Optional[tuple[int, ...]]) -> np.ndarray:
     """``value`` as a contiguous float32 (height, width, 3) array, or a UsageError naming ``name``."""

@@ -12,9 +12,6 @@ from pathlib import Path
 import vkray
 from vkray import _denoise
 
-#: The passes a frame to denoise is rendered with: the denoiser's guides.
-GUIDES = ("albedo", "normal")
-
 
 def _frame_output(output: Path, frame: int, frames: int) -> Path:
     """OUT for one frame; with several, the frame's number before the suffix: out.exr -> out.0001.exr."""
@@ -36,15 +33,15 @@ def _merge_frames(parts: list[list[Path]], folder: Path, suffix: str) -> list[Pa
 
 def _denoise_frames(merged: list[Path], folder: Path, suffix: str, passes: Sequence[str], exr_float: bool,
                     say: Callable[[str], None]) -> list[Path]:
-    """Denoises each merged frame (a float EXR that holds the guides, GUIDES) with Intel Open Image
-    Denoise into a file of its own in `folder`, of the output's type (`suffix`), that keeps
-    `passes` beside the denoised colour; returns those files, frame by frame. The whole frame is
+    """Denoises each merged frame (a float EXR that holds the guides, _denoise.GUIDES) with Intel
+    Open Image Denoise into a file of its own in `folder`, of the output's type (`suffix`), that
+    keeps `passes` beside the denoised colour; returns those files, frame by frame. The whole frame is
     denoised at once: the denoiser looks across the bands' edges."""
     denoised = []
     for frame, file in enumerate(merged):
         arrays, _ = vkray._vkray._read_image(file)
         start = time.perf_counter()
-        color = _denoise.denoise(arrays["color"], *(arrays[guide] for guide in GUIDES))
+        color = _denoise.denoise(arrays["color"], *(arrays[guide] for guide in _denoise.GUIDES))
         say(f"denoised frame {frame} ({color.shape[1]}x{color.shape[0]}) in {time.perf_counter() - start:.2f} s")
         denoised.append(folder / f"denoised{frame:05d}{suffix}")
         vkray._vkray._write_image(denoised[-1], {**{name: arrays[name] for name in passes}, "color": color}, exr_float)

@@ -27,10 +27,9 @@ from typing import Any, Optional
 
 import vkray
 from vkray import _denoise
-from vkray._commands import add_image_options, run_command
+from vkray._commands import add_image_options, read_image_option, run_command
 
 _SCENE_SUFFIXES = (".json", ".gltf", ".glb")
-_GUIDES = ("albedo", "normal")
 
 
 class _Usage(Exception):
@@ -65,16 +64,6 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _limited(name: str, text: Optional[str]) -> Optional[int]:
-    """--width, --height, --spp or --seed, read and checked as `vkray render` reads its flags."""
-    if text is None:
-        return None
-    try:
-        return vkray._vkray._read_integer(f"--{name}", text, *vkray._vkray._ARGUMENT_LIMITS[name])
-    except vkray.UsageError as e:
-        raise _Usage(str(e)) from None
-
-
 def _log(quiet: bool, line: str) -> None:
     if not quiet:
         print(f"vkray.denoise: {line}", file=sys.stderr)
@@ -88,7 +77,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         if given:
             raise _Usage(f"{', '.join(given)}: for a scene to render; {args.input} is an image to denoise")
     extra = [name for name in args.aov.split(",") if name] if from_scene else []
-    guides = [] if args.without_guides else list(_GUIDES)
+    guides = [] if args.without_guides else list(_denoise.GUIDES)
     written = extra + [g for g in guides if g not in extra]
     exr = Path(args.output).suffix.lower() == ".exr"
     # The output is checked before any work, as `vkray render` checks it (--aov for an output that is
@@ -97,7 +86,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
 
     start = time.monotonic()
     if from_scene:
-        sizes = {name: _limited(name, getattr(args, name)) for name in ("width", "height", "spp", "seed")}
+        sizes = {name: read_image_option(name, getattr(args, name)) for name in ("width", "height", "spp", "seed")}
         _denoise._oidn()
         result = vkray.render(args.input, aovs=written, device=args.device, **sizes)
         arrays = result if written else {"color": result}

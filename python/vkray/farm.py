@@ -47,10 +47,10 @@ from typing import Optional, Sequence
 import vkray
 
 from . import _denoise
-from ._commands import add_image_options, no_interrupts, run_command
+from ._commands import add_image_options, no_interrupts, read_image_option, run_command
 from ._farm_cluster import _close, _connect, _gpu_workers, _require_dask
 from ._farm_errors import _CannotWrite, _ClusterError, _MissingPackage, _Usage
-from ._farm_outputs import GUIDES, _commit, _denoise_frames, _frame_output, _merge_frames
+from ._farm_outputs import _commit, _denoise_frames, _frame_output, _merge_frames
 from ._farm_parts import _PART_SUFFIX, _frame_parts, _Job, _Part
 from ._farm_worker import _render_part  # noqa: F401  (the task, also as vkray.farm._render_part)
 
@@ -138,12 +138,6 @@ def _integer(option: str, text: str, low: int, high: int) -> int:
         raise _Usage(str(e)) from None
 
 
-def _limited(name: str, text: Optional[str]) -> Optional[int]:
-    """--width, --height, --spp or --seed (`name`), against the library's table of limits, which
-    `vkray render` checks its flags with."""
-    return None if text is None else _integer(f"--{name}", text, *vkray._vkray._ARGUMENT_LIMITS[name])
-
-
 def _arguments(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     """The command line, its integers read and checked as `vkray render` reads and checks its flags,
     before anything else: --width, --height, --spp and --seed against the library's table of limits,
@@ -151,7 +145,7 @@ def _arguments(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     the scenes are read."""
     args = _parser().parse_args(_glued(sys.argv[1:] if argv is None else argv))
     for name in _LIMITED:
-        setattr(args, name, _limited(name, getattr(args, name)))
+        setattr(args, name, read_image_option(name, getattr(args, name)))
     args.workers = _integer("--workers", args.workers, 1, _MAX_WORKERS)
     # Its range is the rows of a frame, known once the scenes are read (run()).
     args.regions = None if args.regions is None else _integer("--regions", args.regions, 0, 2**32 - 1)
@@ -184,7 +178,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
             raise _MissingPackage(str(e)) from None
         # The parts render the guides too, at full precision: the denoiser's input is the image a
         # single render gives. An .exr output keeps them.
-        rendered_passes = aovs + [guide for guide in GUIDES if guide not in aovs]
+        rendered_passes = aovs + [guide for guide in _denoise.GUIDES if guide not in aovs]
         kept = rendered_passes if output.suffix.lower() == ".exr" else []
         vkray._vkray._check_output(output, kept, args.exr_float, False)
         settings.update(aovs=",".join(rendered_passes), exr_float=True)
