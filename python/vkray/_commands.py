@@ -63,9 +63,19 @@ def run_command(prog: str, run: Callable[[], int], exit_codes: Sequence[tuple[ty
     any exception after one."""
     global _interrupted
     _interrupted = False
+    # The handlers are this call's: a program that calls main() has its own back afterwards.
+    previous = {}
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, _interrupt)
-        signal.signal(signal.SIGTERM, _interrupt)
+        for number in (signal.SIGINT, signal.SIGTERM):
+            previous[number] = signal.signal(number, _interrupt)
+    try:
+        return _ended(prog, run, exit_codes)
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+def _ended(prog: str, run: Callable[[], int], exit_codes: Sequence[tuple[type, int]]) -> int:
     try:
         return run()
     except KeyboardInterrupt:
